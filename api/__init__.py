@@ -1,0 +1,1 @@
+"""HTTP service (FastAPI): tasks, events, plans, domain checks."""

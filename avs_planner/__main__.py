@@ -1,0 +1,5 @@
+import sys
+
+from avs_planner.cli import main
+
+sys.exit(main())

@@ -1,0 +1,1 @@
+"""Probabilistic PDDL: unified-planning's reader plus PPDDL's single-outcome `probabilistic`."""
