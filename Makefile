@@ -24,7 +24,7 @@ $(VENV)/.installed-bench: pyproject.toml | $(BIN)/python
 
 ## run: set up .venv and run the main job on the built-in defaults
 run: $(VENV)/.installed
-	$(BIN)/avs plan domains/avs/problems/corridor.pddl
+	$(BIN)/avs plan domains/avs/domain.pddl domains/avs/problems/corridor.pddl
 
 ## test: set up .venv with test extras and run the fast test suite
 test: $(VENV)/.installed-dev
