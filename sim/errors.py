@@ -7,3 +7,18 @@ class SimError(Exception):
 
 class WorldFileError(SimError):
     """A world file is malformed or describes an impossible world (names the offending entry)."""
+
+
+class MotionError(SimError):
+    """A motion request cannot be executed: blocked path, joint limit, malformed target.
+
+    The robot does not move and its clock does not advance when this is raised.
+    """
+
+
+class PathBlockedError(MotionError):
+    """`move_along` refused a path because the robot's footprint would hit the world."""
+
+
+class JointLimitError(MotionError):
+    """A torso or head target lies outside the robot's joint limits."""
