@@ -1,0 +1,61 @@
+"""The service's one settings object, read from `AVS_*` environment variables."""
+
+from __future__ import annotations
+
+import ipaddress
+from pathlib import Path
+from typing import Literal
+
+from pydantic import Field
+from pydantic_settings import BaseSettings, SettingsConfigDict
+
+DEFAULT_EPISODE_RUNNER = "avs_planner.jobs:run_episode"
+
+
+class Settings(BaseSettings):
+    """Everything the service can be told; `AVS_API_KEY` sets `api_key`, and so on."""
+
+    model_config = SettingsConfigDict(env_prefix="AVS_", extra="ignore")
+
+    api_key: str | None = Field(None, description="required in X-API-Key on mutating calls")
+    host: str = "127.0.0.1"
+    port: int = Field(8000, ge=0, le=65535)
+    data_dir: Path = Path(".avs-data")
+    workers: int = Field(2, ge=1, le=64, description="processes running episodes")
+    plan_workers: int = Field(1, ge=1, le=64, description="processes running plans/checks")
+    queue_size: int = Field(16, ge=1, description="queued tasks accepted before 503")
+    plan_queue_size: int = Field(8, ge=1, description="waiting plan/check jobs before 503")
+    task_time_limit_s: float = Field(900.0, gt=0, description="wall clock per episode")
+    plan_time_limit_s: float = Field(60.0, gt=0, description="wall clock per plan/check job")
+    cancel_grace_s: float = Field(2.0, ge=0, description="time to stop before a kill")
+    memory_limit_mb: int = Field(2048, ge=0, description="address-space limit per worker; 0=none")
+    max_body_bytes: int = Field(1_000_000, ge=1024)
+    rate_limit_per_minute: float = Field(120.0, gt=0, description="mutating calls per key")
+    rate_limit_burst: int = Field(30, ge=1)
+    on_restart: Literal["fail", "requeue"] = "fail"
+    episode_runner: str = Field(
+        DEFAULT_EPISODE_RUNNER, description="'module:function' or '/path/file.py:function'"
+    )
+    worlds_dir: Path | None = Field(None, description="built-in worlds; default: sim/worlds")
+
+    @property
+    def db_path(self) -> Path:
+        return self.data_dir / "avs.sqlite3"
+
+    @property
+    def tasks_dir(self) -> Path:
+        return self.data_dir / "tasks"
+
+    def is_open(self) -> bool:
+        """True when no API key is configured (then the service must stay on loopback)."""
+        return not self.api_key
+
+
+def is_loopback(host: str) -> bool:
+    """Whether `host` names only this machine (so an open service is not reachable from outside)."""
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False

@@ -1,0 +1,71 @@
+"""Dependencies shared by the routes, as `Annotated` aliases (the FastAPI template's idiom)."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated
+
+from fastapi import Depends, Header, HTTPException, Path, Request, status
+
+from api.config import Settings
+from api.manager import TaskManager
+from api.security import RateLimiter, key_matches, owner_of
+from api.store import TaskRecord, TaskStore
+
+
+def get_settings(request: Request) -> Settings:
+    return request.app.state.settings
+
+
+def get_manager(request: Request) -> TaskManager:
+    return request.app.state.manager
+
+
+def get_store(request: Request) -> TaskStore:
+    return request.app.state.manager.store
+
+
+SettingsDep = Annotated[Settings, Depends(get_settings)]
+ManagerDep = Annotated[TaskManager, Depends(get_manager)]
+StoreDep = Annotated[TaskStore, Depends(get_store)]
+
+
+def require_write_access(
+    request: Request,
+    settings: SettingsDep,
+    x_api_key: Annotated[str | None, Header(description="required when AVS_API_KEY is set")] = None,
+) -> str:
+    """Check the API key (401) and the caller's rate limit (429); returns the caller's owner id."""
+    if settings.api_key and not key_matches(x_api_key, settings.api_key):
+        raise HTTPException(
+            status.HTTP_401_UNAUTHORIZED,
+            detail="missing or wrong X-API-Key header (this service requires an API key)",
+            headers={"WWW-Authenticate": "X-API-Key"},
+        )
+    host = request.client.host if request.client else "unknown"
+    owner = owner_of(x_api_key if settings.api_key else None, host)
+    limiter: RateLimiter = request.app.state.rate_limiter
+    wait = limiter.acquire(owner)
+    if wait > 0:
+        raise HTTPException(
+            status.HTTP_429_TOO_MANY_REQUESTS,
+            detail=f"rate limit of {settings.rate_limit_per_minute:g} calls/minute exceeded; "
+            f"retry in {wait:.1f} s",
+            headers={"Retry-After": str(math.ceil(wait))},
+        )
+    return owner
+
+
+WriteAccess = Annotated[str, Depends(require_write_access)]
+
+TaskId = Annotated[str, Path(max_length=64, description="a task id")]
+
+
+def get_task(task_id: TaskId, store: StoreDep) -> TaskRecord:
+    task = store.get(task_id)
+    if task is None:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, detail=f"no task with id {task_id}")
+    return task
+
+
+TaskDep = Annotated[TaskRecord, Depends(get_task)]

@@ -1,0 +1,52 @@
+"""Turning a plan/check job's outcome into a response body or the right HTTP error."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from fastapi import HTTPException, status
+
+from api.manager import QueueFullError, TaskManager
+from api.workers import JobOutcome
+
+UNAVAILABLE = "JobUnavailableError"
+
+
+async def run_job(manager: TaskManager, kind: str, payload: dict[str, Any]) -> Any:
+    """The job's return value; 503 when busy or the planner is missing, 504 on the wall clock."""
+    try:
+        result = await manager.run_job(kind, payload)
+    except QueueFullError as exc:
+        raise HTTPException(
+            status.HTTP_503_SERVICE_UNAVAILABLE, detail=f"too many jobs waiting ({exc}); retry",
+            headers={"Retry-After": "2"},
+        ) from exc
+    if result.outcome is JobOutcome.DONE:
+        return result.value
+    if result.outcome is JobOutcome.TIMEOUT:
+        raise HTTPException(status.HTTP_504_GATEWAY_TIMEOUT, detail=f"{kind}: {result.error}")
+    if result.error_type in (UNAVAILABLE, "MemoryError") or result.outcome is JobOutcome.SHUTDOWN:
+        raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE, detail=f"{kind}: {result.error}")
+    raise HTTPException(
+        status.HTTP_500_INTERNAL_SERVER_ERROR,
+        detail=f"{kind} failed: {result.error_type or result.outcome.value}: {result.error}",
+    )
+
+
+def pddl_422(errors: list[dict[str, Any]]) -> HTTPException:
+    """422 whose `detail` lists each PDDL error with its body field, line and column."""
+    detail = [
+        {
+            "type": "pddl_error",
+            "loc": ["body", _field(e.get("file", ""))],
+            "msg": e.get("message", ""),
+            "line": e.get("line"),
+            "column": e.get("column"),
+        }
+        for e in errors
+    ]
+    return HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, detail=detail)
+
+
+def _field(file: str) -> str:
+    return file if file in ("domain", "problem") else file or "body"

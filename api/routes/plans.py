@@ -1,0 +1,28 @@
+"""/plans: plan a probabilistic PDDL problem (the same planner `avs plan` runs)."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from api.deps import ManagerDep, WriteAccess
+from api.routes.jobs import pddl_422, run_job
+from api.schemas import Message, PlanCreate, PlanPublic
+
+router = APIRouter(prefix="/plans", tags=["plans"])
+
+
+@router.post(
+    "",
+    responses={
+        401: {"model": Message}, 422: {"model": Message, "description": "bad input or PDDL"},
+        429: {"model": Message}, 503: {"model": Message}, 504: {"model": Message},
+    },
+)
+async def create_plan(body: PlanCreate, owner: WriteAccess, manager: ManagerDep) -> PlanPublic:
+    """Plan: 200 with status (solved, unsolvable, timeout, ...) and the plan; 422 for bad PDDL."""
+    options = body.model_dump(include={"reward", "weight", "timeout_s"}, exclude_none=True)
+    payload = {"domain_text": body.domain, "problem_text": body.problem, "options": options}
+    value = await run_job(manager, "plan", payload)
+    if value.get("status") == "invalid":
+        raise pddl_422(value.get("errors", []))
+    return PlanPublic.model_validate(value)

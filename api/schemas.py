@@ -1,0 +1,146 @@
+"""Request and response bodies, in families per resource (`TaskCreate`, `TaskPublic`, ...)."""
+
+from __future__ import annotations
+
+from enum import StrEnum
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+NAME_PATTERN = r"^[A-Za-z][A-Za-z0-9_-]{0,63}$"
+MAX_TEXT = 500_000
+
+
+class TaskState(StrEnum):
+    """Where a task is in its life; the last five are terminal."""
+
+    QUEUED = "queued"
+    RUNNING = "running"
+    SUCCEEDED = "succeeded"
+    FAILED = "failed"
+    GAVE_UP = "gave_up"
+    TIMEOUT = "timeout"
+    CANCELLED = "cancelled"
+
+    @property
+    def terminal(self) -> bool:
+        return self not in (TaskState.QUEUED, TaskState.RUNNING)
+
+
+class TaskCreate(BaseModel):
+    """Find `target` (a label) [in a room of `category`] in a world, with a robot."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    target: str = Field(pattern=NAME_PATTERN, examples=["cerealbox"])
+    category: str | None = Field(None, pattern=NAME_PATTERN, examples=["kitchen"])
+    world: str | None = Field(None, pattern=NAME_PATTERN, description="a built-in world name")
+    world_file: str | None = Field(
+        None, max_length=MAX_TEXT, description="an inline world file (YAML text)"
+    )
+    robot: Literal["pioneer", "pr2"] = "pioneer"
+    start_room: str | None = Field(None, pattern=NAME_PATTERN)
+    start: tuple[float, float, float] | None = Field(
+        None, description="start pose x, y, yaw (m, m, rad); default: the world's"
+    )
+    seed: int = Field(0, ge=0, le=2**31 - 1)
+    time_budget_s: float = Field(600.0, gt=0, le=86_400, description="simulated seconds")
+
+    @model_validator(mode="after")
+    def _one_world(self) -> TaskCreate:
+        if (self.world is None) == (self.world_file is None):
+            raise ValueError("give exactly one of 'world' (a name) or 'world_file' (YAML text)")
+        if self.start is not None and self.start_room is not None:
+            raise ValueError("give at most one of 'start' and 'start_room'")
+        return self
+
+
+class TaskPublic(BaseModel):
+    """A task as clients see it."""
+
+    id: str
+    state: TaskState
+    request: dict[str, Any]
+    created_at: float
+    started_at: float | None = None
+    finished_at: float | None = None
+    summary: dict[str, Any] | None = None
+    error: str | None = None
+    events: int = 0
+
+
+class TasksPublic(BaseModel):
+    data: list[TaskPublic]
+    count: int
+
+
+class PlanCreate(BaseModel):
+    """A domain and a problem in (probabilistic) PDDL, with planner options."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    domain: str = Field(min_length=1, max_length=MAX_TEXT)
+    problem: str = Field(min_length=1, max_length=MAX_TEXT)
+    reward: float | None = Field(None, gt=0, description="R in c(pi) + R(1 - p(pi))")
+    weight: float | None = Field(None, ge=1, le=100)
+    timeout_s: float | None = Field(None, gt=0, le=3600)
+
+
+class PlanPublic(BaseModel):
+    """The planner's answer: status, plan and its cost, success probability and objective."""
+
+    status: str
+    plan: list[str] = []
+    cost: float | None = None
+    probability: float | None = None
+    objective: float | None = None
+    planning_time_s: float | None = None
+    expanded: int | None = None
+
+
+class DomainCheckCreate(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    domain: str = Field(min_length=1, max_length=MAX_TEXT)
+    problems: list[str] = Field(default_factory=list, max_length=50)
+
+
+class Diagnostic(BaseModel):
+    """One linter finding; `file` is `domain` or `problem[i]`."""
+
+    file: str
+    line: int
+    column: int
+    severity: Literal["error", "warning"]
+    message: str
+    code: str
+
+
+class DomainCheckPublic(BaseModel):
+    ok: bool
+    errors: int
+    warnings: int
+    diagnostics: list[Diagnostic]
+
+
+class WorldPublic(BaseModel):
+    name: str
+    rooms: list[str] = []
+
+
+class WorldsPublic(BaseModel):
+    data: list[WorldPublic]
+    count: int
+
+
+class Health(BaseModel):
+    status: Literal["ok"]
+    version: str
+    workers: int
+    queued: int
+    running: int
+    open_access: bool
+
+
+class Message(BaseModel):
+    detail: Any

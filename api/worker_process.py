@@ -1,0 +1,99 @@
+"""What runs inside a worker process: a loop taking jobs over a pipe and sending back events.
+
+Kept free of heavy imports at module level so a spawned worker starts fast; the job functions
+(`avs_planner.jobs` or an injected episode runner) are imported on first use.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import resource
+import traceback
+from collections.abc import Callable
+from multiprocessing.connection import Connection
+from pathlib import Path
+from typing import Any
+
+STOP = "stop"
+JOB_FUNCTIONS = {
+    "plan": "avs_planner.jobs:plan",
+    "check": "avs_planner.jobs:check_domain",
+}
+
+
+def resolve(spec: str) -> Callable[..., Any]:
+    """A function from 'package.module:name' or '/path/to/file.py:name'."""
+    target, sep, name = spec.rpartition(":")
+    if not sep or not target or not name:
+        raise ValueError(f"runner spec {spec!r} is not 'module:function' or 'file.py:function'")
+    if target.endswith(".py"):
+        path = Path(target)
+        module_spec = importlib.util.spec_from_file_location(f"_avs_runner_{path.stem}", path)
+        if module_spec is None or module_spec.loader is None:
+            raise ValueError(f"cannot load runner file {target}")
+        module = importlib.util.module_from_spec(module_spec)
+        module_spec.loader.exec_module(module)
+    else:
+        module = importlib.import_module(target)
+    return getattr(module, name)
+
+
+def limit_memory(memory_limit_mb: int) -> None:
+    """Cap this process's address space so a runaway job fails with MemoryError, not the host."""
+    if memory_limit_mb <= 0:
+        return
+    limit = memory_limit_mb * 1024 * 1024
+    _soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    if hard != resource.RLIM_INFINITY:
+        limit = min(limit, hard)
+    resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
+
+
+class _Channel:
+    """The worker's end of the pipe: emit events, notice a stop request."""
+
+    def __init__(self, conn: Connection):
+        self.conn = conn
+        self.stopped = False
+
+    def emit(self, event: dict[str, Any]) -> None:
+        self.conn.send(("event", dict(event)))
+
+    def should_stop(self) -> bool:
+        while not self.stopped and self.conn.poll():
+            self.stopped = self.conn.recv() == STOP
+        return self.stopped
+
+
+def _run_job(channel: _Channel, episode_runner: str, kind: str, payload: dict[str, Any]) -> Any:
+    if kind == "episode":
+        runner = resolve(episode_runner)
+        return runner(payload, channel.emit, channel.should_stop)
+    function = resolve(JOB_FUNCTIONS[kind])
+    return function(**payload)
+
+
+def worker_main(conn: Connection, memory_limit_mb: int, episode_runner: str) -> None:
+    """Serve jobs until the pipe closes or a None job arrives."""
+    limit_memory(memory_limit_mb)
+    while True:
+        try:
+            message = conn.recv()
+        except (EOFError, OSError):
+            return
+        if message is None:
+            return
+        if message == STOP:  # a stop that arrived after its job ended
+            continue
+        kind, payload = message
+        channel = _Channel(conn)
+        try:
+            value = _run_job(channel, episode_runner, kind, payload)
+            conn.send(("result", value))
+        except MemoryError:
+            conn.send(("error", "MemoryError", f"memory limit of {memory_limit_mb} MB exceeded"))
+        except Exception as exc:  # noqa: BLE001 - reported to the parent, never lost
+            name = type(exc).__name__
+            detail = str(exc) or traceback.format_exc(limit=3)
+            conn.send(("error", name, detail))

@@ -1,0 +1,54 @@
+"""The built-in worlds clients may name in a task: the YAML files in `sim/worlds/`.
+
+Only the file names (and room names, for display) are read here; the episode runner loads and
+validates worlds. `sim` is located, not imported, so the API does not start PyBullet.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import yaml
+
+from api.schemas import WorldPublic
+
+
+def default_worlds_dir() -> Path | None:
+    """`sim/worlds` next to the installed `sim` package, if there is one."""
+    spec = importlib.util.find_spec("sim")
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    return Path(next(iter(spec.submodule_search_locations))) / "worlds"
+
+
+def list_worlds(directory: Path | None) -> list[WorldPublic]:
+    """The worlds in `directory` (`*.yaml`, `*.yml`), sorted by name."""
+    if directory is None or not directory.is_dir():
+        return []
+    files = sorted([*directory.glob("*.yaml"), *directory.glob("*.yml")])
+    return [WorldPublic(name=f.stem, rooms=_room_names(f)) for f in files]
+
+
+def _room_names(path: Path) -> list[str]:
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError):
+        return []
+    rooms = data.get("rooms") if isinstance(data, dict) else None
+    if not isinstance(rooms, list):
+        return []
+    return [str(r["name"]) for r in rooms if isinstance(r, dict) and "name" in r]
+
+
+def world_file_problem(text: str) -> str | None:
+    """Why an inline world file cannot be a world (not YAML, not a mapping), or None."""
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        return f"world_file is not valid YAML{where}: {getattr(exc, 'problem', exc)}"
+    if not isinstance(data, dict):
+        return "world_file must be a YAML mapping (name, size, rooms, ...)"
+    return None

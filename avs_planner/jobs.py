@@ -1,0 +1,93 @@
+"""The planner package as the HTTP service sees it: three plain-data jobs, nothing else.
+
+The service runs these in worker processes, so inputs and outputs are JSON-able dicts and the
+heavy modules are imported on first use. A missing part (e.g. the episode runner before
+`avs_planner/episode.py` exists) raises `JobUnavailableError`, never a fake result.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+from avs_planner.errors import AvsError, PddlError
+
+DOMAIN_NAME = "domain"
+PROBLEM_NAME = "problem"
+
+Emit = Callable[[dict[str, Any]], None]
+ShouldStop = Callable[[], bool]
+
+
+class JobUnavailableError(AvsError):
+    """The part of the planner a job needs is not installed or not written yet."""
+
+
+def _require(module: str, what: str) -> Any:
+    try:
+        return importlib.import_module(module)
+    except ImportError as exc:
+        raise JobUnavailableError(f"{what} not available yet ({module}: {exc})") from exc
+
+
+def problem_name(index: int) -> str:
+    """How the i-th problem text is named in diagnostics: `problem[i]`."""
+    return f"{PROBLEM_NAME}[{index}]"
+
+
+def check_domain(domain_text: str, problem_texts: Sequence[str] = ()) -> list[dict[str, Any]]:
+    """Lint a domain and its problems: one dict per diagnostic (file, line, column, severity,
+    message, code); files are named `domain` and `problem[i]`."""
+    pddl = _require("avs_planner.pddl", "the PDDL linter")
+    if not hasattr(pddl, "check_text"):
+        raise JobUnavailableError("the PDDL linter (avs_planner.pddl.check_text) not available yet")
+    problems = [(problem_name(i), text) for i, text in enumerate(problem_texts)]
+    found = pddl.check_text(domain_text, problems, domain_name=DOMAIN_NAME)
+    return [_diagnostic(d) for d in found]
+
+
+def _diagnostic(d: Any) -> dict[str, Any]:
+    severity = getattr(d.severity, "value", d.severity)
+    return {
+        "file": d.file, "line": int(d.line), "column": int(d.column),
+        "severity": str(severity), "message": d.message, "code": d.code,
+    }
+
+
+def plan(domain_text: str, problem_text: str, options: Mapping[str, Any] | None = None) -> dict:
+    """Read and plan one problem. Returns `avs plan --json`'s dict, or
+    `{"status": "invalid", "errors": [{file, line, column, message}]}` for bad PDDL/options."""
+    pddl = _require("avs_planner.pddl", "the PDDL reader")
+    planner = _require("avs_planner.cp.planner", "the continual planner")
+    search = _require("avs_planner.cp.search", "the continual planner")
+    try:
+        problem = pddl.read_text(domain_text, problem_text, DOMAIN_NAME, PROBLEM_NAME)
+    except PddlError as exc:
+        return _invalid(exc.file, exc.line, exc.column, exc.message)
+    try:
+        search_options = search.SearchOptions(**dict(options or {})).check()
+        result = planner.plan(problem, search_options)
+    except PddlError as exc:
+        return _invalid(exc.file, exc.line, exc.column, exc.message)
+    except TypeError as exc:  # an option the planner does not know
+        return _invalid("options", 1, 1, str(exc))
+    except AvsError as exc:  # PlanningError: a bad option value or an unsupported problem
+        return _invalid("options", 1, 1, str(exc))
+    return result.as_json()
+
+
+def _invalid(file: str, line: int, column: int, message: str) -> dict[str, Any]:
+    error = {"file": file, "line": line, "column": column, "message": message}
+    return {"status": "invalid", "errors": [error]}
+
+
+def run_episode(spec: Mapping[str, Any], emit: Emit, should_stop: ShouldStop) -> dict[str, Any]:
+    """Run one search episode (the switching loop), streaming trace events through `emit` and
+    stopping early when `should_stop()`; returns the summary (`outcome`: found/gave_up/timeout)."""
+    episode = _require("avs_planner.episode", "the episode runner (switching loop)")
+    runner = getattr(episode, "run_episode", None)
+    if runner is None:
+        raise JobUnavailableError("the episode runner (avs_planner.episode.run_episode) not "
+                                  "available yet")
+    return runner(dict(spec), emit, should_stop)

@@ -1,0 +1,55 @@
+"""An injected episode runner for testing the task machinery (queueing, events, cancel,
+persistence) without the real switching loop. Its behaviour is chosen by the task's target label;
+it is loaded by file path in the worker process (see `api.worker_process.resolve`)."""
+
+from __future__ import annotations
+
+import struct
+import time
+import zlib
+from pathlib import Path
+from typing import Any
+
+RUNNER = f"{Path(__file__).resolve()}:run"
+
+
+def _png_1x1() -> bytes:
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
+
+    header = struct.pack(">IIBBBBB", 1, 1, 8, 2, 0, 0, 0)
+    pixels = zlib.compress(b"\x00\xff\x00\x00")
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", pixels) + chunk(
+        b"IEND", b""
+    )
+
+
+def run(spec: dict[str, Any], emit: Any, should_stop: Any) -> dict[str, Any]:
+    behaviour = spec["target"]
+    for i in range(3):
+        emit({"t": float(i), "wall": 0.0, "type": "action", "step": i})
+    if behaviour == "quick":
+        Path(spec["output_dir"], "trajectory.png").write_bytes(_png_1x1())
+        return {"outcome": "found", "target": spec["target"], "seed": spec["seed"]}
+    if behaviour == "hopeless":
+        return {"outcome": "gave_up", "target": spec["target"]}
+    if behaviour == "boom":
+        raise RuntimeError("runner exploded on purpose")
+    if behaviour == "hog":
+        blocks = [bytearray(64 * 1024 * 1024) for _ in range(64)]
+        return {"outcome": "found", "blocks": len(blocks)}
+    if behaviour == "stubborn":  # ignores should_stop: must be killed
+        time.sleep(60)
+    if behaviour == "slow":
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline:
+            if should_stop():
+                return {"outcome": "gave_up", "stopped": True}
+            time.sleep(0.02)
+    if behaviour == "ticker":  # a steady stream of events, for the SSE tests
+        for i in range(20):
+            emit({"t": float(3 + i), "wall": 0.0, "type": "observation", "step": 3 + i})
+            time.sleep(0.01)
+        return {"outcome": "found"}
+    return {"outcome": "nonsense"}
