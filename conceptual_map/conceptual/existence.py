@@ -1,0 +1,199 @@
+"""Object existence as Poisson processes (seed 003 eq. 1-2) and the evidence objects give.
+
+Given a room's category c, the number of `label` objects at a location L is Poisson(lambda_{L,c});
+locations are independent, so lambdas add over a location and its sub-locations. A search that
+covers a fraction `coverage` of L with detector reliability `p_detect` finds each object with
+q = coverage * p_detect; after failed searches the undetected count is Poisson(lambda * r) with
+r = prod(1 - q_i), and the failures have likelihood exp(-lambda * (1 - r)) (Poisson thinning).
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import poisson
+
+from conceptual_map.conceptual.errors import ConceptualError
+from conceptual_map.knowledge import RELATIONS, Knowledge
+
+
+@dataclass(frozen=True)
+class RelatedSpace:
+    """The space `relation` ("in"/"on") a known object, e.g. on object1 (a table)."""
+
+    relation: str
+    object_id: str
+
+
+Location = str | RelatedSpace
+"""A room id, or a related space of a known object."""
+
+
+@dataclass(frozen=True)
+class ObjectRecord:
+    """A detected object; `support` is the object it is on/in, if any."""
+
+    object_id: str
+    label: str
+    room: str
+    relation: str | None = None
+    support: str | None = None
+
+    @property
+    def location(self) -> Location:
+        if self.support is None or self.relation is None:
+            return self.room
+        return RelatedSpace(self.relation, self.support)
+
+
+def p_at_least_one(lam: np.ndarray | float) -> np.ndarray:
+    """P(n >= 1) = 1 - exp(-lambda)."""
+    return -np.expm1(-np.asarray(lam, dtype=float))
+
+
+def p_at_least(k: int, lam: np.ndarray | float) -> np.ndarray:
+    """P(n >= k) for n ~ Poisson(lambda)."""
+    return np.asarray(poisson.sf(k - 1, np.asarray(lam, dtype=float)), dtype=float)
+
+
+def failed_search_likelihood(lam: np.ndarray | float, remaining: float) -> np.ndarray:
+    """P(nothing detected | lambda) after searches leaving a fraction `remaining` unseen."""
+    return np.exp(-np.asarray(lam, dtype=float) * (1.0 - remaining))
+
+
+class ObjectLedger:
+    """Detected objects and failed searches, and the category likelihoods they imply."""
+
+    def __init__(self, knowledge: Knowledge) -> None:
+        self.knowledge = knowledge
+        self.objects: dict[str, ObjectRecord] = {}
+        self._counts: dict[Location, Counter[str]] = {}
+        self._remaining: dict[tuple[Location, str], float] = {}
+
+    def add(
+        self,
+        label: str,
+        room: str,
+        relation: str | None = None,
+        support: str | None = None,
+        object_id: str | None = None,
+    ) -> ObjectRecord:
+        """Record a detected object (a fresh id `object<N>` unless one is given)."""
+        self.require_label(label)
+        if support is not None:
+            self._check_support(room, relation, support)
+        object_id = object_id or self._fresh_id()
+        if object_id in self.objects:
+            raise ConceptualError(f"object id {object_id!r} is already used")
+        record = ObjectRecord(object_id, label, room, relation, support)
+        self.objects[object_id] = record
+        self._counts.setdefault(record.location, Counter())[label] += 1
+        return record
+
+    def _check_support(self, room: str, relation: str | None, support: str) -> None:
+        if relation not in RELATIONS:
+            raise ConceptualError(f"relation must be one of {RELATIONS}, got {relation!r}")
+        holder = self.objects.get(support)
+        if holder is None:
+            raise ConceptualError(f"unknown support object {support!r}")
+        if holder.room != room:
+            raise ConceptualError(f"support {support!r} is in room {holder.room!r}, not {room!r}")
+
+    def _fresh_id(self) -> str:
+        n = len(self.objects) + 1
+        while f"object{n}" in self.objects:
+            n += 1
+        return f"object{n}"
+
+    def require_label(self, label: str) -> None:
+        if label not in self.knowledge.object_lambda:
+            raise ConceptualError(f"unknown object label {label!r} (not in the knowledge)")
+
+    def room_of(self, location: Location) -> str:
+        """The room whose category governs `location`."""
+        if isinstance(location, RelatedSpace):
+            if location.relation not in RELATIONS:
+                raise ConceptualError(f"relation must be one of {RELATIONS}: {location!r}")
+            holder = self.objects.get(location.object_id)
+            if holder is None:
+                raise ConceptualError(f"unknown object {location.object_id!r} in {location!r}")
+            return holder.room
+        return location
+
+    def record_search(self, label: str, location: Location, coverage: float, p_detect: float):
+        """A search of `location` for `label` that found nothing."""
+        self.require_label(label)
+        self.room_of(location)
+        for name, value in (("coverage", coverage), ("p_detect", p_detect)):
+            if not 0.0 <= value <= 1.0:
+                raise ConceptualError(f"{name} must be in [0, 1], got {value!r}")
+        key = (location, label)
+        self._remaining[key] = self._remaining.get(key, 1.0) * (1.0 - coverage * p_detect)
+
+    def count(self, location: Location, label: str) -> int:
+        return self._counts.get(location, Counter())[label]
+
+    def remaining(self, location: Location, label: str) -> float:
+        """Fraction of `label` objects at `location` that searches so far would have missed."""
+        return self._remaining.get((location, label), 1.0)
+
+    def location_lambda(self, label: str, location: Location) -> np.ndarray:
+        """Prior expected count of `label` at `location`, per category."""
+        self.require_label(label)
+        if isinstance(location, RelatedSpace):
+            self.room_of(location)
+            support = self.objects[location.object_id].label
+            return self.knowledge.relation_lambda_of(label, location.relation, support)
+        return self.knowledge.room_lambda(label)
+
+    def sublocations(self, room: str) -> list[RelatedSpace]:
+        """Related spaces (in/on) of the objects detected in `room`."""
+        return [
+            RelatedSpace(relation, record.object_id)
+            for record in self.objects.values()
+            if record.room == room
+            for relation in RELATIONS
+        ]
+
+    def room_likelihood(self, room: str) -> np.ndarray:
+        """P(all object evidence in `room` | category): counts seen and failed searches.
+
+        A location where k >= 1 objects of a label were seen contributes P(n >= k); searches
+        there are then ignored (they succeeded). Otherwise failed searches contribute
+        exp(-lambda (1 - r)).
+        """
+        likelihood = np.ones(len(self.knowledge.categories))
+        for location, label in self._evidence_keys():
+            if self.room_of(location) != room:
+                continue
+            lam = self.location_lambda(label, location)
+            seen = self.count(location, label)
+            if seen:
+                likelihood *= p_at_least(seen, lam)
+            else:
+                likelihood *= failed_search_likelihood(lam, self.remaining(location, label))
+        return likelihood
+
+    def _evidence_keys(self) -> set[tuple[Location, str]]:
+        keys = {(loc, label) for loc, counts in self._counts.items() for label in counts}
+        return keys | set(self._remaining)
+
+    def move_room(self, gone: str, keep: str) -> None:
+        """Objects and room-level searches of `gone` now belong to `keep` (rooms merged).
+
+        Searched fractions cannot be combined without areas, so the merged room keeps the larger
+        unseen fraction: it never claims more coverage than a search achieved.
+        """
+        for object_id, record in list(self.objects.items()):
+            if record.room == gone:
+                self.objects[object_id] = ObjectRecord(
+                    object_id, record.label, keep, record.relation, record.support
+                )
+        moved = self._counts.pop(gone, Counter())
+        self._counts.setdefault(keep, Counter()).update(moved)
+        for (location, label), fraction in list(self._remaining.items()):
+            if location == gone:
+                del self._remaining[(location, label)]
+                self._remaining[(keep, label)] = max(fraction, self.remaining(keep, label))

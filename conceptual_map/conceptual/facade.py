@@ -1,0 +1,263 @@
+"""`ConceptualMap`: the one object the place map feeds with events and the planner queries.
+
+Events (rooms, places, links, placeholders, observations) change the chain graph and mark it
+dirty; the first query afterwards reruns loopy BP, warm-started from the previous messages.
+Ids are plain strings, so any place map can drive it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from types import MappingProxyType
+
+import numpy as np
+from pgmpy.factors.discrete import DiscreteFactor
+
+from conceptual_map.conceptual.bp import BPResult, BPSettings, PairwiseMRF, loopy_bp
+from conceptual_map.conceptual.chain_graph import ChainGraph, PropertyValue
+from conceptual_map.conceptual.errors import ConceptualError
+from conceptual_map.conceptual.existence import (
+    Location,
+    ObjectLedger,
+    RelatedSpace,
+    p_at_least_one,
+)
+from conceptual_map.conceptual.placeholders import (
+    NO_NEW_ROOM,
+    PlaceholderEvidence,
+    PlaceholderPrediction,
+    predict,
+)
+from conceptual_map.knowledge import Knowledge, load_knowledge
+
+
+class ConceptualMap:
+    """Room/placeholder category beliefs and object-existence probabilities (seed 003 §3)."""
+
+    def __init__(
+        self, knowledge: Knowledge | None = None, settings: BPSettings | None = None
+    ) -> None:
+        self.knowledge = knowledge if knowledge is not None else load_knowledge()
+        self.settings = settings or BPSettings()
+        self.graph = ChainGraph(self.knowledge)
+        self.objects = ObjectLedger(self.knowledge)
+        self._placeholders: dict[str, PlaceholderEvidence] = {}
+        self._marginals: dict[str, np.ndarray] = {}
+        self._messages: dict[tuple[str, str], np.ndarray] = {}
+        self._dirty = True
+        self.last_result: BPResult | None = None
+
+    # -- structure events ------------------------------------------------------------------
+
+    def add_room(self, room: str) -> None:
+        self.graph.add_room(room)
+        self._dirty = True
+
+    def add_place(self, place: str, room: str) -> None:
+        """Put a place in a room (creating the room); re-adding moves it."""
+        self.graph.add_place(place, room)
+        self._dirty = True
+
+    def remove_place(self, place: str) -> None:
+        self.graph.remove_place(place)
+        self._dirty = True
+
+    def connect_rooms(self, a: str, b: str) -> None:
+        self.graph.connect(a, b)
+        self._dirty = True
+
+    def disconnect_rooms(self, a: str, b: str) -> None:
+        self.graph.disconnect(a, b)
+        self._dirty = True
+
+    def merge_rooms(self, keep: str, gone: str) -> None:
+        """Two rooms turned out to be one: `gone`'s places, links, objects move to `keep`."""
+        self.graph.merge_rooms(keep, gone)
+        self.objects.move_room(gone, keep)
+        for ph, evidence in self._placeholders.items():
+            if evidence.room == gone:
+                self._placeholders[ph] = PlaceholderEvidence(
+                    keep, evidence.open_space_m2, evidence.p_door
+                )
+        self._refresh_object_evidence(keep)
+
+    # -- placeholders ----------------------------------------------------------------------
+
+    @property
+    def placeholders(self) -> Mapping[str, PlaceholderEvidence]:
+        return MappingProxyType(self._placeholders)
+
+    def add_placeholder(
+        self, placeholder: str, room: str, open_space_m2: float = 0.0, p_door: float = 0.0
+    ) -> None:
+        """A frontier placeholder of `room`, with open space behind it and door belief."""
+        self.graph.require_room(room)
+        self._placeholders[placeholder] = PlaceholderEvidence(room, open_space_m2, p_door)
+
+    def update_placeholder(
+        self,
+        placeholder: str,
+        *,
+        room: str | None = None,
+        open_space_m2: float | None = None,
+        p_door: float | None = None,
+    ) -> None:
+        old = self._placeholder(placeholder)
+        self.add_placeholder(
+            placeholder,
+            room if room is not None else old.room,
+            old.open_space_m2 if open_space_m2 is None else open_space_m2,
+            old.p_door if p_door is None else p_door,
+        )
+
+    def remove_placeholder(self, placeholder: str) -> None:
+        self._placeholder(placeholder)
+        del self._placeholders[placeholder]
+
+    def _placeholder(self, placeholder: str) -> PlaceholderEvidence:
+        try:
+            return self._placeholders[placeholder]
+        except KeyError:
+            raise ConceptualError(f"unknown placeholder {placeholder!r}") from None
+
+    # -- evidence --------------------------------------------------------------------------
+
+    def observe_property(self, place: str, kind: str, value: PropertyValue) -> None:
+        """Property evidence (size, shape, appearance, ...) at a place; replaces older evidence."""
+        self.graph.observe_property(place, kind, value)
+        self._dirty = True
+
+    def observe_object(
+        self,
+        label: str,
+        room: str,
+        on: str | None = None,
+        *,
+        inside: str | None = None,
+        object_id: str | None = None,
+    ) -> str:
+        """A detected object in `room`, optionally on/inside a known object; returns its id."""
+        self.graph.require_room(room)
+        if on is not None and inside is not None:
+            raise ConceptualError(f"object {label!r} cannot be both on {on!r} and in {inside!r}")
+        relation = "on" if on is not None else "in" if inside is not None else None
+        record = self.objects.add(label, room, relation, on or inside, object_id)
+        self._refresh_object_evidence(room)
+        return record.object_id
+
+    def observe_search(
+        self, label: str, location: Location | tuple[str, str], coverage: float, p_detect: float
+    ) -> None:
+        """A search for `label` at `location` found nothing (coverage x detection probability)."""
+        location = _as_location(location)
+        self.objects.record_search(label, location, coverage, p_detect)
+        self._refresh_object_evidence(self._room_of(location))
+
+    def _refresh_object_evidence(self, room: str) -> None:
+        self.graph.set_room_evidence(room, self.objects.room_likelihood(room))
+        self._dirty = True
+
+    def _room_of(self, location: Location) -> str:
+        room = self.objects.room_of(location)
+        self.graph.require_room(room)
+        return room
+
+    # -- inference -------------------------------------------------------------------------
+
+    def update(self, force: bool = False) -> BPResult:
+        """Rerun loopy BP if anything changed (or `force`); returns the run's result."""
+        if self._dirty or force or self.last_result is None:
+            mrf, rooms = self.graph.compile()
+            result = loopy_bp(mrf, self.settings, self._warm_start(mrf, rooms))
+            self._store(mrf, rooms, result)
+        assert self.last_result is not None
+        return self.last_result
+
+    def _warm_start(self, mrf: PairwiseMRF, rooms: list[str]) -> np.ndarray | None:
+        if not self._messages or len(mrf.edges) == 0:
+            return None
+        keys = _directed_keys(mrf, rooms)
+        uniform = np.full(len(self.knowledge.categories), 1.0 / len(self.knowledge.categories))
+        return np.array([self._messages.get(key, uniform) for key in keys])
+
+    def _store(self, mrf: PairwiseMRF, rooms: list[str], result: BPResult) -> None:
+        self._marginals = dict(zip(rooms, result.marginals, strict=True))
+        keys = _directed_keys(mrf, rooms)
+        self._messages = dict(zip(keys, result.messages, strict=True))
+        self.last_result = result
+        self._dirty = False
+
+    def room_marginal(self, room: str) -> np.ndarray:
+        """P_category(room) as a vector in `knowledge.categories` order."""
+        self.graph.require_room(room)
+        self.update()
+        return self._marginals[room]
+
+    def room_category(self, room: str) -> dict[str, float]:
+        """P_category(room)."""
+        return _named(self.knowledge.categories, self.room_marginal(room))
+
+    def placeholder_prediction(self, placeholder: str) -> PlaceholderPrediction:
+        evidence = self._placeholder(placeholder)
+        return predict(self.knowledge, self.room_marginal(evidence.room), evidence)
+
+    def placeholder_category(self, placeholder: str) -> dict[str, float]:
+        """P(placeholder leads to a new room of each category), plus `"none"`: no new room."""
+        prediction = self.placeholder_prediction(placeholder)
+        return {**prediction.any_room, NO_NEW_ROOM: prediction.no_new_room}
+
+    def p_object_at(
+        self, label: str, location: Location | tuple[str, str], include_sublocations: bool = True
+    ) -> float:
+        """P(ObjectAt L): at least one `label` at a room (with its related spaces) or related space.
+
+        Sums, under each room category, the lambdas left unseen by searches over L and (for a
+        room) the in/on spaces of its known objects, then averages over the category belief.
+        """
+        location = _as_location(location)
+        room = self._room_of(location)
+        places = [location]
+        if include_sublocations and not isinstance(location, RelatedSpace):
+            places += self.objects.sublocations(room)
+        if any(self.objects.count(place, label) for place in places):
+            return 1.0
+        residual = sum(
+            self.objects.location_lambda(label, place) * self.objects.remaining(place, label)
+            for place in places
+        )
+        return float(self.room_marginal(room) @ p_at_least_one(residual))
+
+    def p_object_at_category(
+        self, label: str, category: str, support_label: str | None = None, relation: str = "on"
+    ) -> float:
+        """P(ObjectAt L^C): default knowledge for a room of `category` (or `relation` a support)."""
+        try:
+            column = self.knowledge.category_index(category)
+            if support_label is None:
+                lam = self.knowledge.room_lambda(label)
+            else:
+                lam = self.knowledge.relation_lambda_of(label, relation, support_label)
+        except KeyError as exc:
+            raise ConceptualError(str(exc.args[0])) from None
+        return float(p_at_least_one(lam[column]))
+
+    def factors(self, explicit_properties: bool = False) -> list[DiscreteFactor]:
+        """The current chain graph as pgmpy factors (see `ChainGraph.factors`)."""
+        return self.graph.factors(explicit_properties)
+
+
+def _as_location(location: Location | tuple[str, str]) -> Location:
+    if isinstance(location, str | RelatedSpace):
+        return location
+    if isinstance(location, tuple) and len(location) == 2:
+        return RelatedSpace(*location)
+    raise ConceptualError(f"location must be a room id or (relation, object id), got {location!r}")
+
+
+def _directed_keys(mrf: PairwiseMRF, rooms: list[str]) -> list[tuple[str, str]]:
+    forward = [(rooms[a], rooms[b]) for a, b in mrf.edges]
+    return forward + [(b, a) for a, b in forward]
+
+
+def _named(names: tuple[str, ...], values: np.ndarray) -> dict[str, float]:
+    return dict(zip(names, values.tolist(), strict=True))
