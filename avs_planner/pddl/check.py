@@ -1,0 +1,158 @@
+"""`check`: lint a domain and its problems into Diagnostics (what `avs domain check` prints).
+
+The reader runs the same checks first and raises the first error, so a knowledge engineer
+gets the same precise position from `avs plan` as from `avs domain check`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from avs_planner.errors import PddlError
+from avs_planner.pddl.diagnostics import Diagnostic
+from avs_planner.pddl.formulas import FormulaChecker, Usage
+from avs_planner.pddl.probabilistic import translate_domain
+from avs_planner.pddl.problem_checks import check_problem
+from avs_planner.pddl.requirements import check_requirements
+from avs_planner.pddl.sexpr import parse_sexprs
+from avs_planner.pddl.structure import Domain, Report, find_define, read_domain
+
+
+@dataclass(frozen=True)
+class PddlSource:
+    """PDDL text and the name to report it under (a path, or e.g. `<domain>`)."""
+
+    name: str
+    text: str
+
+    @classmethod
+    def from_path(cls, path: str | Path) -> PddlSource:
+        """Read a file; an unreadable file is a PddlError at 1:1."""
+        try:
+            return cls(str(path), Path(path).read_text(encoding="utf-8-sig"))
+        except OSError as exc:
+            raise PddlError(f"cannot read file: {exc.strerror or exc}", str(path)) from exc
+        except UnicodeDecodeError as exc:
+            raise PddlError(f"not a UTF-8 text file ({exc.reason})", str(path)) from exc
+
+
+Source = PddlSource | str | Path
+
+
+def check(domain: Source, problems: Sequence[Source] = ()) -> list[Diagnostic]:
+    """All findings for a domain and its problems; str/Path arguments are file paths."""
+    domain_source = _source(domain)
+    report = Report(domain_source.name)
+    parsed = _read_domain(domain_source, report)
+    if parsed is None:
+        return report.items
+    usage = Usage()
+    _check_domain(parsed, report, usage)
+    diagnostics = report.items
+    for problem in problems:
+        diagnostics += check_problem(parsed, _source(problem), usage)
+    diagnostics += check_requirements(parsed, usage)
+    diagnostics += _unused_predicates(parsed, usage, report.file)
+    return _sorted(diagnostics)
+
+
+def first_error(
+    domain_text: str, problem_text: str, domain_name: str, problem_name: str
+) -> Diagnostic | None:
+    """The first error `check` finds in this domain/problem pair, or None."""
+    found = check(PddlSource(domain_name, domain_text), [PddlSource(problem_name, problem_text)])
+    return next((d for d in found if d.is_error), None)
+
+
+def _sorted(diagnostics: list[Diagnostic]) -> list[Diagnostic]:
+    """Files in the order given, then by position."""
+    order: dict[str, int] = {}
+    for d in diagnostics:
+        order.setdefault(d.file, len(order))
+    return sorted(diagnostics, key=lambda d: (order[d.file], d.line, d.column))
+
+
+def _source(source: Source) -> PddlSource:
+    return source if isinstance(source, PddlSource) else PddlSource.from_path(source)
+
+
+def _read_domain(source: PddlSource, report: Report) -> Domain | None:
+    try:
+        nodes = parse_sexprs(source.text, source.name)
+        translate_domain(source.text, nodes, source.name)
+    except PddlError as exc:
+        report.items.append(Diagnostic.from_error(exc))
+        return None
+    define = find_define(nodes, "domain", report)
+    return None if define is None else read_domain(define, report)
+
+
+def _check_domain(domain: Domain, report: Report, usage: Usage) -> None:
+    checker = FormulaChecker(domain, report, dict(domain.constants), usage)
+    _check_names(domain, report)
+    for entry in domain.constants.values():
+        checker.known_type(entry.atom, entry.type)
+    for sig in [*domain.predicates.values(), *domain.functions.values()]:
+        for param in sig.params:
+            checker.known_type(param.atom, param.type)
+    for action in domain.actions.values():
+        scope = _parameters(action.params, checker, report)
+        if action.precondition is not None:
+            checker.goal(action.precondition, scope)
+        if action.effect is not None:
+            checker.effect(action.effect, scope)
+    for name, node in usage.changed_functions:
+        if name in usage.probability_fluents:
+            report.add(
+                node,
+                "probability-not-static",
+                f"'{name}' is a probability fluent, so no action may change it",
+            )
+
+
+def _parameters(params: list, checker: FormulaChecker, report: Report) -> dict[str, str]:
+    scope: dict[str, str] = {}
+    for param in params:
+        if not param.name.startswith("?"):
+            report.add(param.atom, "syntax", f"parameter must be a variable, not '{param.name}'")
+        elif param.name in scope:
+            report.add(param.atom, "duplicate", f"parameter '{param.name}' is declared twice")
+        checker.known_type(param.atom, param.type)
+        scope[param.name] = param.type
+    return scope
+
+
+def _check_names(domain: Domain, report: Report) -> None:
+    """unified-planning keeps one namespace for types, fluents, actions and objects."""
+    seen: dict[str, str] = {name: "type" for name in domain.type_atoms}
+    groups = [
+        ("predicate", domain.predicates),
+        ("function", domain.functions),
+        ("action", domain.actions),
+        ("constant", domain.constants),
+    ]
+    for kind, table in groups:
+        for name, entry in table.items():
+            if name in seen:
+                report.add(
+                    entry.atom,
+                    "name-clash",
+                    f"{kind} '{name}' has the same name as a {seen[name]}; rename one of them",
+                )
+            else:
+                seen[name] = kind
+
+
+def _unused_predicates(domain: Domain, usage: Usage, file: str) -> list[Diagnostic]:
+    report = Report(file)
+    for name, sig in domain.predicates.items():
+        if name not in usage.predicates:
+            report.add(
+                sig.atom,
+                "unused-predicate",
+                f"predicate '{name}' is never used by an action or goal",
+                warning=True,
+            )
+    return report.items

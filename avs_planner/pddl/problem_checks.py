@@ -1,0 +1,168 @@
+"""Checks of a problem file against its domain: objects, :init, goal, metric, probabilities."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+from avs_planner.errors import PddlError
+from avs_planner.pddl.diagnostics import Diagnostic
+from avs_planner.pddl.formulas import FormulaChecker, Usage
+from avs_planner.pddl.sexpr import Atom, Node, SList, is_number, parse_sexprs
+from avs_planner.pddl.structure import Domain, Problem, Report, find_define, read_problem
+
+GroundAtom = tuple[str, ...]
+
+
+def check_problem(domain: Domain, source, usage: Usage) -> list[Diagnostic]:  # noqa: ANN001
+    """Diagnostics for one problem; goal usage is added to `usage` (requirements, predicates)."""
+    report = Report(source.name)
+    try:
+        nodes = parse_sexprs(source.text, source.name)
+    except PddlError as exc:
+        return [Diagnostic.from_error(exc)]
+    define = find_define(nodes, "problem", report)
+    if define is None:
+        return report.items
+    problem = read_problem(define, report)
+    names = {**domain.constants, **problem.objects}
+    _check_header(domain, problem, report)
+    init_checker = FormulaChecker(domain, report, names, Usage())
+    values = _check_init(problem, init_checker)
+    if problem.goal is not None:
+        FormulaChecker(domain, report, names, usage).goal(problem.goal, {})
+        _goal_true_in_init(problem, values.atoms, report)
+    if problem.metric is not None:
+        _check_metric(problem.metric, init_checker)
+    _check_probabilities(problem, usage, values.numbers, report)
+    return report.items
+
+
+class InitValues:
+    """The ground atoms and numeric assignments of `:init`."""
+
+    def __init__(self) -> None:
+        self.atoms: set[GroundAtom] = set()
+        self.numbers: dict[str, list[tuple[SList, Atom]]] = {}
+
+
+def _check_header(domain: Domain, problem: Problem, report: Report) -> None:
+    ref = problem.domain_ref
+    if ref is not None and domain.name is not None and ref.text != domain.name.text:
+        report.add(
+            ref,
+            "domain-mismatch",
+            f"problem is for domain '{ref.text}' but the domain is '{domain.name.text}'",
+        )
+    checker = FormulaChecker(domain, report, {}, Usage())
+    taken = set(domain.predicates) | set(domain.functions) | set(domain.actions)
+    for name, entry in problem.objects.items():
+        checker.known_type(entry.atom, entry.type)
+        if name in domain.constants:
+            report.add(entry.atom, "duplicate", f"object '{name}' is already a domain constant")
+        elif name in taken or name in domain.type_atoms:
+            report.add(
+                entry.atom,
+                "name-clash",
+                f"object '{name}' has the same name as a type, predicate, function or action",
+            )
+
+
+def _check_init(problem: Problem, checker: FormulaChecker) -> InitValues:
+    values = InitValues()
+    for fact in problem.init:
+        if not isinstance(fact, SList) or not fact.items:
+            checker.report.add(fact, "syntax", "expected a ground atom or (= (f ...) VALUE)")
+        elif fact.head() == "=":
+            _init_assignment(fact, checker, values)
+        elif fact.head() == "not":
+            checker.report.add(fact, "syntax", ":init lists true facts only; drop the (not ...)")
+        else:
+            checker.atom(fact, {})
+            values.atoms.add(_ground(fact))
+    return values
+
+
+def _init_assignment(fact: SList, checker: FormulaChecker, values: InitValues) -> None:
+    if len(fact) != 3 or not isinstance(fact.items[1], SList):
+        checker.report.add(fact, "syntax", "expected (= (FUNCTION ARGS...) VALUE)")
+        return
+    term, value = fact.items[1], fact.items[2]
+    checker.function_term(term, {})
+    if not isinstance(value, Atom) or not is_number(value.text):
+        checker.report.add(value, "syntax", "an initial function value must be a number")
+        return
+    values.numbers.setdefault(term.head(), []).append((term, value))
+
+
+def _ground(node: SList) -> GroundAtom:
+    return tuple(item.text if isinstance(item, Atom) else "()" for item in node.items)
+
+
+def _check_metric(metric: SList, checker: FormulaChecker) -> None:
+    if len(metric) != 3 or not isinstance(metric.items[1], Atom):
+        checker.report.add(metric, "syntax", "expected (:metric minimize|maximize EXPRESSION)")
+        return
+    if metric.items[1].text not in ("minimize", "maximize"):
+        checker.report.add(metric.items[1], "syntax", "expected 'minimize' or 'maximize'")
+    expression = metric.items[2]
+    if not (isinstance(expression, SList) and expression.head() == "total-time"):
+        checker.numeric(expression, {})
+
+
+def _check_probabilities(
+    problem: Problem,
+    usage: Usage,
+    numbers: dict[str, list[tuple[SList, Atom]]],
+    report: Report,
+) -> None:
+    anchor: Node = problem.init_node or problem.goal_node or Atom("", 1, 1, 0)
+    for name in usage.probability_fluents:
+        assigned = numbers.get(name, [])
+        if not assigned:
+            report.add(
+                anchor,
+                "probability-not-in-init",
+                f"probability fluent '{name}' has no value in :init",
+            )
+        for _term, value in assigned:
+            if not 0 <= Fraction(value.text) <= 1:
+                report.add(
+                    value,
+                    "probability-range",
+                    f"probability {value.text} for '{name}' is outside [0, 1]",
+                )
+
+
+def _goal_true_in_init(problem: Problem, atoms: set[GroundAtom], report: Report) -> None:
+    literals = _literals(problem.goal)
+    if literals is None or not literals:
+        return
+    if all((fact in atoms) == positive for fact, positive in literals):
+        report.add(
+            problem.goal_node or problem.goal,
+            "goal-true-in-init",
+            "the goal already holds in :init; the plan will be empty",
+            warning=True,
+        )
+
+
+def _literals(goal: Node | None) -> list[tuple[GroundAtom, bool]] | None:
+    """A conjunction of ground literals as (atom, positive) pairs, else None."""
+    if not isinstance(goal, SList) or not goal.items:
+        return None
+    if goal.head() == "and":
+        result: list[tuple[GroundAtom, bool]] = []
+        for child in goal.items[1:]:
+            sub = _literals(child)
+            if sub is None:
+                return None
+            result += sub
+        return result
+    if goal.head() == "not" and len(goal) == 2 and isinstance(goal.items[1], SList):
+        inner = _literals(goal.items[1])
+        return None if inner is None or len(inner) != 1 else [(inner[0][0], not inner[0][1])]
+    if goal.head() in ("or", "imply", "forall", "exists", "=", "<", ">", "<=", ">="):
+        return None
+    if any(not isinstance(i, Atom) or i.text.startswith("?") for i in goal.items):
+        return None
+    return [(_ground(goal), True)]

@@ -1,0 +1,139 @@
+"""Read a probabilistic PDDL domain + problem into a `ProbabilisticProblem`.
+
+Order: our own checks first (they know positions), then the probabilistic pre-pass, then
+unified-planning's PDDLReader on the translated text; whatever UP still rejects becomes a
+`PddlError` with the position UP or pyparsing reported.
+"""
+
+from __future__ import annotations
+
+import re
+from fractions import Fraction
+from pathlib import Path
+
+import pyparsing
+from unified_planning.io import PDDLReader
+from unified_planning.model import FNode, Problem
+
+from avs_planner.errors import PddlError
+from avs_planner.pddl.check import first_error
+from avs_planner.pddl.model import ProbabilisticProblem
+from avs_planner.pddl.probabilistic import translate_domain
+from avs_planner.pddl.sexpr import Atom, Node, SList, is_number, parse_sexprs
+
+_UP_POSITION = re.compile(r"line:?\s*(\d+),\s*col:?\s*(\d+)", re.IGNORECASE)
+
+
+def read_files(domain_path: str | Path, problem_path: str | Path) -> ProbabilisticProblem:
+    """Read a domain file and a problem file; raises PddlError naming file, line and column."""
+    return read_text(
+        _read(domain_path),
+        _read(problem_path),
+        domain_name=str(domain_path),
+        problem_name=str(problem_path),
+    )
+
+
+def read_text(
+    domain_text: str,
+    problem_text: str,
+    domain_name: str = "<domain>",
+    problem_name: str = "<problem>",
+) -> ProbabilisticProblem:
+    """Read domain and problem text (e.g. from the HTTP service) into a ProbabilisticProblem."""
+    error = first_error(domain_text, problem_text, domain_name, problem_name)
+    if error is not None:
+        raise error.to_error()
+    domain_nodes = parse_sexprs(domain_text, domain_name)
+    translation = translate_domain(domain_text, domain_nodes, domain_name)
+    problem = _up_parse(translation.text, problem_text, domain_name, problem_name)
+    success = {
+        name: _success_expression(problem, name, nodes, domain_name)
+        for name, nodes in translation.probabilities.items()
+    }
+    return ProbabilisticProblem(problem, success, domain_name, problem_name)
+
+
+def _read(path: str | Path) -> str:
+    try:
+        return Path(path).read_text(encoding="utf-8-sig")
+    except OSError as exc:
+        raise PddlError(f"cannot read file: {exc.strerror or exc}", str(path), 1, 1) from exc
+    except UnicodeDecodeError as exc:
+        raise PddlError(f"not a UTF-8 text file ({exc.reason})", str(path), 1, 1) from exc
+
+
+def _up_parse(domain: str, problem: str, domain_name: str, problem_name: str) -> Problem:
+    try:
+        return PDDLReader().parse_problem_string(domain, problem)
+    except Exception as exc:  # noqa: BLE001 - UP raises many kinds; all become PddlError
+        file = domain_name if _domain_fails(domain) else problem_name
+        raise _convert(exc, file) from exc
+
+
+def _domain_fails(domain: str) -> bool:
+    """Which file UP's complaint is about: the domain if it fails on its own."""
+    try:
+        PDDLReader().parse_problem_string(domain, None)
+    except Exception:  # noqa: BLE001
+        return True
+    return False
+
+
+def _convert(exc: Exception, file: str) -> PddlError:
+    if isinstance(exc, pyparsing.ParseBaseException):
+        return PddlError(f"syntax error: {exc.msg}", file, exc.lineno, exc.col)
+    message = str(exc).strip() or type(exc).__name__
+    match = _UP_POSITION.search(message)
+    line, col = (int(match.group(1)), int(match.group(2))) if match else (1, 1)
+    first = message.splitlines()[0]
+    return PddlError(f"unified-planning cannot read this: {first}", file, line, col)
+
+
+def _success_expression(problem: Problem, action: str, nodes: list[Node], file: str) -> FNode:
+    """The product of an action's probability terms, as a UP expression."""
+    em = problem.environment.expression_manager
+    up_action = problem.action(action)
+    factors = [_term(problem, up_action, node, file) for node in nodes]
+    return factors[0] if len(factors) == 1 else em.Times(*factors)
+
+
+def _term(problem: Problem, action, node: Node, file: str) -> FNode:  # noqa: ANN001
+    em = problem.environment.expression_manager
+    if isinstance(node, Atom):
+        if not is_number(node.text):
+            raise PddlError(
+                f"probability must be a number, a fraction or a fluent term, not '{node.text}'",
+                file,
+                node.line,
+                node.column,
+            )
+        return em.Real(Fraction(node.text))
+    return _fluent_term(problem, action, node, file)
+
+
+def _fluent_term(problem: Problem, action, node: SList, file: str) -> FNode:  # noqa: ANN001
+    name = node.head()
+    if not name or not problem.has_fluent(name):
+        raise PddlError(f"unknown function '{name}' in probability", file, node.line, node.column)
+    fluent = problem.fluent(name)
+    args = []
+    for arg in node.items[1:]:
+        if not isinstance(arg, Atom):
+            raise PddlError("probability arguments must be names", file, arg.line, arg.column)
+        if arg.text.startswith("?"):
+            args.append(em_param(action, arg, file))
+        elif problem.has_object(arg.text):
+            args.append(problem.environment.expression_manager.ObjectExp(problem.object(arg.text)))
+        else:
+            raise PddlError(f"unknown object '{arg.text}'", file, arg.line, arg.column)
+    return problem.environment.expression_manager.FluentExp(fluent, args)
+
+
+def em_param(action, arg: Atom, file: str) -> FNode:  # noqa: ANN001
+    """A UP parameter expression for `?name` of `action`."""
+    name = arg.text[1:]
+    for param in action.parameters:
+        if param.name == name:
+            return action.environment.expression_manager.ParameterExp(param)
+    raise PddlError(f"variable '{arg.text}' is not a parameter", file, arg.line, arg.column)

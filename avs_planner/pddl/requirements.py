@@ -1,0 +1,94 @@
+"""Requirement flags: which are known, which imply which, and used-versus-declared checks."""
+
+from __future__ import annotations
+
+from avs_planner.pddl.diagnostics import Diagnostic, did_you_mean
+from avs_planner.pddl.formulas import Usage
+from avs_planner.pddl.structure import Domain, Report
+
+QUANTIFIED = {":universal-preconditions", ":existential-preconditions"}
+IMPLIES: dict[str, set[str]] = {
+    ":adl": {
+        ":strips",
+        ":typing",
+        ":negative-preconditions",
+        ":disjunctive-preconditions",
+        ":equality",
+        ":quantified-preconditions",
+        ":conditional-effects",
+        *QUANTIFIED,
+    },
+    ":quantified-preconditions": QUANTIFIED,
+    ":fluents": {":numeric-fluents", ":object-fluents", ":action-costs"},
+    ":numeric-fluents": {":action-costs"},
+}
+KNOWN = {
+    *IMPLIES[":adl"],
+    ":adl",
+    ":fluents",
+    ":numeric-fluents",
+    ":object-fluents",
+    ":action-costs",
+    ":probabilistic-effects",
+    ":durative-actions",
+    ":duration-inequalities",
+    ":timed-initial-literals",
+    ":derived-predicates",
+    ":constraints",
+    ":preferences",
+}
+
+
+def closure(declared: set[str]) -> set[str]:
+    """Every requirement granted by the declared ones."""
+    granted = set(declared)
+    for flag in declared:
+        granted |= IMPLIES.get(flag, set())
+    return granted
+
+
+def check_requirements(domain: Domain, usage: Usage) -> list[Diagnostic]:
+    """Unknown flags, flags used but not declared (errors), declared but unused (warnings)."""
+    report = Report(domain.file)
+    declared = {atom.text for atom in domain.requirements}
+    _unknown(domain, report)
+    _typing_usage(domain, usage)
+    granted = closure(declared)
+    for flag, (file, node) in usage.requirements.items():
+        if flag not in granted:
+            where = Report(file)
+            where.add(node, "missing-requirement", _missing_message(node, flag))
+            report.items += where.items
+    _unused(domain, usage, report)
+    return report.items
+
+
+def _missing_message(node, flag: str) -> str:  # noqa: ANN001
+    construct = node.head() if hasattr(node, "head") else node.text
+    return f"'{construct}' needs requirement {flag}, which the domain does not declare"
+
+
+def _unknown(domain: Domain, report: Report) -> None:
+    for atom in domain.requirements:
+        if atom.text not in KNOWN:
+            hint = did_you_mean(atom.text, KNOWN)
+            report.add(atom, "unknown-requirement", f"unknown requirement '{atom.text}'{hint}")
+
+
+def _typing_usage(domain: Domain, usage: Usage) -> None:
+    if domain.uses_typing is not None:
+        usage.need(":typing", domain.file, domain.uses_typing)
+
+
+def _unused(domain: Domain, usage: Usage, report: Report) -> None:
+    used = set(usage.requirements)
+    for atom in domain.requirements:
+        if atom.text == ":strips" or atom.text not in KNOWN:
+            continue
+        if not ({atom.text} | IMPLIES.get(atom.text, set())) & used:
+            report.add(
+                atom,
+                "unused-requirement",
+                f"requirement {atom.text} is declared but nothing uses it",
+                warning=True,
+            )

@@ -1,0 +1,345 @@
+"""The declarations of a PDDL domain and problem, with source positions, for the linter.
+
+Reading is forgiving: a malformed part becomes a Diagnostic and the rest is still read,
+so one run of `avs domain check` reports as much as it can.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from avs_planner.pddl.diagnostics import Diagnostic, Severity
+from avs_planner.pddl.sexpr import Atom, Node, SList
+
+OBJECT = "object"
+NUMBER = "number"
+
+
+@dataclass
+class Report:
+    """Collects diagnostics for one file."""
+
+    file: str
+    items: list[Diagnostic] = field(default_factory=list)
+
+    def add(self, node: Node, code: str, message: str, warning: bool = False) -> None:
+        severity = Severity.WARNING if warning else Severity.ERROR
+        self.items.append(Diagnostic(self.file, node.line, node.column, severity, code, message))
+
+
+@dataclass(frozen=True)
+class Typed:
+    """A name with its declared type, e.g. `?r - room` or `kitchen - category`."""
+
+    atom: Atom
+    type: str
+
+    @property
+    def name(self) -> str:
+        return self.atom.text
+
+
+@dataclass
+class Signature:
+    """A predicate or function declaration."""
+
+    atom: Atom
+    params: list[Typed]
+
+    @property
+    def name(self) -> str:
+        return self.atom.text
+
+
+@dataclass
+class Action:
+    """An action schema: parameters, precondition and effect nodes (None when absent)."""
+
+    atom: Atom
+    params: list[Typed]
+    precondition: Node | None = None
+    effect: Node | None = None
+
+
+@dataclass
+class Domain:
+    """Everything declared in a domain file."""
+
+    file: str
+    name: Atom | None = None
+    requirements: list[Atom] = field(default_factory=list)
+    requirements_node: SList | None = None
+    types: dict[str, str | None] = field(default_factory=lambda: {OBJECT: None})
+    type_atoms: dict[str, Atom] = field(default_factory=dict)
+    constants: dict[str, Typed] = field(default_factory=dict)
+    predicates: dict[str, Signature] = field(default_factory=dict)
+    functions: dict[str, Signature] = field(default_factory=dict)
+    actions: dict[str, Action] = field(default_factory=dict)
+    uses_typing: Node | None = None
+
+    def is_subtype(self, sub: str, sup: str) -> bool:
+        """True when `sub` equals `sup` or descends from it (everything is an `object`)."""
+        seen: set[str] = set()
+        current: str | None = sub
+        while current is not None and current not in seen:
+            if current == sup:
+                return True
+            seen.add(current)
+            current = self.types.get(current, OBJECT if current != OBJECT else None)
+        return sup == OBJECT
+
+
+@dataclass
+class Problem:
+    """Everything declared in a problem file."""
+
+    file: str
+    name: Atom | None = None
+    domain_ref: Atom | None = None
+    objects: dict[str, Typed] = field(default_factory=dict)
+    init_node: SList | None = None
+    init: list[Node] = field(default_factory=list)
+    goal: Node | None = None
+    goal_node: SList | None = None
+    metric: SList | None = None
+
+
+def find_define(nodes: list[Node], kind: str, report: Report) -> SList | None:
+    """The `(define (KIND name) ...)` form, or None with a diagnostic."""
+    for node in nodes:
+        if isinstance(node, SList) and node.head() == "define":
+            header = node.items[1] if len(node) > 1 else None
+            if isinstance(header, SList) and header.head() == kind and len(header) == 2:
+                return node
+            report.add(header or node, "syntax", f"expected ({kind} NAME) after define")
+            return None
+        report.add(node, "syntax", f"expected (define ({kind} NAME) ...)")
+        return None
+    report.add(Atom("", 1, 1, 0), "syntax", f"empty file: expected (define ({kind} NAME) ...)")
+    return None
+
+
+def typed_list(items: list[Node], report: Report, default: str = OBJECT) -> list[Typed]:
+    """Parse `a b - t c` into Typed entries; `(either ...)` and stray lists are reported."""
+    result: list[Typed] = []
+    pending: list[Atom] = []
+    i = 0
+    while i < len(items):
+        item = items[i]
+        if isinstance(item, Atom) and item.text == "-":
+            type_name = _type_after_dash(items, i, report)
+            result += [Typed(a, type_name) for a in pending]
+            pending = []
+            i += 2
+            continue
+        if isinstance(item, SList):
+            report.add(item, "syntax", "expected a name here, not a parenthesised list")
+        else:
+            pending.append(item)
+        i += 1
+    return result + [Typed(a, default) for a in pending]
+
+
+def _type_after_dash(items: list[Node], i: int, report: Report) -> str:
+    if i + 1 >= len(items):
+        report.add(items[i], "syntax", "'-' must be followed by a type name")
+        return OBJECT
+    node = items[i + 1]
+    if isinstance(node, SList):
+        if node.head() == "either":
+            report.add(
+                node,
+                "unsupported-either",
+                "(either ...) types are not supported; declare a common supertype instead",
+            )
+        else:
+            report.add(node, "syntax", "expected a type name after '-'")
+        return OBJECT
+    return node.text
+
+
+def read_domain(define: SList, report: Report) -> Domain:
+    """Collect a domain's declarations from its `(define ...)` form."""
+    domain = Domain(report.file)
+    header = define.items[1]
+    if isinstance(header, SList) and isinstance(header.items[1], Atom):
+        domain.name = header.items[1]
+    for section in define.items[2:]:
+        if not isinstance(section, SList) or not section.head().startswith(":"):
+            report.add(section, "syntax", "expected a section such as (:predicates ...)")
+            continue
+        reader = _DOMAIN_SECTIONS.get(section.head())
+        if reader is None:
+            report.add(section, "unknown-section", f"unknown domain section '{section.head()}'")
+        else:
+            reader(domain, section, report)
+    return domain
+
+
+def _requirements(domain: Domain, section: SList, report: Report) -> None:
+    domain.requirements_node = section
+    for item in section.items[1:]:
+        if isinstance(item, Atom):
+            domain.requirements.append(item)
+        else:
+            report.add(item, "syntax", "expected a requirement flag such as :typing")
+
+
+def _types(domain: Domain, section: SList, report: Report) -> None:
+    domain.uses_typing = domain.uses_typing or section
+    for entry in typed_list(section.items[1:], report):
+        if entry.name in domain.type_atoms or entry.name == OBJECT:
+            if entry.name != OBJECT:
+                report.add(entry.atom, "duplicate", f"type '{entry.name}' is declared twice")
+            continue
+        domain.types[entry.name] = entry.type
+        domain.type_atoms[entry.name] = entry.atom
+    for _name, parent in list(domain.types.items()):
+        if parent is not None and parent not in domain.types:
+            domain.types[parent] = OBJECT  # an undeclared parent is implicitly a type
+    _check_cycles(domain, report)
+
+
+def _check_cycles(domain: Domain, report: Report) -> None:
+    for name, atom in domain.type_atoms.items():
+        seen: set[str] = set()
+        current: str | None = name
+        while current is not None and current not in seen:
+            seen.add(current)
+            current = domain.types.get(current)
+        if current is not None:
+            report.add(atom, "type-cycle", f"type '{name}' is (indirectly) its own subtype")
+
+
+def _constants(domain: Domain, section: SList, report: Report) -> None:
+    _typed_into(domain.constants, section, report, "constant")
+
+
+def _typed_into(table: dict[str, Typed], section: SList, report: Report, what: str) -> None:
+    for entry in typed_list(section.items[1:], report):
+        if entry.name in table:
+            report.add(entry.atom, "duplicate", f"{what} '{entry.name}' is declared twice")
+        else:
+            table[entry.name] = entry
+
+
+def _signatures(section: SList, report: Report, functions: bool) -> list[Signature]:
+    """Predicate or function signatures; function lists may carry `- number` result types."""
+    result = []
+    items = section.items[1:]
+    i = 0
+    while i < len(items):
+        item = items[i]
+        if isinstance(item, SList) and item.items and isinstance(item.items[0], Atom):
+            result.append(Signature(item.items[0], typed_list(item.items[1:], report)))
+        elif functions and isinstance(item, Atom) and item.text == "-":
+            after = items[i + 1] if i + 1 < len(items) else item
+            if not isinstance(after, Atom) or after.text not in (NUMBER, "int", "float"):
+                report.add(after, "syntax", "a function's type must be 'number'")
+            i += 2
+            continue
+        else:
+            report.add(item, "syntax", "expected (NAME ?param - type ...)")
+        i += 1
+    return result
+
+
+def _predicates(domain: Domain, section: SList, report: Report) -> None:
+    _signatures_into(domain.predicates, _signatures(section, report, False), report, "predicate")
+
+
+def _functions(domain: Domain, section: SList, report: Report) -> None:
+    _signatures_into(domain.functions, _signatures(section, report, True), report, "function")
+
+
+def _signatures_into(
+    table: dict[str, Signature], sigs: list[Signature], report: Report, what: str
+) -> None:
+    for sig in sigs:
+        if sig.name in table:
+            report.add(sig.atom, "duplicate", f"{what} '{sig.name}' is declared twice")
+        else:
+            table[sig.name] = sig
+
+
+def _action(domain: Domain, section: SList, report: Report) -> None:
+    if len(section) < 2 or not isinstance(section.items[1], Atom):
+        report.add(section, "syntax", "expected (:action NAME :parameters (...) ...)")
+        return
+    action = Action(section.items[1], [])
+    items = section.items[2:]
+    for i in range(0, len(items), 2):
+        key = items[i]
+        value = items[i + 1] if i + 1 < len(items) else None
+        if not isinstance(key, Atom) or value is None:
+            report.add(key, "syntax", "expected :parameters, :precondition or :effect and a value")
+            break
+        _action_part(action, key, value, report)
+    if action.atom.text in domain.actions:
+        report.add(action.atom, "duplicate", f"action '{action.atom.text}' is declared twice")
+    domain.actions[action.atom.text] = action
+
+
+def _action_part(action: Action, key: Atom, value: Node, report: Report) -> None:
+    if key.text == ":parameters":
+        if isinstance(value, SList):
+            action.params = typed_list(value.items, report)
+        else:
+            report.add(value, "syntax", "expected a parameter list (?x - type ...)")
+    elif key.text == ":precondition":
+        action.precondition = value
+    elif key.text == ":effect":
+        action.effect = value
+    else:
+        report.add(key, "syntax", f"unknown action keyword '{key.text}'")
+
+
+def _unsupported(domain: Domain, section: SList, report: Report) -> None:
+    report.add(section, "unsupported", f"'{section.head()}' is not supported by avs-planner")
+
+
+_DOMAIN_SECTIONS = {
+    ":requirements": _requirements,
+    ":types": _types,
+    ":constants": _constants,
+    ":predicates": _predicates,
+    ":functions": _functions,
+    ":action": _action,
+    ":durative-action": _unsupported,
+    ":derived": _unsupported,
+    ":constraints": _unsupported,
+}
+
+
+def read_problem(define: SList, report: Report) -> Problem:
+    """Collect a problem's declarations from its `(define ...)` form."""
+    problem = Problem(report.file)
+    header = define.items[1]
+    if isinstance(header, SList) and isinstance(header.items[1], Atom):
+        problem.name = header.items[1]
+    for section in define.items[2:]:
+        if not isinstance(section, SList) or not section.head().startswith(":"):
+            report.add(section, "syntax", "expected a section such as (:init ...)")
+            continue
+        _problem_section(problem, section, report)
+    if problem.goal_node is None:
+        report.add(define, "syntax", "the problem has no (:goal ...) section")
+    return problem
+
+
+def _problem_section(problem: Problem, section: SList, report: Report) -> None:
+    head = section.head()
+    if head == ":domain" and len(section) == 2 and isinstance(section.items[1], Atom):
+        problem.domain_ref = section.items[1]
+    elif head == ":objects":
+        _typed_into(problem.objects, section, report, "object")
+    elif head == ":init":
+        problem.init_node, problem.init = section, section.items[1:]
+    elif head == ":goal" and len(section) == 2:
+        problem.goal_node, problem.goal = section, section.items[1]
+    elif head == ":metric":
+        problem.metric = section
+    elif head == ":requirements":
+        return
+    else:
+        report.add(section, "syntax", f"unknown or malformed problem section '{head}'")

@@ -1,0 +1,99 @@
+"""Reading probabilistic PDDL into a ProbabilisticProblem: AVS domain, IPC domains, text API."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+
+from avs_planner.errors import PddlError
+from avs_planner.pddl import read_files, read_text
+from avs_planner.pddl.probabilistic import translate_domain
+from avs_planner.pddl.sexpr import parse_sexprs
+
+ROOT = Path(__file__).resolve().parents[3]
+AVS = ROOT / "domains" / "avs"
+IPC = Path("/work/shared/ipc")
+IPC_PAIRS = [
+    (d, p) for d in sorted(IPC.glob("*/domain.pddl")) for p in sorted(d.parent.glob("instance-*"))
+]
+
+TINY_DOMAIN = """(define (domain tiny)
+  (:requirements :strips :typing :negative-preconditions :probabilistic-effects)
+  (:types thing)
+  (:predicates (seen ?t - thing))
+  (:functions (p-see ?t - thing) - number)
+  (:action look
+    :parameters (?t - thing)
+    :precondition (not (seen ?t))
+    :effect (probabilistic 3/10 (seen ?t)))
+  (:action stare
+    :parameters (?t - thing)
+    :precondition (not (seen ?t))
+    :effect (probabilistic (p-see ?t) (seen ?t))))
+"""
+TINY_PROBLEM = """(define (problem one) (:domain tiny)
+  (:objects a - thing)
+  (:init (= (p-see a) 0.25))
+  (:goal (seen a)))
+"""
+
+
+def test_corridor_problem_reads_with_success_probabilities() -> None:
+    task = read_files(AVS / "domain.pddl", AVS / "problems" / "corridor.pddl")
+    assert task.problem.name == "corridor"
+    assert str(task.success["assume-leads-to-room"]) == "p-placeholder-category(p, c)"
+    assert set(task.success) == {
+        "assume-leads-to-room",
+        "assume-category",
+        "assume-obj-exists-in",
+        "assume-obj-exists-on",
+        "searchforobject-in",
+        "searchforobject-on",
+    }
+    assert task.constant_success("move") == Fraction(1)
+    assert task.constant_success("assume-category") is None
+    assert task.is_assumptive("assume-category") and not task.is_assumptive("move")
+
+
+@pytest.mark.parametrize("problem", sorted((AVS / "problems").glob("*.pddl")), ids=str)
+def test_every_avs_problem_reads(problem: Path) -> None:
+    task = read_files(AVS / "domain.pddl", problem)
+    assert task.problem.goals
+
+
+def test_fraction_and_fluent_probabilities_from_text() -> None:
+    task = read_text(TINY_DOMAIN, TINY_PROBLEM)
+    assert task.constant_success("look") == Fraction(3, 10)
+    stare = task.success["stare"]
+    assert stare.is_fluent_exp() and stare.fluent().name == "p-see"
+    assert task.domain_file == "<domain>" and task.problem_file == "<problem>"
+
+
+def test_translation_keeps_every_offset() -> None:
+    text = TINY_DOMAIN
+    translation = translate_domain(text, parse_sexprs(text), "<d>")
+    assert len(translation.text) == len(text)
+    assert "probabilistic" not in translation.text
+    assert [c for c in translation.text if c == "\n"] == [c for c in text if c == "\n"]
+    assert translation.text.count("(") == text.count("(") - 3
+
+
+@pytest.mark.skipif(not IPC.exists(), reason="IPC benchmark set not available")
+@pytest.mark.parametrize(("domain", "problem"), IPC_PAIRS, ids=lambda p: str(p)[-30:])
+def test_ipc_instance_loads(domain: Path, problem: Path) -> None:
+    task = read_files(domain, problem)
+    assert task.problem.actions and not task.success
+
+
+def test_text_errors_name_the_given_file() -> None:
+    with pytest.raises(PddlError) as exc:
+        read_text(TINY_DOMAIN, TINY_PROBLEM.replace("(seen a)", "(sen a)"), problem_name="p.pddl")
+    assert (exc.value.file, exc.value.line, exc.value.column) == ("p.pddl", 4, 11)
+    assert "did you mean 'seen'" in exc.value.message
+
+
+def test_missing_file_is_a_pddl_error(tmp_path: Path) -> None:
+    with pytest.raises(PddlError, match="cannot read file"):
+        read_files(tmp_path / "nope.pddl", tmp_path / "nope2.pddl")
