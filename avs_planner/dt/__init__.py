@@ -1,0 +1,30 @@
+"""Decision-theoretic sub-planner (seed 003, §2): a POMDP over view cones, solved closed-loop.
+
+Entry point: `DTSession`. Models follow pomdp-py's layout (domain, models, agent, problem).
+"""
+
+from avs_planner.dt.domain import (
+    DETECTED,
+    NOT_DETECTED,
+    NOTHING,
+    REJECT,
+    ActionKind,
+    DetectorModel,
+    DTAction,
+    DTObservation,
+    DTState,
+    ObservationKind,
+    ViewCone,
+)
+from avs_planner.dt.errors import DtInputError, DtSessionError
+from avs_planner.dt.policies import POLICIES, PolicyConfig, make_policy
+from avs_planner.dt.pouct import SearchBudget
+from avs_planner.dt.problem import DTProblem, DTRewards, TravelCosts
+from avs_planner.dt.session import DTResult, DTSession, DTStatus, DTStep
+
+__all__ = [
+    "DETECTED", "NOT_DETECTED", "NOTHING", "REJECT", "POLICIES", "ActionKind", "DTAction",
+    "DTObservation", "DTProblem", "DTResult", "DTRewards", "DTSession", "DTState", "DTStatus",
+    "DTStep", "DetectorModel", "DtInputError", "DtSessionError", "ObservationKind",
+    "PolicyConfig", "SearchBudget", "TravelCosts", "ViewCone", "make_policy",
+]

@@ -1,0 +1,159 @@
+"""State, action and observation of the view-cone search POMDP (seed 003, §2 "DT planner").
+
+The robot stands at the start pose or at one view cone's pose; the target is in one cone or in
+none of them. Robot position, the last detection flag and `done` are observed; only the target is
+hidden, so a belief is a distribution over `n + 1` targets.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import Enum
+from functools import cache
+
+import pomdp_py
+
+from avs_planner.dt.errors import DtInputError
+
+START = -1
+"""Robot index of the start pose (no view cone)."""
+NOWHERE = -1
+"""Target index meaning "the object is in none of the cones"."""
+
+Pose2D = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class ViewCone:
+    """A sensing action: robot pose (x, y, yaw), optional PR2 head/torso, P(target inside)."""
+
+    id: str
+    pose: Pose2D
+    probability: float
+    head: tuple[float, float] | None = None  # pan, tilt (rad)
+    torso: float | None = None  # lift (m)
+
+    def check(self, where: str) -> None:
+        """Raise DtInputError naming `where` if the cone is malformed."""
+        if not self.id:
+            raise DtInputError(f"{where}: view cone id is empty")
+        if len(self.pose) != 3 or not all(math.isfinite(v) for v in self.pose):
+            raise DtInputError(f"{where} ({self.id}): pose must be 3 finite numbers (x, y, yaw)")
+        if not (0.0 <= self.probability <= 1.0) or math.isnan(self.probability):
+            raise DtInputError(
+                f"{where} ({self.id}): probability {self.probability} is not in [0, 1]"
+            )
+
+
+@dataclass(frozen=True)
+class DetectorModel:
+    """Object detector noise: P(miss | object in cone), P(hit | object not in cone)."""
+
+    false_negative: float = 0.2
+    false_positive: float = 0.05
+
+    def __post_init__(self) -> None:
+        for name in ("false_negative", "false_positive"):
+            value = getattr(self, name)
+            if not (0.0 <= value < 1.0):
+                raise DtInputError(f"detector: {name}={value} must be in [0, 1)")
+        if self.false_negative + self.false_positive >= 1.0:
+            raise DtInputError(
+                "detector: false_negative + false_positive must be < 1 "
+                "(otherwise a detection carries no evidence)"
+            )
+
+    def p_detect(self, target_in_cone: bool) -> float:
+        """P(detection | whether the target is in the processed cone)."""
+        return 1.0 - self.false_negative if target_in_cone else self.false_positive
+
+
+@dataclass(frozen=True)
+class DTState(pomdp_py.State):
+    """Robot cone index (START), target cone index (NOWHERE), last look detected?, finished?"""
+
+    robot: int
+    target: int
+    detected: bool = False
+    done: bool = False
+    _hash: int = field(init=False, repr=False, compare=False, default=0)
+
+    def __post_init__(self) -> None:  # planners hash states constantly: compute once
+        object.__setattr__(self, "_hash", hash((self.robot, self.target, self.detected,
+                                                self.done)))
+
+    def __hash__(self) -> int:
+        return self._hash
+
+
+class ActionKind(Enum):
+    MOVE = "move"
+    PROCESS_VIEW_CONE = "process_view_cone"
+    CONFIRM = "confirm"
+    REJECT = "reject"
+
+
+@dataclass(frozen=True)
+class DTAction(pomdp_py.Action):
+    """MOVE(cone), PROCESSVIEWCONE(cone the robot is at), CONFIRM(cone), REJECT."""
+
+    kind: ActionKind
+    cone: int = -1
+    _hash: int = field(init=False, repr=False, compare=False, default=0)
+
+    def __post_init__(self) -> None:  # POUCT hashes actions in every UCB step
+        object.__setattr__(self, "_hash", hash((self.kind.value, self.cone)))
+
+    def __hash__(self) -> int:
+        return self._hash
+
+    @property
+    def terminal(self) -> bool:
+        return self.kind in (ActionKind.CONFIRM, ActionKind.REJECT)
+
+    def __str__(self) -> str:
+        return self.kind.value if self.cone < 0 else f"{self.kind.value}({self.cone})"
+
+
+@cache
+def move(cone: int) -> DTAction:
+    return DTAction(ActionKind.MOVE, cone)
+
+
+@cache
+def look(cone: int) -> DTAction:
+    return DTAction(ActionKind.PROCESS_VIEW_CONE, cone)
+
+
+@cache
+def confirm(cone: int) -> DTAction:
+    return DTAction(ActionKind.CONFIRM, cone)
+
+
+REJECT = DTAction(ActionKind.REJECT)
+
+
+class ObservationKind(Enum):
+    NOTHING = "nothing"  # actions that do not sense
+    DETECTED = "detected"
+    NOT_DETECTED = "not_detected"
+
+
+@dataclass(frozen=True)
+class DTObservation(pomdp_py.Observation):
+    """What PROCESSVIEWCONE reported; NOTHING after other actions."""
+
+    kind: ObservationKind = ObservationKind.NOTHING
+
+    def __hash__(self) -> int:
+        return hash(self.kind.value)
+
+    @staticmethod
+    def of(detected: bool) -> DTObservation:
+        return DETECTED if detected else NOT_DETECTED
+
+
+NOTHING = DTObservation(ObservationKind.NOTHING)
+DETECTED = DTObservation(ObservationKind.DETECTED)
+NOT_DETECTED = DTObservation(ObservationKind.NOT_DETECTED)
