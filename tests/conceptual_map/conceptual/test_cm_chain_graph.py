@@ -1,0 +1,107 @@
+"""Chain graph: its pgmpy factors, exact checks of the facade's beliefs, structural events."""
+
+import numpy as np
+import pytest
+
+from conceptual_map.conceptual import ConceptualError, ConceptualMap, category_variable
+from conceptual_map.conceptual.exact import exact_marginals
+
+
+def _building() -> ConceptualMap:
+    """A corridor with three rooms off it (a tree), some evidence everywhere."""
+    cmap = ConceptualMap()
+    for room, places in {"corr": 4, "r1": 2, "r2": 2, "r3": 1}.items():
+        for i in range(places):
+            cmap.add_place(f"{room}_p{i}", room)
+        if room != "corr":
+            cmap.connect_rooms("corr", room)
+    cmap.observe_property("corr_p0", "shape", "elongated")
+    cmap.observe_property("corr_p1", "appearance", {"corridor_like": 0.7, "office_like": 0.3})
+    cmap.observe_property("r1_p0", "appearance", "kitchen_like")
+    cmap.observe_property("r2_p1", "size", "small")
+    cmap.observe_object("desk", "r3")
+    return cmap
+
+
+def _assert_matches_exact(cmap: ConceptualMap, explicit: bool, atol: float) -> None:
+    exact = exact_marginals(cmap.factors(explicit_properties=explicit))
+    for room in cmap.graph.rooms:
+        np.testing.assert_allclose(cmap.room_marginal(room), exact[category_variable(room)],
+                                   atol=atol)
+
+
+def test_tree_beliefs_equal_exact_inference_on_the_reduced_and_explicit_chain_graph():
+    cmap = _building()
+    _assert_matches_exact(cmap, explicit=False, atol=1e-6)
+    _assert_matches_exact(cmap, explicit=True, atol=1e-6)
+
+
+def test_loopy_building_is_close_to_exact():
+    cmap = _building()
+    cmap.connect_rooms("r1", "r2")
+    cmap.connect_rooms("r2", "r3")
+    _assert_matches_exact(cmap, explicit=False, atol=0.02)
+
+
+def test_explicit_factors_hold_property_variables_and_evidence():
+    factors = _building().factors(explicit_properties=True)
+    scopes = [tuple(f.scope()) for f in factors]
+    assert (category_variable("r1"), "appearance[r1_p0]") in scopes
+    assert ("appearance[r1_p0]",) in scopes
+
+
+def test_events_rerun_inference_only_when_something_changed():
+    cmap = _building()
+    first = cmap.update()
+    assert cmap.update() is first
+    cmap.observe_property("r2_p0", "appearance", "bathroom_like")
+    second = cmap.update()
+    assert second is not first
+    assert cmap.room_category("r2")["bathroom"] > 0.5
+
+
+def test_moving_a_place_moves_its_evidence_to_the_new_room():
+    cmap = _building()
+    before = cmap.room_category("r2")["kitchen"]
+    cmap.add_place("r1_p0", "r2")
+    assert cmap.room_category("r2")["kitchen"] > before
+    _assert_matches_exact(cmap, explicit=False, atol=1e-6)
+
+
+def test_merge_rooms_keeps_places_links_and_objects():
+    cmap = _building()
+    cmap.merge_rooms("r2", "r3")
+    assert "r3" not in cmap.graph.rooms
+    assert cmap.graph.places_of("r2") == {"r2_p0", "r2_p1", "r3_p0"}
+    assert cmap.graph.neighbours("r2") == {"corr"}
+    assert cmap.objects.objects["object1"].room == "r2"
+    assert cmap.p_object_at("desk", "r2") == 1.0
+    _assert_matches_exact(cmap, explicit=False, atol=1e-6)
+
+
+def test_remove_place_drops_its_evidence():
+    cmap = _building()
+    before = cmap.room_category("r1")["kitchen"]
+    cmap.remove_place("r1_p0")
+    assert cmap.room_category("r1")["kitchen"] < before
+    assert "r1_p0" not in cmap.graph.places_of("r1")
+    _assert_matches_exact(cmap, explicit=True, atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("action", "message"),
+    [
+        (lambda m: m.observe_property("nowhere", "size", "small"), "unknown place 'nowhere'"),
+        (lambda m: m.observe_property("r1_p0", "smell", "coffee"), "unknown property kind"),
+        (lambda m: m.observe_property("r1_p0", "size", "huge"), "unknown size value 'huge'"),
+        (lambda m: m.observe_property("r1_p0", "size", {"small": -1.0}), "non-negative"),
+        (lambda m: m.connect_rooms("r1", "attic"), "unknown room 'attic'"),
+        (lambda m: m.connect_rooms("r1", "r1"), "itself"),
+        (lambda m: m.room_category("attic"), "unknown room 'attic'"),
+        (lambda m: m.merge_rooms("r1", "r1"), "itself"),
+        (lambda m: m.add_place("", "r1"), "non-empty"),
+    ],
+)
+def test_bad_events_raise_clear_errors(action, message):
+    with pytest.raises(ConceptualError, match=message):
+        action(_building())

@@ -1,0 +1,120 @@
+"""Object existence: Poisson probabilities, hierarchical sums, Bayes after failed searches."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.stats import poisson
+
+from conceptual_map.conceptual import ConceptualError, ConceptualMap, RelatedSpace, p_at_least_one
+from conceptual_map.knowledge import load_knowledge
+
+
+def _posterior_by_enumeration(prior: np.ndarray, lam: np.ndarray, detect: list[float]) -> float:
+    """P(n >= 1 | every search missed), summing over category and count explicitly."""
+    miss = np.prod([1.0 - q for q in detect])
+    counts = np.arange(0, 80)
+    joint = prior[:, None] * poisson.pmf(counts[None, :], lam[:, None]) * miss ** counts[None, :]
+    return float(joint[:, 1:].sum() / joint.sum())
+
+
+def test_p_at_least_one_is_one_minus_exp_minus_lambda():
+    assert p_at_least_one(0.0) == 0.0
+    assert p_at_least_one(2.0) == pytest.approx(1 - math.exp(-2.0))
+
+
+@pytest.mark.parametrize("searches", [[(0.5, 0.8)], [(0.9, 0.8)], [(0.5, 0.8), (0.7, 0.9)]])
+def test_failed_search_posterior_is_bayes_rule(searches):
+    cmap = ConceptualMap()
+    cmap.add_room("kitchen1")
+    prior_p = cmap.p_object_at("table", "kitchen1", include_sublocations=False)
+    for coverage, p_detect in searches:
+        cmap.observe_search("table", "kitchen1", coverage, p_detect)
+    knowledge = cmap.knowledge
+    expected = _posterior_by_enumeration(
+        knowledge.prior, knowledge.room_lambda("table"), [c * d for c, d in searches]
+    )
+    posterior = cmap.p_object_at("table", "kitchen1", include_sublocations=False)
+    assert posterior == pytest.approx(expected, abs=1e-9)
+    assert posterior < prior_p
+
+
+def test_failed_search_is_also_evidence_about_the_room_category():
+    cmap = ConceptualMap()
+    cmap.add_room("r")
+    before = cmap.room_category("r")["kitchen"]
+    cmap.observe_search("counter", "r", coverage=1.0, p_detect=0.9)
+    assert cmap.room_category("r")["kitchen"] < before
+
+
+def test_repeated_searches_of_a_table_keep_lowering_the_probability():
+    cmap = ConceptualMap()
+    cmap.add_place("p", "k")
+    cmap.observe_property("p", "appearance", "kitchen_like")
+    table = cmap.observe_object("table", "k")
+    values = [cmap.p_object_at("cerealbox", ("on", table))]
+    for _ in range(4):
+        cmap.observe_search("cerealbox", RelatedSpace("on", table), 0.8, 0.8)
+        values.append(cmap.p_object_at("cerealbox", ("on", table)))
+    assert all(a > b for a, b in zip(values, values[1:], strict=False))
+    assert values[-1] < 0.05
+
+
+def test_room_probability_adds_lambdas_of_its_related_spaces():
+    cmap = ConceptualMap()
+    cmap.add_room("r")
+    table = cmap.observe_object("table", "r")
+    knowledge = cmap.knowledge
+    lam = (knowledge.room_lambda("cerealbox")
+           + knowledge.relation_lambda_of("cerealbox", "on", "table")
+           + knowledge.relation_lambda_of("cerealbox", "in", "table"))
+    expected = float(cmap.room_marginal("r") @ (1 - np.exp(-lam)))
+    assert cmap.p_object_at("cerealbox", "r") == pytest.approx(expected)
+    direct = cmap.p_object_at("cerealbox", "r", include_sublocations=False)
+    on_table = cmap.p_object_at("cerealbox", ("on", table))
+    assert cmap.p_object_at("cerealbox", "r") > max(direct, on_table)
+
+
+def test_a_detected_object_makes_its_location_certain():
+    cmap = ConceptualMap()
+    cmap.add_room("r")
+    table = cmap.observe_object("table", "r")
+    cmap.observe_object("cup", "r", on=table)
+    assert cmap.p_object_at("cup", ("on", table)) == 1.0
+    assert cmap.p_object_at("cup", "r") == 1.0
+    assert cmap.p_object_at("cup", "r", include_sublocations=False) < 1.0
+
+
+def test_abstract_location_probabilities_come_from_default_knowledge():
+    cmap = ConceptualMap()
+    knowledge = load_knowledge()
+    kitchen = knowledge.category_index("kitchen")
+    assert cmap.p_object_at_category("table", "kitchen") == pytest.approx(
+        1 - math.exp(-knowledge.room_lambda("table")[kitchen]))
+    assert cmap.p_object_at_category("cerealbox", "kitchen", "table") == pytest.approx(
+        1 - math.exp(-0.5))
+    assert cmap.p_object_at_category("cerealbox", "kitchen", "table") > \
+        cmap.p_object_at_category("cerealbox", "office", "table")
+
+
+@pytest.mark.parametrize(
+    ("action", "message"),
+    [
+        (lambda m: m.observe_object("unicorn", "r"), "unknown object label 'unicorn'"),
+        (lambda m: m.observe_object("cup", "attic"), "unknown room 'attic'"),
+        (lambda m: m.observe_object("cup", "r", on="object9"), "unknown support object"),
+        (lambda m: m.observe_search("cup", "r", 1.5, 0.8), "coverage must be in"),
+        (lambda m: m.observe_search("cup", ("under", "object1"), 0.5, 0.8), "relation"),
+        (lambda m: m.p_object_at("cup", ("on", "object9")), "unknown object 'object9'"),
+        (lambda m: m.p_object_at("cup", 3), "location must be"),
+        (lambda m: m.p_object_at_category("cup", "garage"), "unknown room category"),
+        (lambda m: m.p_object_at_category("cup", "kitchen", "moon"), "unknown object label"),
+        (lambda m: m.observe_object("cup", "r", object_id="object1"), "already used"),
+    ],
+)
+def test_bad_object_input_raises_clear_errors(action, message):
+    cmap = ConceptualMap()
+    cmap.add_room("r")
+    cmap.observe_object("table", "r")
+    with pytest.raises(ConceptualError, match=message):
+        action(cmap)
