@@ -36,6 +36,7 @@ class Settings(BaseSettings):
     episode_runner: str = Field(
         DEFAULT_EPISODE_RUNNER, description="'module:function' or '/path/file.py:function'"
     )
+    preload_planner: bool = Field(True, description="import the planner in job workers at start")
     worlds_dir: Path | None = Field(None, description="built-in worlds; default: sim/worlds")
 
     @property

@@ -9,10 +9,10 @@ from contextlib import asynccontextmanager
 from fastapi import APIRouter, FastAPI, Request, status
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
-from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from api.config import Settings
 from api.manager import TaskManager
+from api.middleware import BodyLimitMiddleware
 from api.routes import domains, misc, plans, tasks
 from api.security import RateLimiter
 from api.store import TaskStore
@@ -46,15 +46,15 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         version=__version__,
         summary="Find objects in buildings: tasks, live events, planning and domain checks.",
         lifespan=lifespan,
-        max_body_size=settings.max_body_bytes,
     )
+    app.add_middleware(BodyLimitMiddleware, max_bytes=settings.max_body_bytes)
     app.state.settings = settings
     app.state.rate_limiter = RateLimiter(settings.rate_limit_per_minute, settings.rate_limit_burst)
     v1 = APIRouter(prefix="/v1")
     for module in (tasks, plans, domains, misc):
         v1.include_router(module.router)
     app.include_router(v1)
-    _add_error_handlers(app, settings)
+    _add_error_handlers(app)
     return app
 
 
@@ -68,16 +68,7 @@ def _log_access_mode(settings: Settings) -> None:
         log.info("API key required in X-API-Key for POST and DELETE calls")
 
 
-def _add_error_handlers(app: FastAPI, settings: Settings) -> None:
-    limit = settings.max_body_bytes
-
-    @app.exception_handler(StarletteHTTPException)
-    async def http_error(request: Request, exc: StarletteHTTPException) -> JSONResponse:
-        detail = exc.detail
-        if exc.status_code == status.HTTP_413_CONTENT_TOO_LARGE:
-            detail = f"request body larger than the limit of {limit} bytes"
-        return JSONResponse({"detail": detail}, exc.status_code, headers=exc.headers)
-
+def _add_error_handlers(app: FastAPI) -> None:
     @app.exception_handler(RequestValidationError)
     async def validation_error(request: Request, exc: RequestValidationError) -> JSONResponse:
         errors = [{k: v for k, v in e.items() if k in ("type", "loc", "msg")} for e in exc.errors()]

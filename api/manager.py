@@ -17,6 +17,7 @@ from typing import Any
 from api.config import Settings
 from api.schemas import TaskState
 from api.store import TaskRecord, TaskStore
+from api.worker_process import PRELOAD_JOBS
 from api.workers import Job, JobOutcome, JobResult, WorkerPool
 
 log = logging.getLogger("avs.api.tasks")
@@ -64,7 +65,7 @@ class TaskManager:
         )
         self.jobs = WorkerPool(
             "jobs", settings.plan_workers, settings.memory_limit_mb, settings.episode_runner,
-            settings.cancel_grace_s,
+            settings.cancel_grace_s, preload=PRELOAD_JOBS if settings.preload_planner else (),
         )
         self._cancels: dict[str, threading.Event] = {}
         self._lock = threading.Lock()

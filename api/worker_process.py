@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 STOP = "stop"
+PRELOAD_JOBS = ("avs_planner.jobs", "avs_planner.pddl", "avs_planner.cp.planner")
 JOB_FUNCTIONS = {
     "plan": "avs_planner.jobs:plan",
     "check": "avs_planner.jobs:check_domain",
@@ -74,9 +75,21 @@ def _run_job(channel: _Channel, episode_runner: str, kind: str, payload: dict[st
     return function(**payload)
 
 
-def worker_main(conn: Connection, memory_limit_mb: int, episode_runner: str) -> None:
+def preload(modules: tuple[str, ...]) -> None:
+    """Import what the jobs will need before the first job arrives (best effort)."""
+    for name in modules:
+        try:
+            importlib.import_module(name)
+        except Exception:  # noqa: BLE001 - the job itself reports a missing module properly
+            pass
+
+
+def worker_main(
+    conn: Connection, memory_limit_mb: int, episode_runner: str, modules: tuple[str, ...] = ()
+) -> None:
     """Serve jobs until the pipe closes or a None job arrives."""
     limit_memory(memory_limit_mb)
+    preload(modules)
     while True:
         try:
             message = conn.recv()

@@ -74,7 +74,7 @@ class _Slot:
         parent, child = ctx.Pipe(duplex=True)
         self.process = ctx.Process(
             target=worker_main,
-            args=(child, self.pool.memory_limit_mb, self.pool.episode_runner),
+            args=(child, self.pool.memory_limit_mb, self.pool.episode_runner, self.pool.preload),
             name=f"avs-{self.pool.name}-{self.index}",
             daemon=True,
         )
@@ -179,9 +179,11 @@ class WorkerPool:
     """N worker processes fed from one FIFO of jobs."""
 
     def __init__(
-        self, name: str, size: int, memory_limit_mb: int, episode_runner: str, grace_s: float
+        self, name: str, size: int, memory_limit_mb: int, episode_runner: str, grace_s: float,
+        preload: tuple[str, ...] = (),
     ):
         self.name = name
+        self.preload = preload
         self.memory_limit_mb = memory_limit_mb
         self.episode_runner = episode_runner
         self.grace_s = grace_s

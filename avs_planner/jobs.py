@@ -40,11 +40,22 @@ def check_domain(domain_text: str, problem_texts: Sequence[str] = ()) -> list[di
     """Lint a domain and its problems: one dict per diagnostic (file, line, column, severity,
     message, code); files are named `domain` and `problem[i]`."""
     pddl = _require("avs_planner.pddl", "the PDDL linter")
-    if not hasattr(pddl, "check_text"):
-        raise JobUnavailableError("the PDDL linter (avs_planner.pddl.check_text) not available yet")
-    problems = [(problem_name(i), text) for i, text in enumerate(problem_texts)]
-    found = pddl.check_text(domain_text, problems, domain_name=DOMAIN_NAME)
+    if not hasattr(pddl, "check") or not hasattr(pddl, "PddlSource"):
+        raise JobUnavailableError("the PDDL linter (avs_planner.pddl.check) not available yet")
+    domain = pddl.PddlSource(DOMAIN_NAME, domain_text)
+    problems = [pddl.PddlSource(problem_name(i), text) for i, text in enumerate(problem_texts)]
+    try:
+        found = pddl.check(domain, problems)
+    except PddlError as exc:  # the linter reports what it can; a hard stop is one diagnostic
+        return [_error_diagnostic(exc)]
     return [_diagnostic(d) for d in found]
+
+
+def _error_diagnostic(exc: PddlError) -> dict[str, Any]:
+    return {
+        "file": exc.file, "line": exc.line, "column": exc.column, "severity": "error",
+        "message": exc.message, "code": "error",
+    }
 
 
 def _diagnostic(d: Any) -> dict[str, Any]:
@@ -56,8 +67,9 @@ def _diagnostic(d: Any) -> dict[str, Any]:
 
 
 def plan(domain_text: str, problem_text: str, options: Mapping[str, Any] | None = None) -> dict:
-    """Read and plan one problem. Returns `avs plan --json`'s dict, or
-    `{"status": "invalid", "errors": [{file, line, column, message}]}` for bad PDDL/options."""
+    """Read and plan one problem. Returns `avs plan --json`'s dict; for bad PDDL or options
+    `{"status": "invalid", "errors": [{file, line, column, message}]}`; for a problem the planner
+    cannot handle `{"status": "unsupported", "message": ...}`."""
     pddl = _require("avs_planner.pddl", "the PDDL reader")
     planner = _require("avs_planner.cp.planner", "the continual planner")
     search = _require("avs_planner.cp.search", "the continual planner")
@@ -67,13 +79,14 @@ def plan(domain_text: str, problem_text: str, options: Mapping[str, Any] | None 
         return _invalid(exc.file, exc.line, exc.column, exc.message)
     try:
         search_options = search.SearchOptions(**dict(options or {})).check()
+    except (TypeError, AvsError) as exc:  # an unknown option, or a bad value
+        return _invalid("options", 1, 1, str(exc))
+    try:
         result = planner.plan(problem, search_options)
     except PddlError as exc:
         return _invalid(exc.file, exc.line, exc.column, exc.message)
-    except TypeError as exc:  # an option the planner does not know
-        return _invalid("options", 1, 1, str(exc))
-    except AvsError as exc:  # PlanningError: a bad option value or an unsupported problem
-        return _invalid("options", 1, 1, str(exc))
+    except AvsError as exc:  # PlanningError: a construct the planner does not support
+        return {"status": "unsupported", "message": str(exc)}
     return result.as_json()
 
 

@@ -49,4 +49,4 @@ def pddl_422(errors: list[dict[str, Any]]) -> HTTPException:
 
 
 def _field(file: str) -> str:
-    return file if file in ("domain", "problem") else file or "body"
+    return file if file in ("domain", "problem", "options") else "body"

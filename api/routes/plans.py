@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from fastapi import APIRouter, HTTPException, status
 
 from api.deps import ManagerDep, WriteAccess
 from api.routes.jobs import pddl_422, run_job
@@ -25,4 +25,7 @@ async def create_plan(body: PlanCreate, owner: WriteAccess, manager: ManagerDep)
     value = await run_job(manager, "plan", payload)
     if value.get("status") == "invalid":
         raise pddl_422(value.get("errors", []))
+    if value.get("status") == "unsupported":
+        detail = f"the planner cannot handle this problem: {value.get('message')}"
+        raise HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, detail=detail)
     return PlanPublic.model_validate(value)
