@@ -93,10 +93,10 @@ def _check_domain(domain: Domain, report: Report, usage: Usage) -> None:
     checker = FormulaChecker(domain, report, dict(domain.constants), usage)
     _check_names(domain, report)
     for entry in domain.constants.values():
-        checker.known_type(entry.atom, entry.type)
+        checker.known_type(entry.type_node, entry.type)
     for sig in [*domain.predicates.values(), *domain.functions.values()]:
         for param in sig.params:
-            checker.known_type(param.atom, param.type)
+            checker.known_type(param.type_node, param.type)
     for action in domain.actions.values():
         scope = _parameters(action.params, checker, report)
         if action.precondition is not None:
@@ -119,7 +119,7 @@ def _parameters(params: list, checker: FormulaChecker, report: Report) -> dict[s
             report.add(param.atom, "syntax", f"parameter must be a variable, not '{param.name}'")
         elif param.name in scope:
             report.add(param.atom, "duplicate", f"parameter '{param.name}' is declared twice")
-        checker.known_type(param.atom, param.type)
+        checker.known_type(param.type_node, param.type)
         scope[param.name] = param.type
     return scope
 

@@ -106,7 +106,7 @@ class FormulaChecker:
     def _variable(self, entry: Typed) -> None:
         if not entry.name.startswith("?"):
             self.report.add(entry.atom, "syntax", f"expected a variable (?x), not '{entry.name}'")
-        self.known_type(entry.atom, entry.type)
+        self.known_type(entry.type_node, entry.type)
 
     def known_type(self, node: Node, type_name: str) -> None:
         """Report a type that is not declared."""

@@ -56,7 +56,7 @@ def _check_header(domain: Domain, problem: Problem, report: Report) -> None:
     checker = FormulaChecker(domain, report, {}, Usage())
     taken = set(domain.predicates) | set(domain.functions) | set(domain.actions)
     for name, entry in problem.objects.items():
-        checker.known_type(entry.atom, entry.type)
+        checker.known_type(entry.type_node, entry.type)
         if name in domain.constants:
             report.add(entry.atom, "duplicate", f"object '{name}' is already a domain constant")
         elif name in taken or name in domain.type_atoms:

@@ -33,10 +33,16 @@ class Typed:
 
     atom: Atom
     type: str
+    type_atom: Atom | None = None
 
     @property
     def name(self) -> str:
         return self.atom.text
+
+    @property
+    def type_node(self) -> Atom:
+        """Where the type is written (the name itself when the type is implicit)."""
+        return self.type_atom or self.atom
 
 
 @dataclass
@@ -128,7 +134,9 @@ def typed_list(items: list[Node], report: Report, default: str = OBJECT) -> list
         item = items[i]
         if isinstance(item, Atom) and item.text == "-":
             type_name = _type_after_dash(items, i, report)
-            result += [Typed(a, type_name) for a in pending]
+            type_atom = items[i + 1] if i + 1 < len(items) else None
+            type_atom = type_atom if isinstance(type_atom, Atom) else None
+            result += [Typed(a, type_name, type_atom) for a in pending]
             pending = []
             i += 2
             continue

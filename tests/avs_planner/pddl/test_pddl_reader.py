@@ -80,11 +80,26 @@ def test_translation_keeps_every_offset() -> None:
     assert translation.text.count("(") == text.count("(") - 3
 
 
+FIRST_IPC = [(d, p) for d, p in IPC_PAIRS if p.name == "instance-1.pddl"]
+
+
+def _ids(value: object) -> str:
+    return "/".join(Path(str(value)).parts[-2:])
+
+
 @pytest.mark.skipif(not IPC.exists(), reason="IPC benchmark set not available")
-@pytest.mark.parametrize(("domain", "problem"), IPC_PAIRS, ids=lambda p: str(p)[-30:])
-def test_ipc_instance_loads(domain: Path, problem: Path) -> None:
+@pytest.mark.parametrize(("domain", "problem"), FIRST_IPC, ids=_ids)
+def test_ipc_first_instance_loads(domain: Path, problem: Path) -> None:
     task = read_files(domain, problem)
-    assert task.problem.actions and not task.success
+    assert task.problem.actions and task.problem.goals and not task.success
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not IPC.exists(), reason="IPC benchmark set not available")
+@pytest.mark.parametrize(("domain", "problem"), IPC_PAIRS, ids=_ids)
+def test_every_ipc_instance_loads(domain: Path, problem: Path) -> None:
+    task = read_files(domain, problem)
+    assert task.problem.actions and task.problem.goals and not task.success
 
 
 def test_text_errors_name_the_given_file() -> None:

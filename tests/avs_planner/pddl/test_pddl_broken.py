@@ -1,0 +1,65 @@
+"""Broken inputs: each mistake is found at the right line and column, with the right code."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from avs_planner.errors import PddlError
+from avs_planner.pddl import PddlSource, check, read_text
+
+DATA = Path(__file__).parent / "data"
+DOMAIN = (DATA / "base-domain.pddl").read_text()
+PROBLEM = (DATA / "base-problem.pddl").read_text()
+CASES = json.loads((DATA / "broken.json").read_text())
+
+
+def mutate(case: dict) -> tuple[str, str, tuple[str, int, int]]:
+    """The broken (domain, problem) texts and the expected (file, line, column)."""
+    texts = {"domain": DOMAIN, "problem": PROBLEM}
+    original = texts[case["file"]]
+    assert original.count(case["old"]) == 1, case["name"]
+    broken = original.replace(case["old"], case["new"])
+    texts[case["file"]] = broken
+    find = broken.rfind if case.get("last") else broken.find
+    index = find(case["anchor"]) + case.get("offset", 0)
+    assert index >= 0, case["name"]
+    line = broken.count("\n", 0, index) + 1
+    column = index - (broken.rfind("\n", 0, index) + 1) + 1
+    return texts["domain"], texts["problem"], (f"{case['file']}.pddl", line, column)
+
+
+def test_the_base_files_are_clean() -> None:
+    found = check(PddlSource("domain.pddl", DOMAIN), [PddlSource("problem.pddl", PROBLEM)])
+    assert found == []
+    assert read_text(DOMAIN, PROBLEM).constant_success("place") == pytest.approx(0.9)
+
+
+def test_at_least_fifteen_distinct_mistakes() -> None:
+    assert len({c["name"] for c in CASES}) >= 15
+    assert len({c["code"] for c in CASES}) >= 15
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda c: c["name"])
+def test_check_reports_the_mistake_where_it_is(case: dict) -> None:
+    domain, problem, where = mutate(case)
+    found = check(PddlSource("domain.pddl", domain), [PddlSource("problem.pddl", problem)])
+    errors = [(d.file, d.line, d.column, d.code) for d in found if d.is_error]
+    assert (*where, case["code"]) in errors
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda c: c["name"])
+def test_reader_raises_the_first_error(case: dict) -> None:
+    domain, problem, _ = mutate(case)
+    found = check(PddlSource("domain.pddl", domain), [PddlSource("problem.pddl", problem)])
+    first = next(d for d in found if d.is_error)
+    with pytest.raises(PddlError) as exc:
+        read_text(domain, problem, "domain.pddl", "problem.pddl")
+    assert (exc.value.file, exc.value.line, exc.value.column) == (
+        first.file,
+        first.line,
+        first.column,
+    )
+    assert str(exc.value).startswith(f"{first.file}:{first.line}:{first.column}: ")
