@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import os
 import resource
+import threading
+import time
 import traceback
 from collections.abc import Callable
 from multiprocessing.connection import Connection
@@ -84,10 +87,23 @@ def preload(modules: tuple[str, ...]) -> None:
             pass
 
 
+def exit_with_parent(interval_s: float = 1.0) -> None:
+    """Exit when the service process dies (even by SIGKILL), so no episode runs orphaned."""
+    parent = os.getppid()
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(interval_s)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="avs-parent-watch", daemon=True).start()
+
+
 def worker_main(
     conn: Connection, memory_limit_mb: int, episode_runner: str, modules: tuple[str, ...] = ()
 ) -> None:
     """Serve jobs until the pipe closes or a None job arrives."""
+    exit_with_parent()
     limit_memory(memory_limit_mb)
     preload(modules)
     while True:

@@ -1,0 +1,102 @@
+"""`avs serve` as a real process: refuses an open non-loopback bind; survives a SIGKILL."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.error
+import urllib.request
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import pytest
+
+from avs_planner.cli import EXIT_BAD_INPUT, main
+
+FAKE_RUNNER = f"{Path(__file__).with_name('api_fake_runner.py').resolve()}:run"
+
+
+def test_open_service_refuses_public_bind(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.delenv("AVS_API_KEY", raising=False)
+    assert main(["serve", "--host", "0.0.0.0"]) == EXIT_BAD_INPUT
+    assert "without an API key" in capsys.readouterr().err
+
+
+def test_bad_settings_are_bad_input(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["serve", "--workers", "0"]) == EXIT_BAD_INPUT
+    assert "workers" in capsys.readouterr().err
+
+
+def _free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+def _call(url: str, body: dict | None = None) -> dict:
+    data = json.dumps(body).encode() if body is not None else None
+    request = urllib.request.Request(url, data, {"Content-Type": "application/json"})
+    with urllib.request.urlopen(request, timeout=5) as response:
+        return json.loads(response.read())
+
+
+@contextmanager
+def _server(data_dir: Path, port: int) -> Iterator[subprocess.Popen[bytes]]:
+    env = {**os.environ, "AVS_EPISODE_RUNNER": FAKE_RUNNER, "AVS_PRELOAD_PLANNER": "false",
+           "AVS_WORLDS_DIR": str(data_dir / "worlds"),
+           "AVS_WORKERS": "1", "AVS_PLAN_WORKERS": "1"}
+    env.pop("AVS_API_KEY", None)
+    command = [sys.executable, "-m", "avs_planner", "serve", "--port", str(port),
+               "--data-dir", str(data_dir), "--log-level", "warning"]
+    process = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 30
+        while True:
+            try:
+                _call(f"http://127.0.0.1:{port}/v1/health")
+                break
+            except (urllib.error.URLError, ConnectionError):
+                assert process.poll() is None and time.monotonic() < deadline, "did not start"
+                time.sleep(0.1)
+        yield process
+    finally:
+        if process.poll() is None:
+            process.terminate()
+            process.wait(timeout=15)
+
+
+def _wait_state(base: str, task_id: str, states: set[str]) -> dict:
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline:
+        task = _call(f"{base}/v1/tasks/{task_id}")
+        if task["state"] in states:
+            return task
+        time.sleep(0.05)
+    raise AssertionError(f"{task_id} never reached {states}")
+
+
+@pytest.mark.slow  # two real service start-ups: ~10 s on a busy 2-core machine
+def test_sigkill_mid_task_then_restart_accounts_for_it(tmp_path: Path) -> None:
+    (tmp_path / "worlds").mkdir()
+    (tmp_path / "worlds" / "office.yaml").write_text("name: office\n")
+    port = _free_port()
+    base = f"http://127.0.0.1:{port}"
+    with _server(tmp_path, port) as process:
+        task = _call(f"{base}/v1/tasks", {"target": "slow", "world": "office"})
+        _wait_state(base, task["id"], {"running"})
+        process.send_signal(signal.SIGKILL)
+        process.wait(timeout=10)
+    with _server(tmp_path, port):
+        after = _call(f"{base}/v1/tasks/{task['id']}")
+        assert after["state"] == "failed" and "interrupted" in after["error"]
+        health = _call(f"{base}/v1/health")
+        assert (health["queued"], health["running"]) == (0, 0)
