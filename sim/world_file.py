@@ -176,6 +176,8 @@ def _mapping(value: Any, label: str, where: str, allowed: set[str],
     if not isinstance(value, dict):
         raise WorldFileError(f"{label}: {where}: expected a mapping, got {type(value).__name__}")
     unknown = sorted(str(k) for k in value if k not in allowed)
+    if unknown and "(" not in where:
+        where = _entry_label(where, value)
     if unknown:
         raise WorldFileError(f"{label}: {where}: unknown key {unknown[0]!r} "
                              f"(allowed: {', '.join(sorted(allowed))})")
@@ -183,6 +185,17 @@ def _mapping(value: Any, label: str, where: str, allowed: set[str],
     if missing:
         raise WorldFileError(f"{label}: {where}: missing key {missing[0]!r}")
     return value
+
+
+def _entry_label(where: str, value: dict[str, Any]) -> str:
+    """`rooms[1]` → `rooms[1] (kitchen)` when the entry says its name (or its door's rooms)."""
+    name = value.get("name")
+    rooms = value.get("rooms")
+    if isinstance(name, str):
+        return f"{where} ({name})"
+    if isinstance(rooms, list) and all(isinstance(r, str) for r in rooms):
+        return f"{where} ({'/'.join(rooms)})"
+    return where
 
 
 def _string(value: Any, label: str, where: str) -> str:

@@ -1,0 +1,87 @@
+"""`avs sim render` and `avs sim check`: look at and validate world files."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from sim.errors import SimError
+from sim.render import render_world
+from sim.scene import World
+from sim.world_file import builtin_worlds, load_world_spec
+from sim.world_spec import WorldSpec
+
+_EXIT_OK = 0
+_EXIT_BAD_INPUT = 1
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser("sim", help="simulated worlds: render and check world files")
+    commands = parser.add_subparsers(dest="sim_command", metavar="SIM_COMMAND", required=True)
+    worlds = ", ".join(builtin_worlds())
+    render = commands.add_parser("render", help="draw a world top-down to a PNG")
+    render.add_argument("--world", required=True, help=f"built-in name ({worlds}) or YAML path")
+    render.add_argument("--out", help="PNG to write (default: WORLDNAME.png)")
+    render.set_defaults(func=run_render)
+    check = commands.add_parser("check", help="validate a world file and summarise it")
+    check.add_argument("--world", required=True, help=f"built-in name ({worlds}) or YAML path")
+    check.add_argument("--json", action="store_true", help="print the summary as JSON")
+    check.set_defaults(func=run_check)
+
+
+def run_render(args: argparse.Namespace) -> int:
+    spec = _load(args.world)
+    if spec is None:
+        return _EXIT_BAD_INPUT
+    out = Path(args.out) if args.out else Path(f"{spec.name}.png")
+    if out.suffix.lower() != ".png":
+        print(f"avs: error: --out {out}: expected a .png file", file=sys.stderr)
+        return _EXIT_BAD_INPUT
+    try:
+        render_world(spec, out)
+    except OSError as exc:
+        print(f"avs: error: cannot write {out}: {exc.strerror or exc}", file=sys.stderr)
+        return _EXIT_BAD_INPUT
+    print(f"wrote {out}")
+    return _EXIT_OK
+
+
+def run_check(args: argparse.Namespace) -> int:
+    spec = _load(args.world)
+    if spec is None:
+        return _EXIT_BAD_INPUT
+    summary = _summary(spec)
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        print(f"{spec.source}: ok: world {spec.name!r} {spec.size[0]:g} x {spec.size[1]:g} m, "
+              f"{len(spec.rooms)} rooms, {len(spec.doors)} doors, {len(spec.furniture)} "
+              f"furniture, {len(spec.objects)} objects, robot {spec.robot.model}")
+    return _EXIT_OK
+
+
+def _load(world: str) -> WorldSpec | None:
+    """Parse, validate, and build the world once (which also checks the robot's start)."""
+    try:
+        spec = load_world_spec(world)
+        World(spec).close()
+    except SimError as exc:
+        print(f"avs: error: {exc}", file=sys.stderr)
+        return None
+    return spec
+
+
+def _summary(spec: WorldSpec) -> dict[str, Any]:
+    return {
+        "name": spec.name,
+        "source": spec.source,
+        "size": list(spec.size),
+        "rooms": {r.name: r.category for r in spec.rooms},
+        "doors": [{"rooms": list(d.rooms), "open": d.open} for d in spec.doors],
+        "furniture": {f.name: f.label for f in spec.furniture},
+        "objects": {o.name: o.label for o in spec.objects},
+        "robot": {"model": spec.robot.model, "start": list(spec.robot.start)},
+    }
