@@ -1,0 +1,23 @@
+"""Tunable distances of the place map, in metres (defaults suit a Pioneer in an office)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class PlaceMapConfig:
+    place_spacing: float = 1.0  # a new place once the robot is this far from every place
+    robot_radius: float = 0.25  # for reachability and straight-line edges
+    edge_max_length: float = 1.6  # straight-line edges between places up to this long
+    door_max_width: float = 1.1  # openings narrower than this are door hypotheses
+    door_min_width: float = 0.5
+    door_max_depth: float = 0.35  # a door is a short narrowing (a wall), not a narrow corridor
+    door_merge_distance: float = 0.5
+    probe_range: float = 1.5  # how far the opening probe looks for jambs
+    reach_tolerance: float = 0.6  # frontier cells this close to reachable space count
+    min_frontier_length: float = 0.3
+    min_open_space: float = 0.5  # m^2 of unknown behind a frontier for a placeholder
+    open_space_radius: float = 3.0
+    placeholder_match_distance: float = 1.0
+    trajectory_step: float = 0.05

@@ -1,0 +1,116 @@
+"""Door hypotheses from the robot's own path: a short narrowing it passes through (seed 003 §2).
+
+At each point of the path, chords through the point are probed in many directions up to the
+first occupied cell. The shortest chord is the opening's width across; it is a door when it is
+narrower than ~1.1 m yet widens again a wall's thickness before and after (a narrow corridor
+or a gap between furniture stays narrow for longer).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from conceptual_map.metric.grid2d import OccupancyGrid
+from conceptual_map.metric.logodds import CellState
+from conceptual_map.places.config import PlaceMapConfig
+
+_ANGLES = np.linspace(0.0, np.pi, 24, endpoint=False)
+_WIDENING = 0.3  # metres the chord must grow beside the door to count as short
+
+
+@dataclass(frozen=True)
+class Opening:
+    """A narrow chord through a path point: its centre, width and direction (radians)."""
+
+    centre: np.ndarray
+    width: float
+    angle: float
+
+    @property
+    def axis(self) -> np.ndarray:
+        return np.array([np.cos(self.angle), np.sin(self.angle)])
+
+    @property
+    def normal(self) -> np.ndarray:
+        return np.array([-np.sin(self.angle), np.cos(self.angle)])
+
+    def ends(self) -> tuple[np.ndarray, np.ndarray]:
+        half = 0.5 * self.width * self.axis
+        return self.centre - half, self.centre + half
+
+
+def chord_extents(
+    grid: OccupancyGrid, points: np.ndarray, angles: np.ndarray, reach: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Distances (P, A) from each point to the first occupied cell along +axis and -axis."""
+    occupied = grid.state_grid() == CellState.OCCUPIED
+    steps = np.arange(1, int(np.ceil(reach / (0.5 * grid.resolution))) + 1) * 0.5 * grid.resolution
+    axis = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    out = []
+    for sign in (1.0, -1.0):
+        probe = (
+            points[:, None, None, :] + sign * axis[None, :, None, :] * steps[None, None, :, None]
+        )
+        cells = grid.to_cell(probe.reshape(-1, 2))
+        inside = grid.inside(cells)
+        blocked = np.zeros(cells.shape[0], dtype=bool)
+        blocked[inside] = occupied[cells[inside, 0], cells[inside, 1]]
+        blocked = blocked.reshape(probe.shape[:3])
+        first = np.where(blocked.any(axis=2), steps[np.argmax(blocked, axis=2)], np.inf)
+        out.append(first)
+    return out[0], out[1]
+
+
+def openings_along(
+    grid: OccupancyGrid, points: np.ndarray, config: PlaceMapConfig
+) -> list[Opening]:
+    """Door-like openings at the given path points (at most one per point)."""
+    if points.shape[0] == 0:
+        return []
+    plus, minus = chord_extents(grid, points, _ANGLES, config.probe_range)
+    width = plus + minus
+    best = np.argmin(width, axis=1)
+    rows = np.arange(points.shape[0])
+    narrow = width[rows, best]
+    keep = (narrow >= config.door_min_width) & (narrow <= config.door_max_width)
+    found = []
+    for k in np.nonzero(keep)[0]:
+        angle = float(_ANGLES[best[k]])
+        axis = np.array([np.cos(angle), np.sin(angle)])
+        centre = points[k] + axis * 0.5 * (plus[k, best[k]] - minus[k, best[k]])
+        opening = Opening(centre, float(narrow[k]), angle)
+        if _is_short(grid, opening, config):
+            found.append(opening)
+    return found
+
+
+def _is_short(grid: OccupancyGrid, opening: Opening, config: PlaceMapConfig) -> bool:
+    """The chord widens within `door_max_depth` on both sides of the opening."""
+    beside = np.stack(
+        [opening.centre + s * config.door_max_depth * opening.normal for s in (1.0, -1.0)]
+    )
+    plus, minus = chord_extents(grid, beside, np.array([opening.angle]), config.probe_range)
+    return bool(np.all(plus[:, 0] + minus[:, 0] >= opening.width + _WIDENING))
+
+
+def side_of(opening_centre: np.ndarray, normal: np.ndarray, point: np.ndarray) -> float:
+    """Signed distance of a point from the door line (positive on the normal's side)."""
+    return float(np.dot(np.asarray(point) - opening_centre, normal))
+
+
+def segment_crosses(a: np.ndarray, b: np.ndarray, ends: tuple[np.ndarray, np.ndarray]) -> bool:
+    """Does segment a-b cross the door chord? Points exactly on the door line count as on its
+    positive side, so every place belongs to exactly one side."""
+    p, q = np.asarray(ends[0]), np.asarray(ends[1])
+    d = q - p
+    normal = np.array([-d[1], d[0]])
+    sa, sb = np.dot(a - p, normal) >= 0, np.dot(b - p, normal) >= 0
+    if sa == sb:
+        return False
+    da, db = np.dot(a - p, normal), np.dot(b - p, normal)
+    t = da / (da - db) if da != db else 0.0
+    x = a + t * (b - a)
+    u = np.dot(x - p, d) / np.dot(d, d)
+    return bool(-0.05 <= u <= 1.05)

@@ -1,0 +1,303 @@
+"""The place map (seed 003 §2): places, paths, placeholders, doors and rooms on a networkx graph.
+
+`PlaceMap.follow` takes the robot's poses since the last call and the current occupancy grid
+and returns what changed as `MapEvent`s. It only reads the robot's own grid and poses.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import networkx as nx
+import numpy as np
+
+from conceptual_map.metric.grid2d import OccupancyGrid
+from conceptual_map.places.config import PlaceMapConfig
+from conceptual_map.places.doors import Opening, openings_along, segment_crosses
+from conceptual_map.places.frontiers import FrontierRegion, frontier_regions
+from conceptual_map.places.model import (
+    Change,
+    Door,
+    EntityKind,
+    MapEvent,
+    Place,
+    Placeholder,
+    Room,
+)
+from conceptual_map.places.rooms import free_regions, place_groups, room_geometry
+from conceptual_map.places.tracking import match_by_distance, match_by_overlap
+
+Pose = tuple[float, float, float]
+
+
+class PlaceMap:
+    """The robot's topological map, grown from its path and its occupancy grid."""
+
+    def __init__(self, config: PlaceMapConfig | None = None):
+        self.config = config or PlaceMapConfig()
+        self.graph = nx.Graph()
+        self.places: dict[str, Place] = {}
+        self.placeholders: dict[str, Placeholder] = {}
+        self.doors: dict[str, Door] = {}
+        self.rooms: dict[str, Room] = {}
+        self.current_place: str | None = None
+        self._openings: dict[str, Opening] = {}
+        self._sides: dict[str, set[int]] = {}
+        self._path: list[np.ndarray] = []
+        self._counters: dict[str, int] = {}
+
+    # ---- public API -------------------------------------------------------------------------
+
+    def update(self, grid: OccupancyGrid, pose: Pose, time: float = 0.0) -> list[MapEvent]:
+        """The robot is now at `pose` (having driven straight from its last pose)."""
+        return self.follow(grid, [pose], time)
+
+    def follow(
+        self, grid: OccupancyGrid, poses: Sequence[Pose], time: float = 0.0
+    ) -> list[MapEvent]:
+        """The robot drove through `poses` in order; grow the map and report what changed."""
+        events: list[MapEvent] = []
+        points = self._trajectory(poses)
+        events += self._grow_places(grid, points, time)
+        events += self._find_doors(grid, points, time)
+        self._mark_door_edges()
+        if poses:
+            events += self._refresh_placeholders(grid, poses[-1][:2], time)
+        events += self._refresh_rooms(grid, time)
+        return events
+
+    def room_of(self, place_id: str) -> str | None:
+        """The room holding a place (or, for a placeholder, holding its attached place)."""
+        if place_id in self.placeholders:
+            place_id = self.placeholders[place_id].place or ""
+        for room in self.rooms.values():
+            if place_id in room.places:
+                return room.id
+        return None
+
+    # ---- places -----------------------------------------------------------------------------
+
+    def _new_id(self, prefix: str) -> str:
+        self._counters[prefix] = self._counters.get(prefix, 0) + 1
+        return f"{prefix}{self._counters[prefix]}"
+
+    def _trajectory(self, poses: Sequence[Pose]) -> np.ndarray:
+        """Points every `trajectory_step` along straight legs from the last known pose."""
+        points = [np.asarray(p[:2], dtype=float) for p in poses]
+        if self._path:
+            points.insert(0, self._path[-1])
+        out = [points[0][None, :]]
+        for a, b in zip(points, points[1:], strict=False):
+            n = max(1, int(math.ceil(np.linalg.norm(b - a) / self.config.trajectory_step)))
+            t = np.linspace(0.0, 1.0, n + 1)[1:, None]
+            out.append(a * (1 - t) + b * t)
+        samples = np.vstack(out)
+        if self._path:
+            samples = samples[1:]
+        self._path.extend(samples)
+        return samples
+
+    def _grow_places(self, grid: OccupancyGrid, points: np.ndarray, time: float) -> list[MapEvent]:
+        events = []
+        for p in points:
+            nearest, dist = self._nearest_place(p)
+            if nearest is None or dist >= self.config.place_spacing:
+                events.append(self._add_place(grid, p, time))
+            elif nearest != self.current_place and dist < 0.5 * self.config.place_spacing:
+                self._connect(self.current_place, nearest, traversed=True)
+                self.current_place = nearest
+        return events
+
+    def _nearest_place(self, p: np.ndarray) -> tuple[str | None, float]:
+        best, best_d = None, math.inf
+        for pid, place in self.places.items():
+            d = math.dist(place.position, p)
+            if d < best_d:
+                best, best_d = pid, d
+        return best, best_d
+
+    def _add_place(self, grid: OccupancyGrid, p: np.ndarray, time: float) -> MapEvent:
+        place = Place(self._new_id("place"), (float(p[0]), float(p[1])), time)
+        self.places[place.id] = place
+        self.graph.add_node(place.id, kind="place", pos=place.position)
+        self._connect(self.current_place, place.id, traversed=True)
+        free = grid.traversable(self.config.robot_radius)
+        for other in self.places.values():
+            near = math.dist(other.position, place.position) <= self.config.edge_max_length
+            if other.id != place.id and near and not self.graph.has_edge(other.id, place.id):
+                if grid.segment_clear(other.position, place.position, free):
+                    self._connect(other.id, place.id, traversed=False)
+        self.current_place = place.id
+        return MapEvent(EntityKind.PLACE, Change.APPEARED, place.id, place, time)
+
+    def _connect(self, a: str | None, b: str, traversed: bool) -> None:
+        if a is None or a == b:
+            return
+        if self.graph.has_edge(a, b):
+            self.graph.edges[a, b]["traversed"] |= traversed
+            return
+        length = math.dist(self.places[a].position, self.places[b].position)
+        self.graph.add_edge(a, b, length=length, traversed=traversed, door=None)
+
+    # ---- doors ------------------------------------------------------------------------------
+
+    def _find_doors(self, grid: OccupancyGrid, points: np.ndarray, time: float) -> list[MapEvent]:
+        touched: dict[str, Change] = {}
+        for opening in openings_along(grid, points, self.config):
+            door_id = self._merge_opening(opening)
+            touched.setdefault(door_id, Change.CHANGED)
+            if door_id not in self.doors:
+                touched[door_id] = Change.APPEARED
+        for door_id in self._openings:
+            if self._note_sides(door_id, points if door_id not in touched else self._path):
+                touched.setdefault(door_id, Change.CHANGED)
+        events = []
+        for door_id, change in touched.items():
+            door = self._door_from(door_id)
+            if change is Change.CHANGED and self.doors.get(door_id) == door:
+                continue
+            self.doors[door_id] = door
+            events.append(MapEvent(EntityKind.DOOR, change, door_id, door, time))
+        return events
+
+    def _merge_opening(self, opening: Opening) -> str:
+        for door_id, known in self._openings.items():
+            close = np.linalg.norm(known.centre - opening.centre) < self.config.door_merge_distance
+            if close:
+                if opening.width < known.width - 0.01:
+                    self._openings[door_id] = opening
+                return door_id
+        door_id = self._new_id("door")
+        self._openings[door_id] = opening
+        self._sides[door_id] = set()
+        return door_id
+
+    def _note_sides(self, door_id: str, points: Sequence[np.ndarray] | np.ndarray) -> bool:
+        """Record on which sides of the door the path went; True if a new side was seen."""
+        opening, seen = self._openings[door_id], self._sides[door_id]
+        before = len(seen)
+        pts = np.asarray(points)
+        if pts.size == 0:
+            return False
+        rel = pts - opening.centre
+        along, across = rel @ opening.axis, rel @ opening.normal
+        near = (np.abs(along) <= 0.5 * opening.width) & (np.abs(across) <= 1.5)
+        seen.update(int(s) for s in np.sign(across[near & (np.abs(across) >= 0.2)]))
+        return len(seen) != before
+
+    def _door_from(self, door_id: str) -> Door:
+        opening = self._openings[door_id]
+        a, b = opening.ends()
+        return Door(
+            id=door_id,
+            centre=(float(opening.centre[0]), float(opening.centre[1])),
+            width=round(opening.width, 3),
+            ends=((float(a[0]), float(a[1])), (float(b[0]), float(b[1]))),
+            confirmed=len(self._sides[door_id]) == 2,
+        )
+
+    def _mark_door_edges(self) -> None:
+        for u, v, data in self.graph.edges(data=True):
+            if u not in self.places or v not in self.places:
+                continue
+            a, b = np.asarray(self.places[u].position), np.asarray(self.places[v].position)
+            data["door"] = next(
+                (d.id for d in self.doors.values() if segment_crosses(a, b, d.ends)), None
+            )
+
+    # ---- placeholders -----------------------------------------------------------------------
+
+    def _refresh_placeholders(
+        self, grid: OccupancyGrid, robot: tuple[float, float], time: float
+    ) -> list[MapEvent]:
+        regions = frontier_regions(grid, robot, self.config) if self.places else []
+        old = {k: v.frontier_centre for k, v in self.placeholders.items()}
+        matched = match_by_distance(
+            old, [r.centre for r in regions], self.config.placeholder_match_distance
+        )
+        events, kept = [], set()
+        for i, region in enumerate(regions):
+            pid = matched.get(i) or self._new_id("placeholder")
+            kept.add(pid)
+            new = self._placeholder(pid, region)
+            prev = self.placeholders.get(pid)
+            if prev is None:
+                events.append(MapEvent(EntityKind.PLACEHOLDER, Change.APPEARED, pid, new, time))
+            elif _moved(prev, new):
+                events.append(MapEvent(EntityKind.PLACEHOLDER, Change.CHANGED, pid, new, time))
+            self._set_placeholder(new)
+        for pid in set(self.placeholders) - kept:
+            gone = self.placeholders.pop(pid)
+            self.graph.remove_node(pid)
+            events.append(MapEvent(EntityKind.PLACEHOLDER, Change.VANISHED, pid, gone, time))
+        return events
+
+    def _placeholder(self, pid: str, region: FrontierRegion) -> Placeholder:
+        place, _ = self._nearest_place(np.asarray(region.standpoint))
+        near_door = next(
+            (d.id for d in self.doors.values() if math.dist(d.centre, region.centre) <= 1.0),
+            None,
+        )
+        return Placeholder(
+            id=pid,
+            position=region.standpoint,
+            frontier_centre=region.centre,
+            frontier_length=round(region.length, 3),
+            open_space=round(region.open_space, 3),
+            place=place,
+            near_door=near_door,
+        )
+
+    def _set_placeholder(self, ph: Placeholder) -> None:
+        if ph.id in self.graph:
+            self.graph.remove_node(ph.id)
+        self.placeholders[ph.id] = ph
+        self.graph.add_node(ph.id, kind="placeholder", pos=ph.position)
+        if ph.place is not None:
+            length = math.dist(self.places[ph.place].position, ph.position)
+            self.graph.add_edge(ph.place, ph.id, length=length, traversed=False, door=None)
+
+    # ---- rooms ------------------------------------------------------------------------------
+
+    def _refresh_rooms(self, grid: OccupancyGrid, time: float) -> list[MapEvent]:
+        groups = place_groups(self.graph)
+        matched = match_by_overlap({k: set(r.places) for k, r in self.rooms.items()}, groups)
+        labels = free_regions(grid, [d.ends for d in self.doors.values()])
+        events, kept = [], set()
+        for i, members in enumerate(groups):
+            rid = matched.get(i) or self._new_id("room")
+            kept.add(rid)
+            room = self._room(rid, members, grid, labels)
+            prev = self.rooms.get(rid)
+            self.rooms[rid] = room
+            if prev is None:
+                events.append(MapEvent(EntityKind.ROOM, Change.APPEARED, rid, room, time))
+            elif _room_changed(prev, room):
+                events.append(MapEvent(EntityKind.ROOM, Change.CHANGED, rid, room, time))
+        for rid in set(self.rooms) - kept:
+            gone = self.rooms.pop(rid)
+            events.append(MapEvent(EntityKind.ROOM, Change.VANISHED, rid, gone, time))
+        return events
+
+    def _room(self, rid: str, members: set[str], grid: OccupancyGrid, labels: np.ndarray) -> Room:
+        doors = {
+            door
+            for u, v, door in self.graph.edges(data="door")
+            if door is not None and (u in members or v in members)
+        }
+        area, elongation = room_geometry(
+            grid, labels, [self.places[p].position for p in sorted(members)]
+        )
+        return Room(rid, frozenset(members), frozenset(doors), round(area, 3), round(elongation, 3))
+
+
+def _moved(prev: Placeholder, new: Placeholder) -> bool:
+    shifted = math.dist(prev.position, new.position) > 0.2
+    grown = abs(prev.open_space - new.open_space) > 0.25 * max(prev.open_space, 1e-9)
+    return shifted or grown or prev.place != new.place or prev.near_door != new.near_door
+
+
+def _room_changed(prev: Room, new: Room) -> bool:
+    resized = abs(prev.area - new.area) > 0.5 or abs(prev.elongation - new.elongation) > 0.1
+    return prev.places != new.places or prev.doors != new.doors or resized
