@@ -157,6 +157,8 @@ class Robot:
 
     def detect(self, labels: Sequence[str] | None = None) -> DetectionFrame:
         """Recognise objects (of `labels`, or any) in the camera view (costs `sensing_time`)."""
+        if isinstance(labels, str):
+            labels = [labels]
         self.clock += self.model.time.sensing_time
         return detect_objects(self.world.client, self.camera_view(), self.world.detectables,
                               self.detector_config, self._rng, self.clock, labels)

@@ -163,3 +163,24 @@ def test_place_classifier_with_a_custom_matrix() -> None:
 
 def confusion_column(confusion: dict[str, dict[str, float]], seen: str) -> dict[str, float]:
     return {true: row[seen] for true, row in confusion.items()}
+
+
+def test_min_visible_fraction_decides_on_a_half_seen_object() -> None:
+    with _sensor_room(fn_rate=0.0, fp_rate=0.0) as world:
+        robot = world.robot
+        robot.set_head(0.0, 0.0)
+        robot.turn_to(-0.76)  # the cup (bearing -0.245 rad) sits on the left edge of the image
+        view = robot.camera_view()
+        fraction = visible_fraction(world.client, view, _thing(world, "cup1"))
+        assert 0.2 < fraction < 0.9
+        robot.detector_config = DetectorConfig(fn_rate=0.0, fp_rate=0.0,
+                                                min_visible_fraction=fraction + 0.05)
+        assert "cup" not in robot.detect(["cup"]).labels()
+        robot.detector_config = DetectorConfig(fn_rate=0.0, fp_rate=0.0,
+                                                min_visible_fraction=fraction - 0.05)
+        assert "cup" in robot.detect(["cup"]).labels()
+
+
+def test_a_single_label_string_is_one_label() -> None:
+    with _sensor_room(fn_rate=0.0, fp_rate=0.0) as world:
+        assert world.robot.detect("cup").queried == ("cup",)
