@@ -1,0 +1,176 @@
+"""Relaxed-plan heuristics for the objective c + R(1 - p), chosen by name from a registry.
+
+Every estimator maps a state to a pair (cost part, -log probability part) that depends only
+on the state; the search turns it into h(s, p) = hc + R * p * (1 - exp(-hl)) for a node that
+got to s with probability p. For h^max both parts are h^max values over action costs and over
+-log p(a) respectively, which bound any plan's cost and its -log success probability from
+below, so the combination is admissible for the objective. h_add and FF are not.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from avs_planner.cp.task import GroundTask
+from avs_planner.errors import PlanningError
+
+INF = math.inf
+Estimate = tuple[float, float]
+Estimator = Callable[[int], Estimate]
+
+
+class RelaxedTask:
+    """Per-task arrays the relaxed heuristics iterate over (negative preconditions dropped)."""
+
+    def __init__(self, task: GroundTask, reward: float):
+        self.n_facts = len(task.facts)
+        self.pre = [a.pre_facts for a in task.actions]
+        self.add = [a.add_facts for a in task.actions]
+        self.cost = [a.cost for a in task.actions]
+        self.neglog = [-math.log(a.probability) for a in task.actions]
+        # +1 per action (as LAMA's plusone costs): zero-cost actions otherwise form plateaus
+        self.combined = [1.0 + a.cost + reward * (1.0 - a.probability) for a in task.actions]
+        self.pre_of: list[list[int]] = [[] for _ in range(self.n_facts)]
+        for i, pre in enumerate(self.pre):
+            for f in pre:
+                self.pre_of[f].append(i)
+        self.no_pre = [i for i, pre in enumerate(self.pre) if not pre]
+        self.goal = [i for i in range(self.n_facts) if task.goal >> i & 1]
+
+
+def relaxed_costs(
+    rt: RelaxedTask, state: int, weights: list[float], use_max: bool
+) -> tuple[list[float], list[int]]:
+    """Generalised Dijkstra: cost of each fact (h^max or h^add) and its best supporter."""
+    dist = [INF] * rt.n_facts
+    support = [-1] * rt.n_facts
+    heap: list[tuple[float, int]] = []
+    for f in range(rt.n_facts):
+        if state >> f & 1:
+            dist[f] = 0.0
+            heap.append((0.0, f))
+    remaining = [len(p) for p in rt.pre]
+    value = [0.0] * len(rt.pre)
+
+    def fire(a: int, base: float) -> None:
+        nd = base + weights[a]
+        for g in rt.add[a]:
+            if nd < dist[g]:
+                dist[g] = nd
+                support[g] = a
+                heapq.heappush(heap, (nd, g))
+
+    for a in rt.no_pre:
+        fire(a, 0.0)
+    goals_left = set(rt.goal)
+    while heap and goals_left:
+        d, f = heapq.heappop(heap)
+        if d > dist[f]:
+            continue
+        goals_left.discard(f)
+        for a in rt.pre_of[f]:
+            value[a] = max(value[a], d) if use_max else value[a] + d
+            remaining[a] -= 1
+            if remaining[a] == 0:
+                fire(a, value[a])
+    return dist, support
+
+
+def _goal_value(rt: RelaxedTask, dist: list[float], use_max: bool) -> float:
+    values = [dist[g] for g in rt.goal]
+    if not values:
+        return 0.0
+    return max(values) if use_max else sum(values)
+
+
+def _hmax(task: GroundTask, reward: float) -> Estimator:
+    rt = RelaxedTask(task, reward)
+
+    def estimate(state: int) -> Estimate:
+        dist, _ = relaxed_costs(rt, state, rt.cost, True)
+        hc = _goal_value(rt, dist, True)
+        if hc == INF:
+            return INF, INF
+        dist, _ = relaxed_costs(rt, state, rt.neglog, True)
+        return hc, _goal_value(rt, dist, True)
+
+    return estimate
+
+
+def _hadd(task: GroundTask, reward: float) -> Estimator:
+    rt = RelaxedTask(task, reward)
+
+    def estimate(state: int) -> Estimate:
+        dist, _ = relaxed_costs(rt, state, rt.cost, False)
+        hc = _goal_value(rt, dist, False)
+        if hc == INF:
+            return INF, INF
+        dist, _ = relaxed_costs(rt, state, rt.neglog, False)
+        return hc, _goal_value(rt, dist, False)
+
+    return estimate
+
+
+def _ff(task: GroundTask, reward: float) -> Estimator:
+    """h_add on the combined weight c(a) + R(1 - p(a)), then a relaxed plan's own c and -log p."""
+    rt = RelaxedTask(task, reward)
+
+    def estimate(state: int) -> Estimate:
+        dist, support = relaxed_costs(rt, state, rt.combined, False)
+        if any(dist[g] == INF for g in rt.goal):
+            return INF, INF
+        chosen: set[int] = set()
+        stack = [g for g in rt.goal if not state >> g & 1]
+        seen: set[int] = set(stack)
+        while stack:
+            a = support[stack.pop()]
+            if a < 0 or a in chosen:
+                continue
+            chosen.add(a)
+            for f in rt.pre[a]:
+                if f not in seen and not state >> f & 1:
+                    seen.add(f)
+                    stack.append(f)
+        return sum(rt.cost[a] + 1.0 for a in chosen), sum(rt.neglog[a] for a in chosen)
+
+    return estimate
+
+
+def _blind(task: GroundTask, reward: float) -> Estimator:
+    def estimate(state: int) -> Estimate:
+        return 0.0, 0.0
+
+    return estimate
+
+
+@dataclass(frozen=True)
+class HeuristicSpec:
+    """A heuristic's name travels with its factory and whether it is admissible."""
+
+    name: str
+    factory: Callable[[GroundTask, float], Estimator]
+    admissible: bool
+    description: str
+
+
+HEURISTICS: dict[str, HeuristicSpec] = {
+    spec.name: spec
+    for spec in (
+        HeuristicSpec("hmax", _hmax, True, "probabilistic h^max (admissible; optimal at w=1)"),
+        HeuristicSpec("hadd", _hadd, False, "probabilistic h_add (inadmissible)"),
+        HeuristicSpec("ff", _ff, False, "FF relaxed plan on c + R(1-p) (inadmissible, default)"),
+        HeuristicSpec("blind", _blind, True, "zero (uniform-cost search on the objective)"),
+    )
+}
+
+
+def get_heuristic(name: str) -> HeuristicSpec:
+    """The registered heuristic called `name`; PlanningError listing the choices otherwise."""
+    try:
+        return HEURISTICS[name]
+    except KeyError:
+        known = ", ".join(sorted(HEURISTICS))
+        raise PlanningError(f"unknown heuristic {name!r} (choose one of: {known})") from None

@@ -1,0 +1,193 @@
+"""Lifted action schemas compiled from a UP problem into plain tuples the grounder joins over.
+
+Terms are strings: a parameter is `?name`, anything else is an object name. Numeric
+expressions (action costs, success probabilities) become closures over a parameter binding
+and a table of static numeric values, so evaluating them per ground action is cheap.
+"""
+
+from __future__ import annotations
+
+import operator
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from fractions import Fraction
+
+from unified_planning.model import (
+    FNode,
+    InstantaneousAction,
+    MinimizeActionCosts,
+    Problem,
+    Type,
+)
+
+from avs_planner.errors import PlanningError
+from avs_planner.pddl.model import ProbabilisticProblem
+
+Term = str
+AtomTemplate = tuple[str, ...]  # (predicate, term, ...)
+Binding = Mapping[str, str]
+NumExpr = Callable[[Binding, Mapping[tuple[str, ...], float]], float]
+
+
+@dataclass(frozen=True)
+class LiftedSchema:
+    """One action: parameters with their types, conditions split static/dynamic, effects."""
+
+    name: str
+    params: tuple[str, ...]
+    param_types: tuple[Type, ...]
+    static_pos: tuple[AtomTemplate, ...]
+    static_neg: tuple[AtomTemplate, ...]
+    pre_pos: tuple[AtomTemplate, ...]
+    pre_neg: tuple[AtomTemplate, ...]
+    equal: tuple[tuple[Term, Term], ...]
+    not_equal: tuple[tuple[Term, Term], ...]
+    add: tuple[AtomTemplate, ...]
+    delete: tuple[AtomTemplate, ...]
+    cost: NumExpr
+    probability: NumExpr
+    complex: tuple[FNode, ...] = ()
+    never: bool = False
+
+
+def _term(node: FNode) -> Term:
+    if node.is_parameter_exp():
+        return "?" + node.parameter().name
+    if node.is_object_exp():
+        return node.object().name
+    raise PlanningError(f"unsupported argument {node} (only parameters and objects)")
+
+
+def atom_template(node: FNode) -> AtomTemplate:
+    """`(pred ?x obj)` of a boolean fluent expression."""
+    return (node.fluent().name, *(_term(a) for a in node.args))
+
+
+_ARITH: dict[str, Callable[[float, float], float]] = {
+    "PLUS": operator.add,
+    "MINUS": operator.sub,
+    "TIMES": operator.mul,
+    "DIV": operator.truediv,
+}
+
+
+def compile_numeric(node: FNode, where: str) -> NumExpr:
+    """A closure evaluating a numeric UP expression under a binding and static values."""
+    if node.is_constant():
+        return _constant(float(Fraction(str(node.constant_value()))))
+    if node.is_fluent_exp():
+        name = node.fluent().name
+        terms = tuple(_term(a) for a in node.args)
+
+        def fluent_value(b: Binding, v: Mapping[tuple[str, ...], float]) -> float:
+            key = (name, *(b[t] if t[0] == "?" else t for t in terms))
+            if key not in v:
+                raise PlanningError(f"{where}: no value for ({' '.join(key)}) in :init")
+            return v[key]
+
+        return fluent_value
+    kind = node.node_type.name
+    if kind in _ARITH and node.args:
+        parts = [compile_numeric(a, where) for a in node.args]
+        op = _ARITH[kind]
+
+        def arith(b: Binding, v: Mapping[tuple[str, ...], float]) -> float:
+            acc = parts[0](b, v)
+            for part in parts[1:]:
+                acc = op(acc, part(b, v))
+            return acc
+
+        return arith
+    raise PlanningError(f"{where}: unsupported numeric expression {node}")
+
+
+def _conjuncts(node: FNode) -> list[FNode]:
+    if node.is_and():
+        return [c for arg in node.args for c in _conjuncts(arg)]
+    return [node]
+
+
+def _split_preconditions(action: InstantaneousAction, static: set[str]) -> dict[str, list]:
+    parts: dict[str, list] = {
+        k: [] for k in ("sp", "sn", "dp", "dn", "eq", "ne", "never", "complex")
+    }
+    for cond in (c for pre in action.preconditions for c in _conjuncts(pre)):
+        negated = cond.is_not()
+        inner = cond.arg(0) if negated else cond
+        if inner.is_fluent_exp() and inner.fluent().type.is_bool_type():
+            atom = atom_template(inner)
+            key = ("s" if atom[0] in static else "d") + ("n" if negated else "p")
+            parts[key].append(atom)
+        elif inner.is_equals():
+            parts["ne" if negated else "eq"].append((_term(inner.arg(0)), _term(inner.arg(1))))
+        elif inner.is_bool_constant():
+            if inner.bool_constant_value() == negated:
+                parts["never"].append(True)
+        else:
+            parts["complex"].append(cond)  # or / imply / forall / exists: grounded to CNF
+    return parts
+
+
+def _split_effects(action: InstantaneousAction) -> tuple[list, list]:
+    add: list[AtomTemplate] = []
+    delete: list[AtomTemplate] = []
+    for eff in action.effects:
+        if eff.is_conditional() or eff.is_forall() or not eff.is_assignment():
+            raise PlanningError(f"action {action.name}: unsupported effect {eff}")
+        if not eff.fluent.fluent().type.is_bool_type():
+            raise PlanningError(f"action {action.name}: numeric effect {eff} is not supported")
+        if not eff.value.is_bool_constant():
+            raise PlanningError(f"action {action.name}: non-constant effect {eff}")
+        (add if eff.value.bool_constant_value() else delete).append(atom_template(eff.fluent))
+    return add, delete
+
+
+def _cost_exprs(problem: Problem) -> tuple[dict[str, FNode], FNode | None]:
+    for metric in problem.quality_metrics:
+        if isinstance(metric, MinimizeActionCosts):
+            costs = {a.name: metric.get_action_cost(a) for a in problem.actions}
+            return costs, metric.default
+    return {}, None
+
+
+def compile_schemas(pproblem: ProbabilisticProblem) -> tuple[LiftedSchema, ...]:
+    """Compile every action of the problem; raises PlanningError naming what is unsupported."""
+    problem = pproblem.problem
+    static = {f.name for f in problem.get_static_fluents()}
+    costs, _default = _cost_exprs(problem)  # default is 0 when a metric is given
+    has_metric = bool(costs)
+    schemas = []
+    for action in problem.actions:
+        if not isinstance(action, InstantaneousAction):
+            raise PlanningError(f"action {action.name}: only instantaneous actions are supported")
+        parts = _split_preconditions(action, static)
+        add, delete = _split_effects(action)
+        cost_node = costs.get(action.name)
+        if cost_node is None:
+            cost = _constant(0.0 if has_metric else 1.0)
+        else:
+            cost = compile_numeric(cost_node, f"cost of {action.name}")
+        prob_node = pproblem.success.get(action.name)
+        prob = (
+            _constant(1.0)
+            if prob_node is None
+            else compile_numeric(prob_node, f"success probability of {action.name}")
+        )
+        schemas.append(
+            LiftedSchema(
+                name=action.name,
+                params=tuple("?" + p.name for p in action.parameters),
+                param_types=tuple(p.type for p in action.parameters),
+                static_pos=tuple(parts["sp"]), static_neg=tuple(parts["sn"]),
+                pre_pos=tuple(parts["dp"]), pre_neg=tuple(parts["dn"]),
+                equal=tuple(parts["eq"]), not_equal=tuple(parts["ne"]),
+                add=tuple(add), delete=tuple(delete),
+                cost=cost, probability=prob, never=bool(parts["never"]),
+                complex=tuple(parts["complex"]),
+            )
+        )
+    return tuple(schemas)
+
+
+def _constant(value: float) -> NumExpr:
+    return lambda b, v: value

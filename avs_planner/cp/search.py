@@ -1,0 +1,299 @@
+"""Weighted A* on g = c + R(1 - p) over a `GroundTask` (seed 003, "Switching Planner").
+
+A node carries its cost c and success probability p. Two paths to the same state are only
+merged when one dominates the other in both c and p, because the better g now need not be
+the better g later (the rest of the plan scales R(1 - p)). With an admissible heuristic and
+weight 1 the first goal popped is optimal for the objective.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+import time
+from dataclasses import dataclass, field
+from enum import Enum
+
+from avs_planner.cp.heuristics import get_heuristic
+from avs_planner.cp.task import GroundAction, GroundTask, atom_str
+from avs_planner.errors import PlanningError
+
+DEFAULT_REWARD = 1000.0
+
+
+class PlanStatus(Enum):
+    SOLVED = "solved"
+    UNSOLVABLE = "unsolvable"
+    NO_PLAN_ABOVE_THRESHOLD = "no_plan_above_threshold"
+    TIMEOUT = "timeout"
+    NODE_LIMIT = "node_limit"
+
+
+@dataclass(frozen=True)
+class SearchOptions:
+    """R (goal reward), weight w of f = g + w h, heuristic name, limits, success threshold."""
+
+    reward: float = DEFAULT_REWARD
+    weight: float = 1.0
+    heuristic: str = "ff"
+    timeout_s: float | None = None
+    node_limit: int | None = None
+    min_success: float = 0.0
+
+    def check(self) -> SearchOptions:
+        if self.reward < 0 or not math.isfinite(self.reward):
+            raise PlanningError(f"reward must be a finite number >= 0, got {self.reward}")
+        if self.weight < 1 or not math.isfinite(self.weight):
+            raise PlanningError(f"weight must be a finite number >= 1, got {self.weight}")
+        if self.timeout_s is not None and self.timeout_s <= 0:
+            raise PlanningError(f"timeout must be > 0 seconds, got {self.timeout_s}")
+        if self.node_limit is not None and self.node_limit <= 0:
+            raise PlanningError(f"node limit must be > 0, got {self.node_limit}")
+        if not 0.0 <= self.min_success <= 1.0:
+            raise PlanningError(f"success threshold must be in [0, 1], got {self.min_success}")
+        get_heuristic(self.heuristic)
+        return self
+
+
+@dataclass(frozen=True)
+class PlanStep:
+    """One grounded action of a plan."""
+
+    name: str
+    args: tuple[str, ...]
+    cost: float
+    probability: float
+    assumptive: bool = False
+
+    @property
+    def label(self) -> str:
+        return atom_str((self.name, *self.args))
+
+    @classmethod
+    def of(cls, action: GroundAction) -> PlanStep:
+        return cls(action.name, action.args, action.cost, action.probability, action.assumptive)
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """Outcome of one planning call; `plan` is empty unless status is SOLVED."""
+
+    status: PlanStatus
+    plan: tuple[PlanStep, ...] = ()
+    cost: float = 0.0
+    probability: float = 0.0
+    objective: float = math.inf
+    planning_time_s: float = 0.0
+    expanded: int = 0
+    generated: int = 0
+    reward: float = DEFAULT_REWARD
+    heuristic: str = ""
+    weight: float = 1.0
+    grounding_time_s: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def solved(self) -> bool:
+        return self.status is PlanStatus.SOLVED
+
+    def as_json(self) -> dict:
+        """The JSON shape `avs plan --json` and the HTTP service rely on."""
+        return {
+            "status": self.status.value,
+            "plan": [s.label for s in self.plan],
+            "cost": self.cost,
+            "probability": self.probability,
+            "objective": self.objective if math.isfinite(self.objective) else None,
+            "planning_time_s": self.planning_time_s,
+            "grounding_time_s": self.grounding_time_s,
+            "expanded": self.expanded,
+            "generated": self.generated,
+            "reward": self.reward,
+            "heuristic": self.heuristic,
+            "weight": self.weight,
+        }
+
+
+def objective(cost: float, probability: float, reward: float) -> float:
+    """The seed's c(pi) + R(1 - p(pi))."""
+    return cost + reward * (1.0 - probability)
+
+
+class _Labels:
+    """Per-state Pareto set of (cost, probability, node) labels."""
+
+    def __init__(self) -> None:
+        self.by_state: dict[int, list[tuple[float, float, int]]] = {}
+
+    def add(self, state: int, c: float, p: float, node: int, alive: list[bool]) -> bool:
+        labels = self.by_state.get(state)
+        if labels is None:
+            self.by_state[state] = [(c, p, node)]
+            return True
+        for c0, p0, _ in labels:
+            if c0 <= c and p0 >= p:
+                return False
+        kept = []
+        for label in labels:
+            if c <= label[0] and p >= label[1]:
+                alive[label[2]] = False
+            else:
+                kept.append(label)
+        kept.append((c, p, node))
+        self.by_state[state] = kept
+        return True
+
+
+def search(task: GroundTask, options: SearchOptions | None = None) -> PlanResult:
+    """Weighted A* from `task.init`; times itself (search only, not grounding)."""
+    options = (options or SearchOptions()).check()
+    start = time.perf_counter()
+    if task.goal_impossible:
+        return _finish(task, options, PlanStatus.UNSOLVABLE, None, start, 0, 0)
+    return _Search(task, options, start).run()
+
+
+class _Search:
+    def __init__(self, task: GroundTask, options: SearchOptions, start: float):
+        self.task, self.options, self.start = task, options, start
+        self.reward, self.weight = options.reward, options.weight
+        self.estimator = get_heuristic(options.heuristic).factory(task, options.reward)
+        self.h_cache: dict[int, tuple[float, float]] = {}
+        self.states: list[int] = []
+        self.costs: list[float] = []
+        self.probs: list[float] = []
+        self.parents: list[int] = []
+        self.via: list[int] = []
+        self.alive: list[bool] = []
+        self.labels = _Labels()
+        self.heap: list[tuple[float, float, int]] = []
+        self.pruned_threshold = False
+        self.lazy = not get_heuristic(options.heuristic).admissible
+        self.h_of_node: list[float] = []
+        self.evaluated: list[bool] = []
+        self.commutes: dict[tuple[int, int], bool] = {}
+
+    def h(self, state: int, p: float) -> float:
+        est = self.h_cache.get(state)
+        if est is None:
+            est = self.h_cache[state] = self.estimator(state)
+        hc, hl = est
+        if hc == math.inf:
+            return math.inf
+        return hc + self.reward * p * (1.0 - math.exp(-hl))
+
+    def push(self, state: int, c: float, p: float, parent: int, action: int) -> None:
+        if p <= 0.0 or p < self.options.min_success:
+            self.pruned_threshold |= p > 0.0
+            return
+        node = len(self.states)
+        if not self.labels.add(state, c, p, node, self.alive):
+            return
+        if self.lazy and parent >= 0:
+            h = self.h_of_node[parent]  # deferred: evaluated when popped
+        else:
+            h = self.h(state, p)
+        self.states.append(state)
+        self.costs.append(c)
+        self.probs.append(p)
+        self.parents.append(parent)
+        self.via.append(action)
+        self.alive.append(h != math.inf)
+        self.h_of_node.append(h)
+        self.evaluated.append(not (self.lazy and parent >= 0))
+        if h != math.inf:
+            g = objective(c, p, self.reward)
+            heapq.heappush(self.heap, (g + self.weight * h, h, node))
+
+    def commute(self, i: int, j: int) -> bool:
+        key = (i, j)
+        value = self.commutes.get(key)
+        if value is None:
+            value = self.commutes[key] = self.task.actions[i].commutes_with(self.task.actions[j])
+        return value
+
+    def evaluate(self, node: int) -> bool:
+        """Deferred evaluation: True if the node may be expanded now, else it was re-queued."""
+        if self.evaluated[node]:
+            return True
+        self.evaluated[node] = True
+        h = self.h(self.states[node], self.probs[node])
+        self.h_of_node[node] = h
+        if h == math.inf:
+            self.alive[node] = False
+            return False
+        g = objective(self.costs[node], self.probs[node], self.reward)
+        f = g + self.weight * h
+        if self.heap and f > self.heap[0][0]:
+            heapq.heappush(self.heap, (f, h, node))
+            return False
+        return True
+
+    def run(self) -> PlanResult:
+        task, options = self.task, self.options
+        self.push(task.init, 0.0, 1.0, -1, -1)
+        expanded = 0
+        actions = task.actions
+        while self.heap:
+            _, _, node = heapq.heappop(self.heap)
+            if not self.alive[node] or not self.evaluate(node):
+                continue
+            self.alive[node] = False
+            state, c, p = self.states[node], self.costs[node], self.probs[node]
+            if task.is_goal(state):
+                return self.finish(PlanStatus.SOLVED, node, expanded)
+            expanded += 1
+            if options.node_limit is not None and expanded > options.node_limit:
+                return self.finish(PlanStatus.NODE_LIMIT, None, expanded)
+            if options.timeout_s is not None and expanded % 64 == 0:
+                if time.perf_counter() - self.start > options.timeout_s:
+                    return self.finish(PlanStatus.TIMEOUT, None, expanded)
+            last = self.via[node]
+            for a in actions:
+                if (state & a.pre) == a.pre and not (state & a.pre_neg):
+                    if a.clauses and not a.applicable(state):
+                        continue
+                    if last > a.index and self.commute(a.index, last):
+                        continue  # the order (a, last) is explored instead
+                    succ = (state & ~a.delete) | a.add
+                    self.push(succ, c + a.cost, p * a.probability, node, a.index)
+        status = (
+            PlanStatus.NO_PLAN_ABOVE_THRESHOLD if self.pruned_threshold else PlanStatus.UNSOLVABLE
+        )
+        return self.finish(status, None, expanded)
+
+    def finish(self, status: PlanStatus, node: int | None, expanded: int) -> PlanResult:
+        path: list[int] = []
+        while node is not None and node >= 0 and self.via[node] >= 0:
+            path.append(self.via[node])
+            node = self.parents[node]
+        path.reverse()
+        steps = [self.task.actions[i] for i in path]
+        return _finish(
+            self.task, self.options, status, steps, self.start, expanded, len(self.states)
+        )
+
+
+def _finish(
+    task: GroundTask,
+    options: SearchOptions,
+    status: PlanStatus,
+    steps: list[GroundAction] | None,
+    start: float,
+    expanded: int,
+    generated: int,
+) -> PlanResult:
+    elapsed = time.perf_counter() - start
+    if status is not PlanStatus.SOLVED or steps is None:
+        return PlanResult(
+            status, planning_time_s=elapsed, expanded=expanded, generated=generated,
+            reward=options.reward, heuristic=options.heuristic, weight=options.weight,
+        )
+    plan = tuple(PlanStep.of(a) for a in steps)
+    cost = math.fsum(s.cost for s in plan)
+    probability = math.prod(s.probability for s in plan)
+    return PlanResult(
+        status, plan, cost, probability, objective(cost, probability, options.reward),
+        planning_time_s=elapsed, expanded=expanded, generated=generated,
+        reward=options.reward, heuristic=options.heuristic, weight=options.weight,
+    )

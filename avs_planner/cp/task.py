@@ -1,0 +1,129 @@
+"""The grounded probabilistic task the search runs on: facts are ints, states are int bitsets.
+
+A `GroundTask` is immutable; `with_state` gives the same task from another initial state
+without grounding again (the continual planner's replans from a new state use it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field, replace
+
+Atom = tuple[str, ...]
+"""A ground atom: (predicate, arg1, ..., argN), names as in the problem."""
+
+
+def atom_str(atom: Atom) -> str:
+    """PDDL-style text of an atom or action: `(move hall far)`."""
+    return "(" + " ".join(atom) + ")"
+
+
+@dataclass(frozen=True, slots=True)
+class GroundAction:
+    """One grounded action: STRIPS bitsets plus cost and success probability."""
+
+    index: int
+    name: str
+    args: tuple[str, ...]
+    pre: int
+    pre_neg: int
+    add: int
+    delete: int
+    cost: float
+    probability: float
+    assumptive: bool = False
+    pre_facts: tuple[int, ...] = ()
+    add_facts: tuple[int, ...] = ()
+    clauses: tuple[tuple[int, int], ...] = ()
+    """Disjunctive preconditions: (pos, neg) holds if a pos fact is true or a neg fact false."""
+
+    @property
+    def reads(self) -> int:
+        """Every fact the action's applicability depends on."""
+        mask = self.pre | self.pre_neg
+        for pos, neg in self.clauses:
+            mask |= pos | neg
+        return mask
+
+    def commutes_with(self, other: GroundAction) -> bool:
+        """Neither touches what the other reads or writes: both orders give the same state."""
+        w1, w2 = self.add | self.delete, other.add | other.delete
+        return not (
+            self.reads & w2 or other.reads & w1 or self.add & other.delete
+            or self.delete & other.add
+        )
+
+    def applicable(self, state: int) -> bool:
+        if (state & self.pre) != self.pre or state & self.pre_neg:
+            return False
+        return all(state & pos or neg & ~state for pos, neg in self.clauses)
+
+    def apply(self, state: int) -> int:
+        """PDDL semantics: deletes first, then adds."""
+        return (state & ~self.delete) | self.add
+
+    @property
+    def label(self) -> str:
+        return atom_str((self.name, *self.args))
+
+
+@dataclass(frozen=True)
+class WorldState:
+    """What the planner believes now: true boolean atoms and numeric fluent values.
+
+    The switching loop builds one from the conceptual map (or updates the problem's own with
+    `updated`) and hands it to the planner; grounding structure is reused as long as the
+    static atoms and objects stay the same.
+    """
+
+    true_atoms: frozenset[Atom]
+    values: Mapping[Atom, float] = field(default_factory=dict)
+
+    def updated(
+        self,
+        add: Iterable[Atom] = (),
+        delete: Iterable[Atom] = (),
+        values: Mapping[Atom, float] | None = None,
+    ) -> WorldState:
+        """A new state with atoms added/removed and numeric values overridden."""
+        atoms = (self.true_atoms - frozenset(delete)) | frozenset(add)
+        merged = dict(self.values)
+        merged.update(values or {})
+        return WorldState(atoms, merged)
+
+
+@dataclass(frozen=True)
+class GroundTask:
+    """Facts, reachable ground actions, initial state and goal of one planning call."""
+
+    facts: tuple[Atom, ...]
+    fact_index: Mapping[Atom, int]
+    actions: tuple[GroundAction, ...]
+    init: int
+    goal: int
+    goal_neg: int = 0
+    goal_impossible: bool = False
+    by_signature: Mapping[tuple[str, ...], GroundAction] = field(default_factory=dict)
+
+    def is_goal(self, state: int) -> bool:
+        return (state & self.goal) == self.goal and not (state & self.goal_neg)
+
+    def state_of(self, atoms: Iterable[Atom]) -> int:
+        """Bitset of the given atoms (atoms outside this task's fact table are ignored)."""
+        bits = 0
+        index = self.fact_index
+        for atom in atoms:
+            i = index.get(atom)
+            if i is not None:
+                bits |= 1 << i
+        return bits
+
+    def atoms_of(self, state: int) -> list[Atom]:
+        return [self.facts[i] for i in range(len(self.facts)) if state >> i & 1]
+
+    def action(self, name: str, args: Iterable[str]) -> GroundAction | None:
+        """The ground action with this name and arguments, if it is in the task."""
+        return self.by_signature.get((name.lower(), *(a.lower() for a in args)))
+
+    def with_init(self, init: int) -> GroundTask:
+        return replace(self, init=init)
