@@ -93,9 +93,15 @@ class World:
         w, h = self.spec.size
         self._static_box("floor", (w / 2, h / 2, -0.05), (w + 1.0, h + 1.0, 0.1), 0.0)
         t = self.spec.wall_thickness
+        door_edges = {(d.segment.axis, round(d.segment.line, 6), round(v, 6))
+                      for d in self.doors for v in (d.segment.lo, d.segment.hi)}
         for seg in self.walls:
-            length = seg.hi - seg.lo + t
-            mid = (seg.lo + seg.hi) / 2
+            # close the corners by t/2 at each end, but never narrow a door opening
+            lo = seg.lo - (0 if (seg.axis, round(seg.line, 6), round(seg.lo, 6)) in door_edges
+                           else t / 2)
+            hi = seg.hi + (0 if (seg.axis, round(seg.line, 6), round(seg.hi, 6)) in door_edges
+                           else t / 2)
+            length, mid = hi - lo, (lo + hi) / 2
             center = (seg.line, mid) if seg.axis == "x" else (mid, seg.line)
             size = (t, length) if seg.axis == "x" else (length, t)
             name = f"wall {seg.axis}={seg.line:g} [{seg.lo:g}, {seg.hi:g}]"

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sim.errors import WorldFileError
+from sim.rays import ranges_along
 from sim.scene import World, load_world
 from sim.walls import door_openings, wall_segments
 from sim.world_file import builtin_worlds, load_world_spec
@@ -92,3 +94,15 @@ def test_doors_cut_openings_in_the_shared_wall() -> None:
     assert walls_on_y4 == [(0.0, pytest.approx(1.55)), (pytest.approx(2.45), 8.0)]
     openings = door_openings(spec)
     assert [(o.segment.lo, o.segment.hi) for o in openings][0] == (1.55, 2.45)
+
+
+def test_door_opening_in_the_scene_is_as_wide_as_the_file_says() -> None:
+    with load_world("office") as world:  # kitchen door: centre (2.0, 4.0), width 0.9
+        along_wall = np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+        gaps = ranges_along(world.client, np.array([2.0, 4.0, 1.0]), along_wall, 3.0)
+        assert gaps == pytest.approx([0.45, 0.45])
+        world.set_door_open(0, False)
+        assert not world.door_is_open(0)
+        across = ranges_along(world.client, np.array([2.0, 3.5, 1.0]),
+                              np.array([[0.0, 1.0, 0.0]]), 3.0)
+        assert across[0] == pytest.approx(0.5 - 0.02)  # the closed door panel is 4 cm thick
