@@ -1,7 +1,8 @@
 """Geometric validation of a parsed world: every impossible thing is an error naming its entry.
 
 Checked: unique names, rooms inside the world and not overlapping, doors on the wall two rooms
-share, furniture inside its room clear of the walls, objects on a furniture top or inside a room.
+share, furniture inside its room clear of the walls and of other furniture, objects on a
+furniture top or inside a room.
 """
 
 from __future__ import annotations
@@ -117,9 +118,25 @@ def _check_furniture(spec: WorldSpec, i: int, item: FurnitureSpec) -> None:
         if not room.contains(x, y, margin - _EPS):
             raise _fail(spec, where, f"overlaps a wall of room {room.name}: corner "
                         f"({x:.2f}, {y:.2f}) is within {margin:g} m of the border")
+    for other in spec.furniture[:i]:
+        if _footprints_overlap(item.footprint(), other.footprint()):
+            raise _fail(spec, where, f"overlaps furniture {other.name}")
     if item.size[2] >= spec.wall_height:
         raise _fail(spec, where, f"height {item.size[2]:g} reaches the ceiling "
                     f"(wall_height {spec.wall_height:g})")
+
+
+def _footprints_overlap(a: list[tuple[float, float]], b: list[tuple[float, float]]) -> bool:
+    """Separating-axis test of two convex quadrilaterals (touching does not count)."""
+    for poly in (a, b):
+        for k in range(len(poly)):
+            (x0, y0), (x1, y1) = poly[k], poly[(k + 1) % len(poly)]
+            nx, ny = y0 - y1, x1 - x0
+            pa = [nx * x + ny * y for x, y in a]
+            pb = [nx * x + ny * y for x, y in b]
+            if max(pa) <= min(pb) + _EPS or max(pb) <= min(pa) + _EPS:
+                return False
+    return True
 
 
 def _check_object(spec: WorldSpec, i: int, obj: ObjectSpec) -> None:

@@ -25,6 +25,7 @@ BROKEN = {
     "object_floating": ["objects[0] (cereal1)", "floating", "table1"],
     "object_in_furniture": ["objects[1] (mug1)", "intersects furniture table1"],
     "furniture_in_wall": ["furniture[0] (table1)", "overlaps a wall of room kitchen"],
+    "furniture_overlap": ["furniture[1] (counter1)", "overlaps furniture table1"],
     "unknown_room_ref": ["furniture[0] (table1)", "no room named 'garage'"],
     "bad_robot_model": ["robot.model", "unknown model 'turtlebot'"],
     "robot_start_collides": ["robot.start", "collides with mug1"],
