@@ -25,7 +25,17 @@ _TOP_KEYS = {"name", "size", "wall_height", "wall_thickness", "rooms", "doors", 
 
 
 class _WorldLoader(yaml.SafeLoader):
-    """YAML 1.2 booleans: only true/false, so the key `on:` stays the string "on"."""
+    """YAML 1.2 booleans (only true/false, so the key `on:` stays "on"); no duplicate keys."""
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+        seen: set[Any] = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            if key in seen:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"duplicate key {key!r}", key_node.start_mark)
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
 
 
 _WorldLoader.yaml_implicit_resolvers = {
@@ -65,7 +75,7 @@ def load_world_spec(source: str | Path) -> WorldSpec:
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark
         where = f":{mark.line + 1}:{mark.column + 1}" if mark is not None else ""
-        raise WorldFileError(f"{label}{where}: YAML syntax error: {exc.problem}") from None
+        raise WorldFileError(f"{label}{where}: YAML error: {exc.problem}") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise WorldFileError(f"{label}: cannot read: {exc}") from None
     spec = parse_world(data, label)

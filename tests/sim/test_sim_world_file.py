@@ -31,7 +31,8 @@ BROKEN = {
     "robot_start_collides": ["robot.start", "collides with mug1"],
     "duplicate_name": ["objects[1] (table1)", "already used by furniture[0] (table1)"],
     "bad_vector": ["size", "expected a list of 2 numbers"],
-    "yaml_syntax": ["broken_yaml_syntax.yaml:6:", "YAML syntax error"],
+    "yaml_syntax": ["broken_yaml_syntax.yaml:6:5", "YAML error: expected ','"],
+    "duplicate_key": ["broken_duplicate_key.yaml:4:1", "duplicate key 'size'"],
 }
 
 
