@@ -55,8 +55,12 @@ class World:
         self._door_open = [d.open for d in self.doors]
         self._names: dict[int, str] = {}
         self.detectables: list[Detectable] = []
-        self._build()
-        self.robot = Robot(self, spec.robot.model, spec.robot.start)
+        try:
+            self._build()
+            self.robot = Robot(self, spec.robot.model, spec.robot.start)
+        except BaseException:
+            self.close()  # a refused world must not leak its physics client
+            raise
 
     def rng(self, stream: str) -> np.random.Generator:
         """A generator for one named purpose, determined by the world's seed and the name."""
