@@ -6,6 +6,7 @@ Drawn from the world spec alone (no physics), so a user can check a world file b
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import matplotlib
@@ -33,14 +34,18 @@ def category_colours(spec: WorldSpec) -> dict[str, str]:
 
 
 def render_world(spec: WorldSpec, out: str | Path,
-                 robot_pose: tuple[float, float, float] | None = None) -> Path:
-    """Write a PNG of `spec` to `out` (robot at its start pose unless `robot_pose` is given)."""
+                 robot_pose: tuple[float, float, float] | None = None,
+                 trajectory: Sequence[Sequence[float]] = ()) -> Path:
+    """Write a PNG of `spec` to `out`: robot at `robot_pose` (default: start), optional path."""
     w, h = spec.size
     fig, ax = plt.subplots(figsize=(max(6.0, w * 0.9), max(4.0, h * 0.9) + 0.6))
     try:
         _draw_rooms(ax, spec)
         _draw_walls_and_doors(ax, spec)
         _draw_furniture_and_objects(ax, spec)
+        if len(trajectory) > 1:
+            xs, ys = zip(*[(p[0], p[1]) for p in trajectory], strict=True)
+            ax.plot(xs, ys, color="#1f3a93", linewidth=1.5, zorder=7, label="trajectory")
         _draw_robot(ax, spec, robot_pose or spec.robot.start)
         ax.set_xlim(-0.3, w + 0.3)
         ax.set_ylim(-0.3, h + 0.3)

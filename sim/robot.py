@@ -100,6 +100,14 @@ class Robot:
         self.odometry += distance
         return self._spend(duration, distance)
 
+    def blocked_by(self, path: Sequence[Sequence[float]]) -> str | None:
+        """Why `move_along(path)` would be refused (a message), or None if it is free."""
+        try:
+            self._check_path([_waypoint(p, i) for i, p in enumerate(path)])
+        except PathBlockedError as exc:
+            return str(exc)
+        return None
+
     def turn_to(self, yaw: float) -> MotionResult:
         """Turn in place to heading `yaw` the short way round."""
         if not math.isfinite(yaw):

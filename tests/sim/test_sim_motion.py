@@ -133,3 +133,12 @@ def test_several_worlds_live_side_by_side() -> None:
     finally:
         first.close()
         second.close()
+
+
+def test_blocked_by_explains_without_moving() -> None:
+    with load_world("office") as world:
+        robot = world.robot
+        assert robot.blocked_by([(7.0, 3.2), (7.0, 5.5)]) is None
+        reason = robot.blocked_by([(5.0, 3.2), (5.0, 6.0)])
+        assert reason is not None and "wall y=4" in reason
+        assert robot.pose == (6.0, 3.2, 0.0) and robot.clock == 0.0

@@ -54,3 +54,11 @@ def test_cli_check_prints_json(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["sim", "check", "--world", "qsr_desks", "--json"]) == 0
     out = capsys.readouterr().out
     assert '"name": "qsr_desks"' in out and '"model": "pioneer"' in out
+
+
+def test_render_with_a_trajectory_and_pose(tmp_path: Path) -> None:
+    spec = load_world_spec("office")
+    path = [(6.0, 3.2), (2.0, 3.25), (2.0, 5.0)]
+    plain = render_world(spec, tmp_path / "plain.png").read_bytes()
+    drawn = render_world(spec, tmp_path / "tour.png", (2.0, 5.0, 1.57), path).read_bytes()
+    assert drawn.startswith(PNG_MAGIC) and drawn != plain
