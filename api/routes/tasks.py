@@ -127,7 +127,7 @@ def cancel_task(task_id: TaskId, owner: WriteAccess, manager: ManagerDep) -> Tas
 async def stream_events(
     task: TaskDep,
     store: StoreDep,
-    last_event_id: Annotated[int | None, Header(alias="Last-Event-ID", ge=0)] = None,
+    last_event_id: Annotated[int | None, Header(alias="Last-Event-ID", ge=0, le=2**62)] = None,
 ) -> AsyncIterable[ServerSentEvent]:
     """The task's events as Server-Sent Events, from after `Last-Event-ID`; ends with the task."""
     after = last_event_id or 0
