@@ -5,8 +5,9 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 
-from avs_planner.cp.grounding import GroundingCache, ground
+from avs_planner.cp.grounding import GroundingCache, ground, world_state
 from avs_planner.cp.search import PlanResult, SearchOptions, search
+from avs_planner.cp.symmetry import NO_SYMMETRIES, find_symmetries
 from avs_planner.cp.task import GroundTask, WorldState
 from avs_planner.pddl.model import ProbabilisticProblem
 
@@ -20,9 +21,11 @@ def plan(
     """Plan from `state` (default: the problem's :init); planning_time_s includes grounding."""
     options = (options or SearchOptions()).check()
     start = time.perf_counter()
+    state = world_state(pproblem.problem) if state is None else state
     task = ground(pproblem, state, cache)
+    symmetries = find_symmetries(pproblem, state, task) if options.symmetry else NO_SYMMETRIES
     grounded = time.perf_counter()
-    result = search(task, options)
+    result = search(task, options, symmetries)
     return replace(
         result,
         planning_time_s=time.perf_counter() - start,

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 
 from avs_planner.cp.heuristics import get_heuristic
+from avs_planner.cp.symmetry import NO_SYMMETRIES, Symmetries
 from avs_planner.cp.task import GroundAction, GroundTask, atom_str
 from avs_planner.errors import PlanningError
 
@@ -39,6 +40,8 @@ class SearchOptions:
     timeout_s: float | None = None
     node_limit: int | None = None
     min_success: float = 0.0
+    symmetry: bool = True
+    lazy: bool = False
 
     def check(self) -> SearchOptions:
         if self.reward < 0 or not math.isfinite(self.reward):
@@ -144,18 +147,25 @@ class _Labels:
         return True
 
 
-def search(task: GroundTask, options: SearchOptions | None = None) -> PlanResult:
+def search(
+    task: GroundTask,
+    options: SearchOptions | None = None,
+    symmetries: Symmetries = NO_SYMMETRIES,
+) -> PlanResult:
     """Weighted A* from `task.init`; times itself (search only, not grounding)."""
     options = (options or SearchOptions()).check()
     start = time.perf_counter()
     if task.goal_impossible:
         return _finish(task, options, PlanStatus.UNSOLVABLE, None, start, 0, 0)
-    return _Search(task, options, start).run()
+    return _Search(task, options, start, symmetries).run()
 
 
 class _Search:
-    def __init__(self, task: GroundTask, options: SearchOptions, start: float):
+    def __init__(
+        self, task: GroundTask, options: SearchOptions, start: float, symmetries: Symmetries
+    ):
         self.task, self.options, self.start = task, options, start
+        self.symmetries = symmetries
         self.reward, self.weight = options.reward, options.weight
         self.estimator = get_heuristic(options.heuristic).factory(task, options.reward)
         self.h_cache: dict[int, tuple[float, float]] = {}
@@ -168,19 +178,22 @@ class _Search:
         self.labels = _Labels()
         self.heap: list[tuple[float, float, int]] = []
         self.pruned_threshold = False
-        self.lazy = not get_heuristic(options.heuristic).admissible
+        self.lazy = options.lazy and not get_heuristic(options.heuristic).admissible
         self.h_of_node: list[float] = []
         self.evaluated: list[bool] = []
         self.commutes: dict[tuple[int, int], bool] = {}
 
-    def h(self, state: int, p: float) -> float:
+    def f(self, state: int, c: float, p: float) -> float:
+        """c + w*hc + R(1 - p exp(-hl)): the weight inflates the remaining cost only; weighting
+        the failure risk too would make a lower p look better (f = g + h at w = 1)."""
         est = self.h_cache.get(state)
         if est is None:
             est = self.h_cache[state] = self.estimator(state)
         hc, hl = est
         if hc == math.inf:
             return math.inf
-        return hc + self.reward * p * (1.0 - math.exp(-hl))
+        w = self.weight
+        return c + w * hc + self.reward * (1.0 - p * math.exp(-hl))
 
     def push(self, state: int, c: float, p: float, parent: int, action: int) -> None:
         if p <= 0.0 or p < self.options.min_success:
@@ -189,10 +202,11 @@ class _Search:
         node = len(self.states)
         if not self.labels.add(state, c, p, node, self.alive):
             return
+        g = objective(c, p, self.reward)
         if self.lazy and parent >= 0:
             h = self.h_of_node[parent]  # deferred: evaluated when popped
         else:
-            h = self.h(state, p)
+            h = self.f(state, c, p) - g
         self.states.append(state)
         self.costs.append(c)
         self.probs.append(p)
@@ -202,8 +216,7 @@ class _Search:
         self.h_of_node.append(h)
         self.evaluated.append(not (self.lazy and parent >= 0))
         if h != math.inf:
-            g = objective(c, p, self.reward)
-            heapq.heappush(self.heap, (g + self.weight * h, h, node))
+            heapq.heappush(self.heap, (g + h, h, node))
 
     def commute(self, i: int, j: int) -> bool:
         key = (i, j)
@@ -217,13 +230,13 @@ class _Search:
         if self.evaluated[node]:
             return True
         self.evaluated[node] = True
-        h = self.h(self.states[node], self.probs[node])
-        self.h_of_node[node] = h
-        if h == math.inf:
+        c, p = self.costs[node], self.probs[node]
+        f = self.f(self.states[node], c, p)
+        if f == math.inf:
             self.alive[node] = False
             return False
-        g = objective(self.costs[node], self.probs[node], self.reward)
-        f = g + self.weight * h
+        h = f - objective(c, p, self.reward)
+        self.h_of_node[node] = h
         if self.heap and f > self.heap[0][0]:
             heapq.heappush(self.heap, (f, h, node))
             return False
@@ -234,6 +247,7 @@ class _Search:
         self.push(task.init, 0.0, 1.0, -1, -1)
         expanded = 0
         actions = task.actions
+        symmetries = self.symmetries
         while self.heap:
             _, _, node = heapq.heappop(self.heap)
             if not self.alive[node] or not self.evaluate(node):
@@ -255,6 +269,8 @@ class _Search:
                         continue
                     if last > a.index and self.commute(a.index, last):
                         continue  # the order (a, last) is explored instead
+                    if symmetries.checks and symmetries.prunes(a.index, state):
+                        continue  # a mirror image with a lower object is explored
                     succ = (state & ~a.delete) | a.add
                     self.push(succ, c + a.cost, p * a.probability, node, a.index)
         status = (

@@ -1,0 +1,140 @@
+"""Interchangeable objects (e.g. the pre-allocated virtual `new-object1..k`) and pruning them.
+
+Two objects of the same type are interchangeable when swapping their names maps the initial
+state, the numeric values and the goal onto themselves and the domain never names either.
+Then, in a state that the swap leaves unchanged, applying an action to the higher one leads
+to a mirror image of applying it to the lower one (same cost, same probability), so the
+search only tries the lower one.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+
+from unified_planning.model import FNode, Problem
+
+from avs_planner.cp.task import Atom, GroundTask, WorldState
+from avs_planner.pddl.model import ProbabilisticProblem
+
+Pair = tuple[str, str]
+
+
+def _swap(atom: Atom, a: str, b: str) -> Atom:
+    return (atom[0], *(b if x == a else a if x == b else x for x in atom[1:]))
+
+
+def _named_objects(pproblem: ProbabilisticProblem) -> set[str]:
+    """Objects the domain or the goal names explicitly (PDDL constants, goal arguments)."""
+    problem = pproblem.problem
+    roots: list[FNode] = list(problem.goals) + list(pproblem.success.values())
+    for action in problem.actions:
+        roots.extend(action.preconditions)
+        for eff in action.effects:
+            roots.extend((eff.fluent, eff.value, eff.condition))
+    for metric in problem.quality_metrics:
+        roots.extend(getattr(metric, "costs", {}).values())
+    names: set[str] = set()
+    stack = roots
+    while stack:
+        node = stack.pop()
+        if node.is_object_exp():
+            names.add(node.object().name)
+        stack.extend(node.args)
+    return names
+
+
+def _mentions(state: WorldState) -> dict[str, list[Atom]]:
+    index: dict[str, list[Atom]] = defaultdict(list)
+    for atom in list(state.true_atoms) + list(state.values):
+        for x in set(atom[1:]):
+            index[x].append(atom)
+    return index
+
+
+def _interchangeable(a: str, b: str, state: WorldState, mentions) -> bool:
+    atoms = set(mentions.get(a, ())) | set(mentions.get(b, ()))
+    for atom in atoms:
+        other = _swap(atom, a, b)
+        if atom in state.true_atoms:
+            if other not in state.true_atoms:
+                return False
+        elif state.values.get(atom) != state.values.get(other):
+            return False
+    return True
+
+
+@dataclass(frozen=True)
+class Symmetries:
+    """Groups of interchangeable objects and, per pair, the fact pairs the swap exchanges."""
+
+    groups: tuple[tuple[str, ...], ...]
+    fact_pairs: Mapping[Pair, tuple[tuple[int, int], ...]]
+    checks: Mapping[int, tuple[Pair, ...]]  # action index -> pairs that may prune it
+
+    def prunes(self, action_index: int, state: int) -> bool:
+        """True if a lower interchangeable object makes this action redundant in `state`."""
+        for pair in self.checks.get(action_index, ()):
+            if all((state >> f & 1) == (g >= 0 and state >> g & 1)
+                   for f, g in self.fact_pairs[pair]):
+                return True
+        return False
+
+
+NO_SYMMETRIES = Symmetries((), {}, {})
+
+
+def find_symmetries(
+    pproblem: ProbabilisticProblem, state: WorldState, task: GroundTask
+) -> Symmetries:
+    """Interchangeable object groups of this task in this state (none if nothing is)."""
+    problem: Problem = pproblem.problem
+    named = _named_objects(pproblem)
+    mentions = _mentions(state)
+    by_type: dict[str, list[str]] = defaultdict(list)
+    for obj in problem.all_objects:
+        if obj.name not in named:
+            by_type[str(obj.type)].append(obj.name)
+    groups = []
+    for names in by_type.values():
+        groups.extend(_partition(names, state, mentions))
+    groups = [g for g in groups if len(g) > 1]
+    if not groups:
+        return NO_SYMMETRIES
+    return _build(task, groups)
+
+
+def _partition(names: list[str], state: WorldState, mentions) -> list[tuple[str, ...]]:
+    classes: list[list[str]] = []
+    for name in names:
+        for cls in classes:
+            if _interchangeable(cls[0], name, state, mentions):
+                cls.append(name)
+                break
+        else:
+            classes.append([name])
+    return [tuple(c) for c in classes]
+
+
+def _build(task: GroundTask, groups: Iterable[tuple[str, ...]]) -> Symmetries:
+    fact_pairs: dict[Pair, tuple[tuple[int, int], ...]] = {}
+    lower: dict[str, list[Pair]] = {}
+    facts_of: dict[str, list[int]] = defaultdict(list)
+    for i, atom in enumerate(task.facts):
+        for x in set(atom[1:]):
+            facts_of[x].append(i)
+    for group in groups:
+        for j, b in enumerate(group):
+            lower[b] = [(a, b) for a in group[:j]]
+            for a in group[:j]:
+                touched = sorted(set(facts_of[a]) | set(facts_of[b]))
+                fact_pairs[(a, b)] = tuple(
+                    (f, task.fact_index.get(_swap(task.facts[f], a, b), -1)) for f in touched
+                )
+    checks = {}
+    for action in task.actions:
+        pairs = tuple(p for x in dict.fromkeys(action.args) for p in lower.get(x, ()))
+        if pairs:
+            checks[action.index] = pairs
+    return Symmetries(tuple(groups), fact_pairs, checks)
