@@ -50,20 +50,25 @@ class OccupancyGrid(LogOddsGrid):
         return self._cached(("states",), self.states)
 
     def frontier_mask(self) -> np.ndarray:
-        """Unknown cells with at least one free 4-neighbour."""
-        states = self.state_grid()
-        near_free = ndimage.binary_dilation(states == CellState.FREE, structure=_FOUR)
-        return near_free & (states == CellState.UNKNOWN)
+        """Unknown cells with at least one free 4-neighbour (cached until the next update)."""
+
+        def build() -> np.ndarray:
+            states = self.state_grid()
+            near_free = ndimage.binary_dilation(states == CellState.FREE, structure=_FOUR)
+            return near_free & (states == CellState.UNKNOWN)
+
+        return self._cached(("frontier",), build)
 
     def clearance(self) -> np.ndarray:
-        """Distance (m) from each cell centre to the nearest occupied cell's border."""
+        """Distance (m) from each cell centre to the nearest occupied cell, less that cell's
+        half-diagonal: a lower bound on the distance to the surface that made it occupied."""
 
         def build() -> np.ndarray:
             occupied = self.state_grid() == CellState.OCCUPIED
             if not occupied.any():
                 return np.full(self.shape, np.inf)
             dist = ndimage.distance_transform_edt(~occupied) * self.resolution
-            return dist - 0.5 * self.resolution
+            return dist - self.resolution / np.sqrt(2.0)
 
         return self._cached(("clearance",), build)
 

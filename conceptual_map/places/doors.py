@@ -70,7 +70,9 @@ def openings_along(
     if points.shape[0] == 0:
         return []
     plus, minus = chord_extents(grid, points, _ANGLES, config.probe_range)
-    width = plus + minus
+    # the probe stops at the near border of a jamb's cell; the surface lies, on average,
+    # half a cell further in on each side
+    width = plus + minus + grid.resolution
     best = np.argmin(width, axis=1)
     rows = np.arange(points.shape[0])
     narrow = width[rows, best]
@@ -95,22 +97,19 @@ def _is_short(grid: OccupancyGrid, opening: Opening, config: PlaceMapConfig) -> 
     return bool(np.all(plus[:, 0] + minus[:, 0] >= opening.width + _WIDENING))
 
 
-def side_of(opening_centre: np.ndarray, normal: np.ndarray, point: np.ndarray) -> float:
-    """Signed distance of a point from the door line (positive on the normal's side)."""
-    return float(np.dot(np.asarray(point) - opening_centre, normal))
-
-
-def segment_crosses(a: np.ndarray, b: np.ndarray, ends: tuple[np.ndarray, np.ndarray]) -> bool:
-    """Does segment a-b cross the door chord? Points exactly on the door line count as on its
-    positive side, so every place belongs to exactly one side."""
-    p, q = np.asarray(ends[0]), np.asarray(ends[1])
+def path_crosses(points: np.ndarray, ends: tuple[np.ndarray, np.ndarray]) -> bool:
+    """Does the polyline through `points` (K, 2) cross the door chord? Points exactly on the
+    door line count as on its positive side, so every place belongs to exactly one side."""
+    pts = np.asarray(points, dtype=float)
+    p, q = np.asarray(ends[0], dtype=float), np.asarray(ends[1], dtype=float)
     d = q - p
     normal = np.array([-d[1], d[0]])
-    sa, sb = np.dot(a - p, normal) >= 0, np.dot(b - p, normal) >= 0
-    if sa == sb:
+    side = (pts - p) @ normal
+    a, b = side[:-1], side[1:]
+    switch = (a >= 0) != (b >= 0)
+    if not switch.any():
         return False
-    da, db = np.dot(a - p, normal), np.dot(b - p, normal)
-    t = da / (da - db) if da != db else 0.0
-    x = a + t * (b - a)
-    u = np.dot(x - p, d) / np.dot(d, d)
-    return bool(-0.05 <= u <= 1.05)
+    t = a[switch] / (a[switch] - b[switch])
+    x = pts[:-1][switch] + t[:, None] * (pts[1:][switch] - pts[:-1][switch])
+    u = (x - p) @ d / (d @ d)
+    return bool(np.any((u >= -0.05) & (u <= 1.05)))

@@ -53,38 +53,47 @@ def frontier_regions(
     reachable = reachable_mask(grid, robot, config.robot_radius)
     if not reachable.any():
         return []
-    far, nearest = ndimage.distance_transform_edt(~reachable, return_indices=True)
-    frontier = grid.frontier_mask() & (far * grid.resolution <= config.reach_tolerance)
-    labels, count = ndimage.label(frontier, structure=_EIGHT)
+    reach = int(np.ceil(config.reach_tolerance / grid.resolution)) + 1
+    window = _bounding_window(reachable, reach, grid.shape)
+    far = ndimage.distance_transform_edt(~reachable[window]) * grid.resolution
+    frontier = grid.frontier_mask()[window] & (far <= config.reach_tolerance)
+    labels, _ = ndimage.label(frontier, structure=_EIGHT)
+    sizes = np.bincount(labels.ravel())
     unknown_labels, _ = ndimage.label(grid.state_grid() == CellState.UNKNOWN)
+    offset = np.array([window[0].start, window[1].start])
     regions = []
-    for cells in _groups(labels, count):
-        if cells.shape[0] * grid.resolution < config.min_frontier_length:
+    for k, box in enumerate(ndimage.find_objects(labels), start=1):
+        if sizes[k] * grid.resolution < config.min_frontier_length:
             continue
-        region = _describe(grid, cells, nearest, unknown_labels, config)
-        if region.open_space >= config.min_open_space:
+        cells = np.argwhere(labels[box] == k) + [box[0].start, box[1].start] + offset
+        region = _describe(grid, cells, reachable, unknown_labels, config)
+        if region is not None and region.open_space >= config.min_open_space:
             regions.append(region)
     return regions
 
 
-def _groups(labels: np.ndarray, count: int) -> list[np.ndarray]:
-    """Cell coordinates of each labelled group, without scanning the grid once per label."""
-    flat = labels.ravel()
-    order = np.argsort(flat, kind="stable")
-    bounds = np.searchsorted(flat[order], np.arange(1, count + 2))
-    coords = np.stack(np.unravel_index(order, labels.shape), axis=1)
-    return [coords[bounds[k] : bounds[k + 1]] for k in range(count)]
+def _bounding_window(mask: np.ndarray, margin: int, shape: tuple[int, ...]) -> tuple[slice, ...]:
+    """The bounding box of a mask's True cells, grown by `margin` cells."""
+    rows, cols = np.nonzero(mask.any(axis=1))[0], np.nonzero(mask.any(axis=0))[0]
+    return (
+        slice(max(rows[0] - margin, 0), min(rows[-1] + margin + 1, shape[0])),
+        slice(max(cols[0] - margin, 0), min(cols[-1] + margin + 1, shape[1])),
+    )
 
 
 def _describe(
     grid: OccupancyGrid,
     cells: np.ndarray,
-    nearest: np.ndarray,
+    reachable: np.ndarray,
     unknown_labels: np.ndarray,
     config: PlaceMapConfig,
-) -> FrontierRegion:
+) -> FrontierRegion | None:
     medoid = cells[np.argmin(np.linalg.norm(cells - cells.mean(axis=0), axis=1))]
-    stand = (int(nearest[0][tuple(medoid)]), int(nearest[1][tuple(medoid)]))
+    stand = _nearest_true(
+        reachable, medoid, int(np.ceil(2 * config.reach_tolerance / grid.resolution))
+    )
+    if stand is None:
+        return None
     standpoint = grid.to_world(np.asarray([stand]))[0]
     centre = grid.to_world(medoid[None, :])[0]
     space = _open_space(grid, medoid, unknown_labels, config.open_space_radius)
@@ -94,6 +103,16 @@ def _describe(
         length=cells.shape[0] * grid.resolution,
         open_space=space,
     )
+
+
+def _nearest_true(mask: np.ndarray, cell: np.ndarray, radius: int) -> np.ndarray | None:
+    """The True cell of `mask` nearest to `cell` within a square window of `radius` cells."""
+    i0, j0 = max(cell[0] - radius, 0), max(cell[1] - radius, 0)
+    found = np.argwhere(mask[i0 : cell[0] + radius + 1, j0 : cell[1] + radius + 1])
+    if found.shape[0] == 0:
+        return None
+    found += [i0, j0]
+    return found[np.argmin(np.linalg.norm(found - cell, axis=1))]
 
 
 def _open_space(

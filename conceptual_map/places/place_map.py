@@ -14,7 +14,7 @@ import numpy as np
 
 from conceptual_map.metric.grid2d import OccupancyGrid
 from conceptual_map.places.config import PlaceMapConfig
-from conceptual_map.places.doors import Opening, openings_along, segment_crosses
+from conceptual_map.places.doors import Opening, openings_along, path_crosses
 from conceptual_map.places.frontiers import FrontierRegion, frontier_regions
 from conceptual_map.places.model import (
     Change,
@@ -42,10 +42,12 @@ class PlaceMap:
         self.doors: dict[str, Door] = {}
         self.rooms: dict[str, Room] = {}
         self.current_place: str | None = None
+        self._since_current: list[np.ndarray] = []  # path points since leaving current_place
         self._openings: dict[str, Opening] = {}
         self._sides: dict[str, set[int]] = {}
         self._path: list[np.ndarray] = []
         self._counters: dict[str, int] = {}
+        self._door_revision = 0  # edges remember which revision of the doors they were checked at
 
     # ---- public API -------------------------------------------------------------------------
 
@@ -101,13 +103,18 @@ class PlaceMap:
     def _grow_places(self, grid: OccupancyGrid, points: np.ndarray, time: float) -> list[MapEvent]:
         events = []
         for p in points:
+            self._since_current.append(p)
             nearest, dist = self._nearest_place(p)
             if nearest is None or dist >= self.config.place_spacing:
                 events.append(self._add_place(grid, p, time))
             elif nearest != self.current_place and dist < 0.5 * self.config.place_spacing:
                 self._connect(self.current_place, nearest, traversed=True)
-                self.current_place = nearest
+                self._arrive(nearest)
         return events
+
+    def _arrive(self, place_id: str) -> None:
+        self.current_place = place_id
+        self._since_current = [np.asarray(self.places[place_id].position)]
 
     def _nearest_place(self, p: np.ndarray) -> tuple[str | None, float]:
         best, best_d = None, math.inf
@@ -128,17 +135,21 @@ class PlaceMap:
             if other.id != place.id and near and not self.graph.has_edge(other.id, place.id):
                 if grid.segment_clear(other.position, place.position, free):
                     self._connect(other.id, place.id, traversed=False)
-        self.current_place = place.id
+        self._arrive(place.id)
         return MapEvent(EntityKind.PLACE, Change.APPEARED, place.id, place, time)
 
     def _connect(self, a: str | None, b: str, traversed: bool) -> None:
         if a is None or a == b:
             return
+        ends = [np.asarray(self.places[a].position), np.asarray(self.places[b].position)]
+        trace = np.array([ends[0], *self._since_current[1:], ends[1]]) if traversed else None
         if self.graph.has_edge(a, b):
-            self.graph.edges[a, b]["traversed"] |= traversed
+            edge = self.graph.edges[a, b]
+            edge["traversed"] |= traversed
+            edge["trace"] = edge["trace"] if edge["trace"] is not None else trace
             return
         length = math.dist(self.places[a].position, self.places[b].position)
-        self.graph.add_edge(a, b, length=length, traversed=traversed, door=None)
+        self.graph.add_edge(a, b, length=length, traversed=traversed, door=None, trace=trace)
 
     # ---- doors ------------------------------------------------------------------------------
 
@@ -158,6 +169,7 @@ class PlaceMap:
             if change is Change.CHANGED and self.doors.get(door_id) == door:
                 continue
             self.doors[door_id] = door
+            self._door_revision += 1
             events.append(MapEvent(EntityKind.DOOR, change, door_id, door, time))
         return events
 
@@ -198,13 +210,21 @@ class PlaceMap:
         )
 
     def _mark_door_edges(self) -> None:
+        """An edge passes a door if its straight line does, or (if driven) the path driven does."""
         for u, v, data in self.graph.edges(data=True):
             if u not in self.places or v not in self.places:
                 continue
+            if data.get("doors_checked") == self._door_revision:
+                continue
             a, b = np.asarray(self.places[u].position), np.asarray(self.places[v].position)
-            data["door"] = next(
-                (d.id for d in self.doors.values() if segment_crosses(a, b, d.ends)), None
+            lines = [np.array([a, b])]
+            if data["trace"] is not None:
+                lines.append(data["trace"])
+            crossed = (
+                d.id for d in self.doors.values() if any(path_crosses(ln, d.ends) for ln in lines)
             )
+            data["door"] = next(crossed, None)
+            data["doors_checked"] = self._door_revision
 
     # ---- placeholders -----------------------------------------------------------------------
 
@@ -256,7 +276,9 @@ class PlaceMap:
         self.graph.add_node(ph.id, kind="placeholder", pos=ph.position)
         if ph.place is not None:
             length = math.dist(self.places[ph.place].position, ph.position)
-            self.graph.add_edge(ph.place, ph.id, length=length, traversed=False, door=None)
+            self.graph.add_edge(
+                ph.place, ph.id, length=length, traversed=False, door=None, trace=None
+            )
 
     # ---- rooms ------------------------------------------------------------------------------
 

@@ -1,0 +1,155 @@
+"""Frontier exploration by nearest placeholder: a driver for tests, benchmarks, explore-only runs.
+
+It only uses what a robot adapter offers (pose, move_along, turn_to, scan, clock) and the
+robot's own maps; the planner's MOVE actions go through the executor instead.
+"""
+
+from __future__ import annotations
+
+import math
+import time as wallclock
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Protocol
+
+import numpy as np
+
+from conceptual_map.metric.grid2d import OccupancyGrid
+from conceptual_map.metric.path_planning import distance_field, plan_path
+from conceptual_map.metric.sensors import LaserScanLike
+from conceptual_map.places.model import MapEvent
+from conceptual_map.places.place_map import PlaceMap
+
+
+class RobotLike(Protocol):
+    """The part of a robot adapter exploration needs."""
+
+    clock: float
+
+    @property
+    def pose(self) -> tuple[float, float, float]: ...
+
+    def move_along(self, path: list[tuple[float, float]]) -> object: ...
+
+    def turn_to(self, yaw: float) -> object: ...
+
+    def scan(self) -> LaserScanLike: ...
+
+
+class ExplorationStatus(Enum):
+    COMPLETE = "complete"  # no placeholder left
+    STUCK = "stuck"  # placeholders left, none reachable or all tried
+    MOVE_LIMIT = "move_limit"
+
+
+@dataclass
+class ExplorationResult:
+    status: ExplorationStatus
+    moves: int
+    distance: float
+    sim_time: float
+    mapping_wall_time: float  # seconds spent in grid and place-map updates
+    scans: int
+    events: list[MapEvent] = field(default_factory=list)
+    failures: list[str] = field(default_factory=list)
+
+
+@dataclass
+class Explorer:
+    """Drives to the nearest reachable placeholder, sensing every `step` m, until none is left."""
+
+    robot: RobotLike
+    grid: OccupancyGrid
+    place_map: PlaceMap
+    step: float = 0.5
+    max_moves: int = 300
+    max_tries: int = 2  # visits to a placeholder that stays unexplored before giving it up
+
+    def __post_init__(self) -> None:
+        self._radius = self.place_map.config.robot_radius
+        self._result = ExplorationResult(ExplorationStatus.COMPLETE, 0, 0.0, 0.0, 0.0, 0)
+        self._tries: dict[str, int] = {}
+
+    def run(self) -> ExplorationResult:
+        start = self.robot.clock
+        self._look_around()
+        while self.place_map.placeholders:
+            if self._result.moves >= self.max_moves:
+                self._result.status = ExplorationStatus.MOVE_LIMIT
+                break
+            target = self._nearest_placeholder()
+            if target is None:
+                self._result.status = ExplorationStatus.STUCK
+                break
+            self._visit(target)
+        self._result.sim_time = self.robot.clock - start
+        return self._result
+
+    def _sense(self, poses: list[tuple[float, float, float]]) -> None:
+        scan = self.robot.scan()
+        began = wallclock.perf_counter()
+        self.grid.integrate_scan(scan)
+        events = self.place_map.follow(self.grid, poses, self.robot.clock)
+        self._result.mapping_wall_time += wallclock.perf_counter() - began
+        self._result.scans += 1
+        self._result.events.extend(events)
+
+    def _look_around(self) -> None:
+        self._sense([self.robot.pose])
+        self.robot.turn_to(self.robot.pose[2] + math.pi)
+        self._sense([self.robot.pose])
+
+    def _nearest_placeholder(self) -> str | None:
+        field_ = distance_field(self.grid, self.robot.pose[:2], self._radius)
+        best, best_cost = None, math.inf
+        for pid, ph in self.place_map.placeholders.items():
+            cell = self.grid.cell_of(ph.position)
+            if self._tries.get(pid, 0) >= self.max_tries or not self.grid.contains(cell):
+                continue
+            if field_[cell] < best_cost:
+                best, best_cost = pid, float(field_[cell])
+        return best
+
+    def _visit(self, target: str) -> None:
+        self._tries[target] = self._tries.get(target, 0) + 1
+        goal = self.place_map.placeholders[target].position
+        path = plan_path(self.grid, self.robot.pose[:2], goal, self._radius)
+        if not path.found:
+            return
+        for leg in _legs(path.waypoints, self.step):
+            here = self.robot.pose[:2]
+            try:
+                self.robot.move_along(leg)
+            except Exception as exc:  # noqa: BLE001 - the adapter's own "blocked" error
+                self._result.failures.append(f"{target}: {exc}")
+                break
+            self._result.moves += 1
+            self._result.distance += sum(
+                math.dist(a, b) for a, b in zip([here, *leg], leg, strict=False)
+            )
+            self._sense([(x, y, self.robot.pose[2]) for x, y in leg])
+            if target not in self.place_map.placeholders:
+                return
+        self._look_around()
+
+
+def _legs(
+    waypoints: tuple[tuple[float, float], ...], step: float
+) -> list[list[tuple[float, float]]]:
+    """Split a polyline (first point = where the robot is) into legs of about `step` metres."""
+    legs, current, budget = [], [], step
+    for a, b in zip(waypoints, waypoints[1:], strict=False):
+        a_, b_ = np.asarray(a), np.asarray(b)
+        length = float(np.linalg.norm(b_ - a_))
+        travelled = 0.0
+        while length - travelled > budget:
+            travelled += budget
+            point = a_ + (b_ - a_) * travelled / length
+            current.append((float(point[0]), float(point[1])))
+            legs.append(current)
+            current, budget = [], step
+        budget -= length - travelled
+        current.append((float(b[0]), float(b[1])))
+    if current:
+        legs.append(current)
+    return legs
