@@ -28,6 +28,7 @@ class Settings(BaseSettings):
     task_time_limit_s: float = Field(900.0, gt=0, description="wall clock per episode")
     plan_time_limit_s: float = Field(60.0, gt=0, description="wall clock per plan/check job")
     cancel_grace_s: float = Field(2.0, ge=0, description="time to stop before a kill")
+    worker_nice: int = Field(10, ge=0, le=19, description="CPU niceness of worker processes")
     memory_limit_mb: int = Field(2048, ge=0, description="address-space limit per worker; 0=none")
     max_body_bytes: int = Field(1_000_000, ge=1024)
     rate_limit_per_minute: float = Field(120.0, gt=0, description="mutating calls per key")

@@ -13,15 +13,15 @@ from api.security import RateLimiter, key_matches, owner_of
 from api.store import TaskRecord, TaskStore
 
 
-def get_settings(request: Request) -> Settings:
+async def get_settings(request: Request) -> Settings:
     return request.app.state.settings
 
 
-def get_manager(request: Request) -> TaskManager:
+async def get_manager(request: Request) -> TaskManager:
     return request.app.state.manager
 
 
-def get_store(request: Request) -> TaskStore:
+async def get_store(request: Request) -> TaskStore:
     return request.app.state.manager.store
 
 
@@ -30,7 +30,7 @@ ManagerDep = Annotated[TaskManager, Depends(get_manager)]
 StoreDep = Annotated[TaskStore, Depends(get_store)]
 
 
-def require_write_access(
+async def require_write_access(
     request: Request,
     settings: SettingsDep,
     x_api_key: Annotated[str | None, Header(description="required when AVS_API_KEY is set")] = None,
@@ -61,7 +61,7 @@ WriteAccess = Annotated[str, Depends(require_write_access)]
 TaskId = Annotated[str, Path(max_length=64, description="a task id")]
 
 
-def get_task(task_id: TaskId, store: StoreDep) -> TaskRecord:
+async def get_task(task_id: TaskId, store: StoreDep) -> TaskRecord:
     task = store.get(task_id)
     if task is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, detail=f"no task with id {task_id}")

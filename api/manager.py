@@ -61,11 +61,12 @@ class TaskManager:
         self.store = store
         self.episodes = WorkerPool(
             "episodes", settings.workers, settings.memory_limit_mb, settings.episode_runner,
-            settings.cancel_grace_s,
+            settings.cancel_grace_s, nice=settings.worker_nice,
         )
         self.jobs = WorkerPool(
             "jobs", settings.plan_workers, settings.memory_limit_mb, settings.episode_runner,
             settings.cancel_grace_s, preload=PRELOAD_JOBS if settings.preload_planner else (),
+            nice=settings.worker_nice,
         )
         self._cancels: dict[str, threading.Event] = {}
         self._lock = threading.Lock()

@@ -27,6 +27,7 @@ CREATE TABLE IF NOT EXISTS tasks (
     finished_at REAL,
     result TEXT,
     error TEXT,
+    events INTEGER NOT NULL DEFAULT 0,
     UNIQUE (owner, idempotency_key)
 );
 CREATE INDEX IF NOT EXISTS tasks_state ON tasks (state, created_at);
@@ -73,7 +74,6 @@ class TaskStore:
         self._conn.execute("PRAGMA synchronous=NORMAL")
         self._conn.executescript(_SCHEMA)
         self._lock = threading.Lock()
-        self._next_seq: dict[str, int] = {}
 
     def close(self) -> None:
         with self._lock:
@@ -179,15 +179,13 @@ class TaskStore:
     def add_event(self, task_id: str, data: dict[str, Any]) -> int:
         """Append an event to a task's stream; returns its sequence number (1, 2, ...)."""
         with self._tx() as db:
-            seq = self._next_seq.get(task_id)
-            if seq is None:
-                row = db.execute("SELECT max(seq) FROM events WHERE task_id=?", (task_id,))
-                seq = int(row.fetchone()[0] or 0) + 1
+            row = db.execute("SELECT events FROM tasks WHERE id=?", (task_id,)).fetchone()
+            seq = int(row[0]) + 1
             db.execute(
                 "INSERT INTO events (task_id, seq, data) VALUES (?, ?, ?)",
                 (task_id, seq, json.dumps(data, default=str)),
             )
-            self._next_seq[task_id] = seq + 1
+            db.execute("UPDATE tasks SET events=? WHERE id=?", (seq, task_id))
             return seq
 
     def events_after(self, task_id: str, after: int, limit: int = 500) -> list[StoredEvent]:
@@ -201,8 +199,7 @@ class TaskStore:
 
 _SELECT = (
     "SELECT t.id, t.state, t.request, t.owner, t.idempotency_key, t.request_hash, t.created_at,"
-    " t.started_at, t.finished_at, t.result, t.error,"
-    " (SELECT count(*) FROM events e WHERE e.task_id=t.id) FROM tasks t"
+    " t.started_at, t.finished_at, t.result, t.error, t.events FROM tasks t"
 )
 
 

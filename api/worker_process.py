@@ -10,6 +10,7 @@ import importlib
 import importlib.util
 import os
 import resource
+import sys
 import threading
 import time
 import traceback
@@ -37,6 +38,7 @@ def resolve(spec: str) -> Callable[..., Any]:
         if module_spec is None or module_spec.loader is None:
             raise ValueError(f"cannot load runner file {target}")
         module = importlib.util.module_from_spec(module_spec)
+        sys.modules[module_spec.name] = module  # dataclasses and pickling look it up there
         module_spec.loader.exec_module(module)
     else:
         module = importlib.import_module(target)
@@ -100,10 +102,13 @@ def exit_with_parent(interval_s: float = 1.0) -> None:
 
 
 def worker_main(
-    conn: Connection, memory_limit_mb: int, episode_runner: str, modules: tuple[str, ...] = ()
+    conn: Connection, memory_limit_mb: int, episode_runner: str, modules: tuple[str, ...] = (),
+    nice: int = 0,
 ) -> None:
     """Serve jobs until the pipe closes or a None job arrives."""
     exit_with_parent()
+    if nice:
+        os.nice(nice)  # batch work yields the CPU to the service's request handling
     limit_memory(memory_limit_mb)
     preload(modules)
     while True:

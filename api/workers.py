@@ -74,7 +74,8 @@ class _Slot:
         parent, child = ctx.Pipe(duplex=True)
         self.process = ctx.Process(
             target=worker_main,
-            args=(child, self.pool.memory_limit_mb, self.pool.episode_runner, self.pool.preload),
+            args=(child, self.pool.memory_limit_mb, self.pool.episode_runner, self.pool.preload,
+                  self.pool.nice),
             name=f"avs-{self.pool.name}-{self.index}",
             daemon=True,
         )
@@ -180,10 +181,11 @@ class WorkerPool:
 
     def __init__(
         self, name: str, size: int, memory_limit_mb: int, episode_runner: str, grace_s: float,
-        preload: tuple[str, ...] = (),
+        preload: tuple[str, ...] = (), nice: int = 0,
     ):
         self.name = name
         self.preload = preload
+        self.nice = nice
         self.memory_limit_mb = memory_limit_mb
         self.episode_runner = episode_runner
         self.grace_s = grace_s

@@ -20,7 +20,7 @@ def read_worlds(settings: SettingsDep) -> WorldsPublic:
 
 
 @router.get("/health")
-def read_health(manager: ManagerDep, settings: SettingsDep) -> Health:
+async def read_health(manager: ManagerDep, settings: SettingsDep) -> Health:
     """200 once the service is up and its workers are started."""
     queued, running = manager.counts()
     return Health(

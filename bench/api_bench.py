@@ -1,0 +1,223 @@
+"""HTTP service load: req/s and p50/p99 latency of GET /v1/tasks/{id} while episodes run.
+
+Starts `avs serve` on 127.0.0.1 (a free port, a temporary data dir), then measures the same
+request loop in three phases of one run: the idle service (the reference), with two episodes
+that stream events but barely use the CPU, and with two episodes that keep both cores busy (as a
+real planner would). Until `avs_planner/episode.py` exists the episodes come from the
+synthetic runner below, and the output says so.
+
+    .venv/bin/python -m bench.api_bench [--quick] [--requests N] [--connections C]
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import importlib.util
+import json
+import os
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+TARGET_RPS = 300.0
+TARGET_P99_MS = 50.0
+SYNTHETIC_RUNNER = f"{Path(__file__).resolve()}:synthetic_episode"
+
+
+def synthetic_episode(spec: dict[str, Any], emit: Any, should_stop: Any) -> dict[str, Any]:
+    """A stand-in episode for load testing only: emits a trace event every 50 ms; target
+    'busy' also spins the CPU between events. Stops when asked (or after 10 minutes)."""
+    start = time.monotonic()
+    step = 0
+    while not should_stop() and time.monotonic() - start < 600:
+        emit({"t": float(step), "wall": time.monotonic() - start, "type": "action", "step": step})
+        step += 1
+        until = time.monotonic() + 0.05
+        while time.monotonic() < until:
+            if spec["target"] != "busy":
+                time.sleep(0.01)
+    return {"outcome": "gave_up", "steps": step}
+
+
+@dataclass(frozen=True)
+class Phase:
+    name: str
+    requests: int
+    seconds: float
+    p50_ms: float
+    p99_ms: float
+    errors: int
+
+    @property
+    def rps(self) -> float:
+        return self.requests / self.seconds
+
+
+async def _connection(port: int, path: str, count: int, latencies: list[float]) -> int:
+    reader, writer = await asyncio.open_connection("127.0.0.1", port)
+    request = f"GET {path} HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n".encode()
+    errors = 0
+    for _ in range(count):
+        began = time.perf_counter()
+        writer.write(request)
+        await writer.drain()
+        status = await reader.readline()
+        length = 0
+        while (line := await reader.readline()) not in (b"\r\n", b""):
+            if line.lower().startswith(b"content-length:"):
+                length = int(line.split(b":", 1)[1])
+        await reader.readexactly(length)
+        latencies.append(time.perf_counter() - began)
+        errors += not status.startswith(b"HTTP/1.1 200")
+    writer.close()
+    return errors
+
+
+async def _load(port: int, path: str, requests: int, connections: int) -> tuple[list[float], int]:
+    latencies: list[float] = []
+    per = requests // connections
+    errors = await asyncio.gather(
+        *(_connection(port, path, per, latencies) for _ in range(connections))
+    )
+    return latencies, sum(errors)
+
+
+def measure(name: str, port: int, path: str, requests: int, connections: int) -> Phase:
+    asyncio.run(_load(port, path, max(connections, requests // 10), connections))  # warm up
+    began = time.perf_counter()
+    latencies, errors = asyncio.run(_load(port, path, requests, connections))
+    seconds = time.perf_counter() - began
+    cuts = statistics.quantiles(latencies, n=100)
+    return Phase(name, len(latencies), seconds, cuts[49] * 1e3, cuts[98] * 1e3, errors)
+
+
+def _call(port: int, path: str, body: dict | None = None, method: str | None = None) -> dict:
+    data = json.dumps(body).encode() if body is not None else None
+    request = urllib.request.Request(
+        f"http://127.0.0.1:{port}{path}", data, {"Content-Type": "application/json"},
+        method=method,
+    )
+    with urllib.request.urlopen(request, timeout=10) as response:
+        return json.loads(response.read())
+
+
+def _free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+def start_service(
+    data_dir: Path, runner: str, worlds_dir: Path | None
+) -> tuple[subprocess.Popen[bytes], int]:
+    port = _free_port()
+    env = {**os.environ, "AVS_EPISODE_RUNNER": runner, "AVS_PRELOAD_PLANNER": "false",
+           "AVS_WORKERS": "2", "AVS_RATE_LIMIT_BURST": "1000"}
+    if worlds_dir is not None:
+        env["AVS_WORLDS_DIR"] = str(worlds_dir)
+    env.pop("AVS_API_KEY", None)
+    command = [sys.executable, "-m", "avs_planner", "serve", "--host", "127.0.0.1",
+               "--port", str(port), "--data-dir", str(data_dir), "--log-level", "warning"]
+    process = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        try:
+            _call(port, "/v1/health")
+            return process, port
+        except OSError:
+            time.sleep(0.2)
+    process.kill()
+    raise SystemExit("api_bench: the service did not start within 60 s")
+
+
+def run_episodes(port: int, target: str, world: str) -> list[str]:
+    """Submit two episodes and wait until both are running."""
+    ids = [_call(port, "/v1/tasks", {"target": target, "world": world})["id"] for _ in range(2)]
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        tasks = [_call(port, f"/v1/tasks/{i}") for i in ids]
+        if all(t["state"] == "running" for t in tasks):
+            return ids
+        if any(t["state"] not in ("queued", "running") for t in tasks):
+            ended = [(t["state"], t["error"]) for t in tasks]
+            raise SystemExit(f"api_bench: episodes ended early: {ended}")
+        time.sleep(0.1)
+    raise SystemExit("api_bench: episodes did not start")
+
+
+def stop_episodes(port: int, ids: list[str]) -> None:
+    for task_id in ids:
+        _call(port, f"/v1/tasks/{task_id}", method="DELETE")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="fewer requests per phase")
+    parser.add_argument("--requests", type=int, help="requests per phase (default 4000)")
+    parser.add_argument("--connections", type=int, default=4)
+    args = parser.parse_args(argv)
+    requests = args.requests or (800 if args.quick else 4000)
+    real = importlib.util.find_spec("avs_planner.episode") is not None
+    runner = "avs_planner.jobs:run_episode" if real else SYNTHETIC_RUNNER
+    with tempfile.TemporaryDirectory(prefix="avs-api-bench-") as tmp:
+        worlds = None
+        if not real:  # the synthetic runner never loads it; a name is all the API checks
+            worlds = Path(tmp) / "worlds"
+            worlds.mkdir()
+            (worlds / "office.yaml").write_text("name: office\n")
+        process, port = start_service(Path(tmp) / "data", runner, worlds)
+        try:
+            phases = _phases(port, real, requests, args.connections)
+        finally:
+            process.terminate()
+            process.wait(timeout=30)
+    _report(phases, real, requests, args.connections)
+    return 0
+
+
+def _phases(port: int, real: bool, requests: int, connections: int) -> list[Phase]:
+    world = "office"
+    probe = _call(port, "/v1/tasks", {"target": "probe", "world": world})["id"]
+    path = f"/v1/tasks/{probe}"
+    _call(port, path, method="DELETE")
+    phases = [measure("idle service (reference)", port, path, requests, connections)]
+    loads = [("cerealbox", "2 real episodes")] if real else [
+        ("calm", "2 synthetic episodes, events only"),
+        ("busy", "2 synthetic episodes, CPU-bound"),
+    ]
+    for target, name in loads:
+        ids = run_episodes(port, target, world)
+        phases.append(measure(name, port, f"/v1/tasks/{ids[0]}", requests, connections))
+        stop_episodes(port, ids)
+    return phases
+
+
+def _report(phases: list[Phase], real: bool, requests: int, connections: int) -> None:
+    source = "the real episode runner" if real else (
+        "a SYNTHETIC episode runner (avs_planner/episode.py does not exist yet)")
+    print(f"GET /v1/tasks/{{id}}: {requests} requests/phase over {connections} keep-alive "
+          f"connections; episodes from {source}; {os.cpu_count()} CPUs")
+    ref = phases[0]
+    print(f"{'phase':42} {'req/s':>8} {'p50 ms':>8} {'p99 ms':>8} {'err':>4} "
+          f"{'rps/ref':>8} {'p99/ref':>8}")
+    for p in phases:
+        print(f"{p.name:42} {p.rps:8.0f} {p.p50_ms:8.2f} {p.p99_ms:8.2f} {p.errors:4d} "
+              f"{p.rps / ref.rps:8.2f} {p.p99_ms / ref.p99_ms:8.2f}")
+    worst = phases[1:] or phases
+    ok_rps = all(p.rps >= TARGET_RPS for p in worst)
+    ok_p99 = all(p.p99_ms <= TARGET_P99_MS for p in worst)
+    print(f"target with episodes running: >= {TARGET_RPS:.0f} req/s "
+          f"({'met' if ok_rps else 'MISSED'}), p99 <= {TARGET_P99_MS:.0f} ms "
+          f"({'met' if ok_p99 else 'MISSED'})")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
