@@ -1,0 +1,67 @@
+"""`avs plan DOMAIN PROBLEM`: plan with the continual planner and print the plan or JSON."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+
+from avs_planner.cp.heuristics import HEURISTICS
+from avs_planner.cp.planner import plan
+from avs_planner.cp.search import DEFAULT_REWARD, PlanResult, PlanStatus, SearchOptions
+from avs_planner.pddl import read_files
+
+EXIT_CODES = {
+    PlanStatus.SOLVED: 0,
+    PlanStatus.UNSOLVABLE: 2,
+    PlanStatus.NO_PLAN_ABOVE_THRESHOLD: 2,
+    PlanStatus.TIMEOUT: 3,
+    PlanStatus.NODE_LIMIT: 3,
+}
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "plan",
+        help="plan a (probabilistic) PDDL problem",
+        description="Find a plan minimising c(pi) + R(1 - p(pi)) (seed 003). Exit codes: "
+        "0 solved, 1 bad input, 2 unsolvable / no plan with p > 0 (or above --min-success), "
+        "3 timeout or node limit.",
+    )
+    parser.add_argument("domain", help="domain PDDL file")
+    parser.add_argument("problem", help="problem PDDL file")
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    parser.add_argument("--reward", type=float, default=DEFAULT_REWARD, help="goal reward R")
+    parser.add_argument("--weight", type=float, default=1.0, help="weight w >= 1 of A*")
+    parser.add_argument("--timeout", type=float, default=None, help="seconds (default: none)")
+    parser.add_argument("--node-limit", type=int, default=None, help="max expanded states")
+    parser.add_argument("--heuristic", choices=sorted(HEURISTICS), default="ff")
+    parser.add_argument("--min-success", type=float, default=0.0,
+                        help="give up if the best plan's success probability is below this")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    options = SearchOptions(
+        reward=args.reward, weight=args.weight, heuristic=args.heuristic,
+        timeout_s=args.timeout, node_limit=args.node_limit, min_success=args.min_success,
+    ).check()
+    pproblem = read_files(args.domain, args.problem)
+    result = plan(pproblem, options)
+    print(json.dumps(result.as_json()) if args.json else _text(result))
+    return EXIT_CODES[result.status]
+
+
+def _text(result: PlanResult) -> str:
+    lines = [step.label for step in result.plan]
+    if not result.solved:
+        lines.append(f"; status: {result.status.value}")
+    lines += [
+        f"; cost: {result.cost:g}",
+        f"; probability: {result.probability:.6g}",
+        f"; objective: {result.objective:.6g}" if math.isfinite(result.objective)
+        else "; objective: none",
+        f"; planning time: {result.planning_time_s:.4f} s",
+        f"; expanded: {result.expanded}",
+    ]
+    return "\n".join(lines)
