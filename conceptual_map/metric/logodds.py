@@ -102,16 +102,36 @@ class LogOddsGrid:
             self.ensure_contains(np.vstack([rays.starts, rays.ends]))
         scale = 1.0 / self.resolution
         _, cells = traverse((rays.starts - self.origin) * scale, (rays.ends - self.origin) * scale)
-        passed = self._flat(cells)
-        hits = self._flat(self.to_cell(rays.ends[rays.hit]))
-        free = np.setdiff1d(passed, hits)
+        passed = self.unique_flat(self._flat(cells))
+        hits = self.unique_flat(self._flat(self.to_cell(rays.ends[rays.hit])))
+        stamp = self._scratch()
+        stamp[hits] = -1
+        free = passed[stamp[passed] != -1]
         return self._apply(free, hits)
 
     def _flat(self, cells: np.ndarray) -> np.ndarray:
+        """Flat indices of the cells inside the grid (duplicates kept)."""
         cells = cells[self.inside(cells)]
         if cells.shape[0] == 0:
             return np.zeros(0, dtype=np.int64)
-        return np.unique(np.ravel_multi_index(tuple(cells.T), self.shape))
+        return np.ravel_multi_index(tuple(cells.T), self.shape)
+
+    def unique_flat(self, flat: np.ndarray) -> np.ndarray:
+        """Distinct flat indices in O(n) (no sort): each index keeps the slot that wrote last.
+
+        Rays from one origin repeat many cells; hashing or sorting them was the hot spot.
+        """
+        stamp = self._scratch()
+        order = np.arange(flat.size, dtype=np.int32)
+        stamp[flat] = order
+        return flat[stamp[flat] == order]
+
+    def _scratch(self) -> np.ndarray:
+        """A reusable int32 array with one slot per cell (contents are never relied on)."""
+        size = self.logodds.size
+        if getattr(self, "_stamp", None) is None or self._stamp.size != size:
+            self._stamp = np.empty(size, dtype=np.int32)
+        return self._stamp
 
     def _apply(self, free: np.ndarray, hits: np.ndarray) -> UpdateSummary:
         flat = self.logodds.reshape(-1)

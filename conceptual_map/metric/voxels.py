@@ -118,7 +118,7 @@ class VoxelMap(LogOddsGrid):
             nb = coords + off
             ok = self.inside(nb)
             around.append(np.ravel_multi_index(tuple(nb[ok].T), self.shape))
-        cells = np.unique(np.concatenate(around))
+        cells = self.unique_flat(np.concatenate(around))
         self.frontier.reshape(-1)[cells] = self._is_frontier(cells)
 
     def _is_frontier(self, flat: np.ndarray) -> np.ndarray:
