@@ -27,6 +27,7 @@ class Usage:
     predicates: set[str] = field(default_factory=set)
     probability_fluents: dict[str, SList] = field(default_factory=dict)
     changed_functions: list[tuple[str, SList]] = field(default_factory=list)
+    cost_functions: set[str] = field(default_factory=set)
 
     def need(self, requirement: str, file: str, node: Node) -> None:
         self.requirements.setdefault(requirement, (file, node))
@@ -284,6 +285,8 @@ class FormulaChecker:
         self.usage.changed_functions.append((target.head(), node))
         self.function_term(target, scope)
         self.numeric(value, scope)
+        if isinstance(value, SList) and value.head() in self.domain.functions:
+            self.usage.cost_functions.add(value.head())
 
     def _probabilistic(self, node: SList, scope: dict[str, str]) -> None:
         self._need(":probabilistic-effects", node)

@@ -3,12 +3,20 @@
 from __future__ import annotations
 
 from fractions import Fraction
+from itertools import product
 
 from avs_planner.errors import PddlError
 from avs_planner.pddl.diagnostics import Diagnostic
 from avs_planner.pddl.formulas import FormulaChecker, Usage
 from avs_planner.pddl.sexpr import Atom, Node, SList, is_number, parse_sexprs
-from avs_planner.pddl.structure import Domain, Problem, Report, find_define, read_problem
+from avs_planner.pddl.structure import (
+    Domain,
+    Problem,
+    Report,
+    Typed,
+    find_define,
+    read_problem,
+)
 
 GroundAtom = tuple[str, ...]
 
@@ -34,6 +42,7 @@ def check_problem(domain: Domain, source, usage: Usage) -> list[Diagnostic]:  # 
     if problem.metric is not None:
         _check_metric(problem.metric, init_checker)
     _check_probabilities(problem, usage, values.numbers, report)
+    _check_missing_values(domain, names, usage, values.numbers, report, problem.init_node)
     return report.items
 
 
@@ -166,3 +175,50 @@ def _literals(goal: Node | None) -> list[tuple[GroundAtom, bool]] | None:
     if any(not isinstance(i, Atom) or i.text.startswith("?") for i in goal.items):
         return None
     return [(_ground(goal), True)]
+
+
+MAX_GROUNDINGS = 100_000
+
+
+def _check_missing_values(
+    domain: Domain,
+    names: dict[str, Typed],
+    usage: Usage,
+    numbers: dict[str, list[tuple[SList, Atom]]],
+    report: Report,
+    anchor: SList | None,
+) -> None:
+    """Every ground instance of a used function needs an :init value; UP planners reject
+    problems with undefined numeric values. Missing probabilities are errors."""
+    used = {name for name, _ in usage.changed_functions} | set(usage.probability_fluents)
+    used |= usage.cost_functions
+    for name in sorted(used & set(domain.functions)):
+        if name not in numbers or name == "total-cost":
+            continue  # wholly absent probability fluents are reported by _check_probabilities
+        missing = _missing(domain, names, name, numbers[name])
+        if missing:
+            first, count = missing
+            is_probability = name in usage.probability_fluents
+            report.add(
+                anchor or Atom("", 1, 1, 0),
+                "probability-not-in-init" if is_probability else "missing-init-value",
+                f"no :init value for ({name} {' '.join(first)})"
+                + (f" and {count - 1} more instance(s)" if count > 1 else ""),
+                warning=not is_probability,
+            )
+
+
+def _missing(
+    domain: Domain, names: dict[str, Typed], name: str, assigned: list[tuple[SList, Atom]]
+) -> tuple[tuple[str, ...], int] | None:
+    """The first ground instance without a value and how many there are, or None."""
+    params = domain.functions[name].params
+    pools = [[n for n, e in names.items() if domain.is_subtype(e.type, p.type)] for p in params]
+    total = 1
+    for pool in pools:
+        total *= len(pool)
+    if total > MAX_GROUNDINGS:
+        return None
+    given = {tuple(_ground(term)[1:]) for term, _ in assigned}
+    missing = [args for args in product(*pools) if args not in given]
+    return (missing[0], len(missing)) if missing else None

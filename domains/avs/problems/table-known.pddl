@@ -1,0 +1,57 @@
+;; Seed 003, section 4, third plan: the DT planner found a table (object1) in room3, and
+;; room3 is now so likely a kitchen that it counts as certain. The robot stands at place16
+;; in room3. Target: a cerealbox. Expected best plan (R = 500):
+;;   assume-obj-exists-on cerealbox object1 table kitchen room3 new-object2
+;;   createviewcones-on cerealbox object1
+;;   searchforobject-on cerealbox object1 new-object2 room3 place16
+;;   reportposition new-object2 cerealbox
+(define (problem table-known)
+  (:domain avs)
+  (:objects
+    place10 place18 - place
+    place16 place20 - placeholder
+    room1 room3 - room
+    object1 new-object2 new-object3 - visualobject
+    cerealbox table - label
+    kitchen office corridor - category)
+  (:init
+    (at place16) (visited place10) (visited place18) (visited place16)
+    (connected place10 place18) (connected place18 place10)
+    (connected place18 place16) (connected place16 place18)
+    (connected place10 place20) (connected place20 place10)
+    (in-room place10 room1) (in-room place20 room1)
+    (in-room place18 room3) (in-room place16 room3)
+    (has-category room1 corridor) (defined-category room1)
+    (has-category room3 kitchen) (defined-category room3)
+    (label-of object1 table) (related object1 in room3) (detected object1)
+    (defined-exists table in room3)
+    (virtual new-object2) (virtual new-object3)
+    (= (total-cost) 0)
+    ;; path lengths in metres (0 where there is no path)
+    (= (move-cost place10 place10) 0) (= (move-cost place10 place16) 0) (= (move-cost place10 place18) 3) (= (move-cost place10 place20) 10)
+    (= (move-cost place16 place10) 0) (= (move-cost place16 place16) 0) (= (move-cost place16 place18) 3) (= (move-cost place16 place20) 0)
+    (= (move-cost place18 place10) 3) (= (move-cost place18 place16) 3) (= (move-cost place18 place18) 0) (= (move-cost place18 place20) 0)
+    (= (move-cost place20 place10) 10) (= (move-cost place20 place16) 0) (= (move-cost place20 place18) 0) (= (move-cost place20 place20) 0)
+    (= (search-cost table in) 40) (= (search-cost table on) 10)
+    (= (search-cost cerealbox in) 120) (= (search-cost cerealbox on) 10)
+    (= (p-detect table in) 0.8) (= (p-detect table on) 0.8)
+    (= (p-detect cerealbox in) 0.5) (= (p-detect cerealbox on) 0.8)
+    ;; P_category(room)
+    (= (p-room-category room1 kitchen) 0) (= (p-room-category room1 office) 0) (= (p-room-category room1 corridor) 1)
+    (= (p-room-category room3 kitchen) 1) (= (p-room-category room3 office) 0) (= (p-room-category room3 corridor) 0)
+    ;; P_category(placeholder)
+    (= (p-placeholder-category place16 kitchen) 0) (= (p-placeholder-category place16 office) 0) (= (p-placeholder-category place16 corridor) 0)
+    (= (p-placeholder-category place20 kitchen) 0.2) (= (p-placeholder-category place20 office) 0.5) (= (p-placeholder-category place20 corridor) 0.1)
+    ;; P(ObjectAt L) for rooms; unexplored (virtual) rooms get the category defaults
+    (= (p-obj-in cerealbox room1 kitchen) 0.6) (= (p-obj-in cerealbox room1 office) 0.1) (= (p-obj-in cerealbox room1 corridor) 0.02)
+    (= (p-obj-in table room1 kitchen) 0.9) (= (p-obj-in table room1 office) 0.7) (= (p-obj-in table room1 corridor) 0.1)
+    (= (p-obj-in cerealbox room3 kitchen) 0.6) (= (p-obj-in cerealbox room3 office) 0.1) (= (p-obj-in cerealbox room3 corridor) 0.02)
+    (= (p-obj-in table room3 kitchen) 0.9) (= (p-obj-in table room3 office) 0.7) (= (p-obj-in table room3 corridor) 0.1)
+    ;; P(ObjectAt L^C): default knowledge, on an object of class S in a room of category C
+    (= (p-obj-on cerealbox cerealbox kitchen) 0) (= (p-obj-on cerealbox cerealbox office) 0) (= (p-obj-on cerealbox cerealbox corridor) 0)
+    (= (p-obj-on cerealbox table kitchen) 0.6) (= (p-obj-on cerealbox table office) 0.1) (= (p-obj-on cerealbox table corridor) 0.05)
+    (= (p-obj-on table cerealbox kitchen) 0) (= (p-obj-on table cerealbox office) 0) (= (p-obj-on table cerealbox corridor) 0)
+    (= (p-obj-on table table kitchen) 0) (= (p-obj-on table table office) 0) (= (p-obj-on table table corridor) 0)
+    )
+  (:goal (reported cerealbox))
+  (:metric minimize (total-cost)))
