@@ -66,7 +66,7 @@ class TaskManager:
         self.jobs = WorkerPool(
             "jobs", settings.plan_workers, settings.memory_limit_mb, settings.episode_runner,
             settings.cancel_grace_s, preload=PRELOAD_JOBS if settings.preload_planner else (),
-            nice=settings.worker_nice,
+            nice=settings.worker_nice, warm=settings.preload_planner,
         )
         self._cancels: dict[str, threading.Event] = {}
         self._lock = threading.Lock()

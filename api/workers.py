@@ -140,10 +140,11 @@ class _Slot:
         return JobResult(JobOutcome.ERROR, error=message[2], error_type=message[1])
 
     def loop(self) -> None:
-        try:
-            self.ensure_process()  # warm start: the first job does not pay for the spawn
-        except OSError:
-            log.exception("could not pre-start worker %s", self.index)
+        if self.pool.warm:
+            try:
+                self.ensure_process()  # warm start: the first job does not pay for the spawn
+            except OSError:
+                log.exception("could not pre-start worker %s", self.index)
         while True:
             job = self.pool.jobs.get()
             if job is None or self.pool.stopping.is_set():
@@ -181,9 +182,10 @@ class WorkerPool:
 
     def __init__(
         self, name: str, size: int, memory_limit_mb: int, episode_runner: str, grace_s: float,
-        preload: tuple[str, ...] = (), nice: int = 0,
+        preload: tuple[str, ...] = (), nice: int = 0, warm: bool = True,
     ):
         self.name = name
+        self.warm = warm
         self.preload = preload
         self.nice = nice
         self.memory_limit_mb = memory_limit_mb
