@@ -94,6 +94,7 @@ class PlanPublic(BaseModel):
     cost: float | None = None
     probability: float | None = None
     objective: float | None = None
+    reward: float | None = None
     planning_time_s: float | None = None
     expanded: int | None = None
 
