@@ -1,0 +1,51 @@
+"""`avs_planner.jobs`, the only planner code the service calls: plain data in and out."""
+
+from __future__ import annotations
+
+import importlib.util
+from collections.abc import Callable
+
+import pytest
+from fastapi.testclient import TestClient
+
+from api.config import DEFAULT_EPISODE_RUNNER, Settings
+from api.main import create_app
+from api.worker_process import resolve
+from avs_planner import jobs
+
+EPISODE_MISSING = importlib.util.find_spec("avs_planner.episode") is None
+
+
+@pytest.mark.skipif(not EPISODE_MISSING, reason="the episode runner exists now")
+def test_run_episode_says_the_runner_is_missing() -> None:
+    with pytest.raises(jobs.JobUnavailableError, match="episode runner .* not available yet"):
+        jobs.run_episode({"target": "cup"}, lambda event: None, lambda: False)
+
+
+@pytest.mark.skipif(not EPISODE_MISSING, reason="the episode runner exists now")
+def test_task_fails_clearly_without_the_runner(
+    make_settings: Callable[..., Settings], wait_for: Callable[..., dict]
+) -> None:
+    settings = make_settings(episode_runner=DEFAULT_EPISODE_RUNNER)
+    with TestClient(create_app(settings)) as client:
+        task_id = client.post("/v1/tasks", json={"target": "cup", "world": "office"}).json()["id"]
+        done = wait_for(client, task_id, {"failed", "succeeded"})
+    assert done["state"] == "failed" and "not available yet" in done["error"]
+
+
+def test_plan_reports_bad_options_as_invalid() -> None:
+    pytest.importorskip("avs_planner.cp.search", reason="the continual planner has not landed")
+    domain = "(define (domain d) (:predicates (p)) (:action a :parameters () :effect (p)))"
+    problem = "(define (problem q) (:domain d) (:init) (:goal (p)))"
+    bad = jobs.plan(domain, problem, {"weight": 0.5})
+    assert bad["status"] == "invalid" and bad["errors"][0]["file"] == "options"
+    unknown = jobs.plan(domain, problem, {"colour": 1})
+    assert unknown["status"] == "invalid" and unknown["errors"][0]["file"] == "options"
+    assert jobs.plan(domain, problem, {})["plan"] == ["(a)"]
+
+
+def test_resolve_runner_specs() -> None:
+    assert resolve("avs_planner.jobs:plan") is jobs.plan
+    for spec in ("no-colon", ":x", "avs_planner.jobs:"):
+        with pytest.raises(ValueError, match="not 'module:function'"):
+            resolve(spec)
