@@ -210,6 +210,10 @@ class WorkerPool:
         self.jobs.put(job)
         return job.future
 
+    def alive(self) -> bool:
+        """Whether every slot thread is still serving (false before start and after stop)."""
+        return bool(self._threads) and all(t.is_alive() for t in self._threads)
+
     def pending(self) -> int:
         return self.jobs.qsize()
 

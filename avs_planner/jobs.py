@@ -97,7 +97,13 @@ def _invalid(file: str, line: int, column: int, message: str) -> dict[str, Any]:
 
 def run_episode(spec: Mapping[str, Any], emit: Emit, should_stop: ShouldStop) -> dict[str, Any]:
     """Run one search episode (the switching loop), streaming trace events through `emit` and
-    stopping early when `should_stop()`; returns the summary (`outcome`: found/gave_up/timeout)."""
+    stopping early when `should_stop()`; returns the summary (`outcome`: found/gave_up/timeout).
+
+    `spec` holds the HTTP task body (`target`, `category`, `world` name or `world_file` YAML
+    text, `robot`, `start_room`, `start`, `seed`, `time_budget_s`) plus `task_id` and
+    `output_dir`, where the runner writes `trace.jsonl`, `summary.json` and `trajectory.png`
+    (the service serves that picture). Events are the trace's dicts (`t`, `wall`, `type`, ...).
+    """
     episode = _require("avs_planner.episode", "the episode runner (switching loop)")
     runner = getattr(episode, "run_episode", None)
     if runner is None:

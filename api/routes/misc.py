@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from fastapi import APIRouter, HTTPException, status
 
 from api.deps import ManagerDep, SettingsDep
-from api.schemas import Health, WorldsPublic
+from api.schemas import Health, Message, WorldsPublic
 from api.worlds import list_worlds
 from avs_planner import __version__
 
@@ -19,9 +19,11 @@ def read_worlds(settings: SettingsDep) -> WorldsPublic:
     return WorldsPublic(data=worlds, count=len(worlds))
 
 
-@router.get("/health")
+@router.get("/health", responses={503: {"model": Message, "description": "not ready"}})
 async def read_health(manager: ManagerDep, settings: SettingsDep) -> Health:
-    """200 once the service is up and its workers are started."""
+    """200 once the service is up and its workers are started; 503 if they are not."""
+    if not (manager.episodes.alive() and manager.jobs.alive()):
+        raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE, detail="workers not running")
     queued, running = manager.counts()
     return Health(
         status="ok", version=__version__, workers=manager.episodes.size, queued=queued,

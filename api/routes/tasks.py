@@ -27,9 +27,13 @@ _ERRORS = {
 }
 
 
-def to_public(task: TaskRecord) -> TaskPublic:
+def to_public(task: TaskRecord, full: bool = True) -> TaskPublic:
+    """The client's view; lists (`full=False`) elide inline world files to their size."""
+    request = task.request
+    if not full and isinstance(request.get("world_file"), str):
+        request = {**request, "world_file": f"<inline, {len(request['world_file'])} chars>"}
     return TaskPublic(
-        id=task.id, state=task.state, request=task.request, created_at=task.created_at,
+        id=task.id, state=task.state, request=request, created_at=task.created_at,
         started_at=task.started_at, finished_at=task.finished_at, summary=task.result,
         error=task.error, events=task.events,
     )
@@ -97,7 +101,7 @@ def list_tasks(
 ) -> TasksPublic:
     """Tasks, newest first, optionally only those in one state."""
     tasks, count = store.page(state, limit, offset)
-    return TasksPublic(data=[to_public(t) for t in tasks], count=count)
+    return TasksPublic(data=[to_public(t, full=False) for t in tasks], count=count)
 
 
 @router.get("/{task_id}", responses={404: {"model": Message}})
@@ -111,7 +115,8 @@ async def read_task(task: TaskDep) -> TaskPublic:
     responses={**_ERRORS, 404: {"model": Message}, 409: {"model": Message}},
 )
 def cancel_task(task_id: TaskId, owner: WriteAccess, manager: ManagerDep) -> TaskPublic:
-    """Cancel: a queued task ends at once; a running episode is stopped (killed after a grace)."""
+    """Cancel: a queued task ends at once; a running episode is asked to stop and killed after
+    a grace time, so the task returned may still say `running` for that long."""
     try:
         task = manager.cancel(task_id)
     except NotCancellableError as exc:

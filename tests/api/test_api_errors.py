@@ -117,3 +117,18 @@ def test_huge_streamed_body_is_413(make_settings: Make) -> None:
             "/v1/plans", content=chunks(), headers={"Content-Type": "application/json"}
         )
     assert response.status_code == 413
+
+
+def test_health_is_503_when_workers_are_gone(client: TestClient) -> None:
+    client.app.state.manager.episodes.stop()
+    response = client.get("/v1/health")
+    assert response.status_code == 503 and "workers" in response.json()["detail"]
+
+
+def test_lists_elide_inline_world_files(client: TestClient) -> None:
+    world = "name: tiny\nsize: [2, 2]\nrooms: []\n"
+    task_id = client.post("/v1/tasks", json={"target": "slow", "world_file": world}).json()["id"]
+    listed = client.get("/v1/tasks").json()["data"][0]["request"]["world_file"]
+    assert listed == f"<inline, {len(world)} chars>"
+    assert client.get(f"/v1/tasks/{task_id}").json()["request"]["world_file"] == world
+    client.delete(f"/v1/tasks/{task_id}")
