@@ -64,9 +64,14 @@ def chord_extents(
 
 
 def openings_along(
-    grid: OccupancyGrid, points: np.ndarray, config: PlaceMapConfig
+    grid: OccupancyGrid, points: np.ndarray, config: PlaceMapConfig, in_wall: bool = False
 ) -> list[Opening]:
-    """Door-like openings at the given path points (at most one per point)."""
+    """Door-like openings at the given points (at most one per point).
+
+    With `in_wall`, the jambs must also continue as straight walls along the chord: a stricter
+    test for hypotheses from partly seen space, where a diagonal across a half-seen corner
+    can look like a short narrow opening.
+    """
     if points.shape[0] == 0:
         return []
     plus, minus = chord_extents(grid, points, _ANGLES, config.probe_range)
@@ -83,9 +88,29 @@ def openings_along(
         axis = np.array([np.cos(angle), np.sin(angle)])
         centre = points[k] + axis * 0.5 * (plus[k, best[k]] - minus[k, best[k]])
         opening = Opening(centre, float(narrow[k]), angle)
-        if _is_short(grid, opening, config):
+        if _is_short(grid, opening, config) and (not in_wall or _in_wall(grid, opening)):
             found.append(opening)
     return found
+
+
+def _in_wall(grid: OccupancyGrid, opening: Opening, reach: float = 0.3) -> bool:
+    """Occupied cells continue along the chord's line beyond both jambs (most of `reach`)."""
+    occupied = grid.state_grid() == CellState.OCCUPIED
+    steps = np.arange(0.05, reach + 1e-9, 0.025)
+    across = np.array([-0.075, -0.025, 0.025, 0.075])
+    for sign, end in zip((1.0, -1.0), (opening.ends()[1], opening.ends()[0]), strict=True):
+        pts = (
+            end[None, None, :]
+            + sign * steps[:, None, None] * opening.axis
+            + across[None, :, None] * opening.normal
+        )
+        cells = grid.to_cell(pts.reshape(-1, 2))
+        inside = grid.inside(cells)
+        hit = np.zeros(len(cells), dtype=bool)
+        hit[inside] = occupied[cells[inside, 0], cells[inside, 1]]
+        if hit.reshape(len(steps), len(across)).any(axis=1).mean() < 0.7:
+            return False
+    return True
 
 
 def _is_short(grid: OccupancyGrid, opening: Opening, config: PlaceMapConfig) -> bool:

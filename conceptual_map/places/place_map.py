@@ -154,14 +154,21 @@ class PlaceMap:
     # ---- doors ------------------------------------------------------------------------------
 
     def _find_doors(self, grid: OccupancyGrid, points: np.ndarray, time: float) -> list[MapEvent]:
+        """Openings on the path just driven (they get confirmed once the path crosses them)."""
+        return self._add_openings(openings_along(grid, points, self.config), points, time)
+
+    def _add_openings(
+        self, openings: list[Opening], path_points: np.ndarray, time: float
+    ) -> list[MapEvent]:
         touched: dict[str, Change] = {}
-        for opening in openings_along(grid, points, self.config):
+        for opening in openings:
             door_id = self._merge_opening(opening)
             touched.setdefault(door_id, Change.CHANGED)
             if door_id not in self.doors:
                 touched[door_id] = Change.APPEARED
         for door_id in self._openings:
-            if self._note_sides(door_id, points if door_id not in touched else self._path):
+            seen = path_points if door_id not in touched else self._path
+            if self._note_sides(door_id, seen):
                 touched.setdefault(door_id, Change.CHANGED)
         events = []
         for door_id, change in touched.items():
@@ -236,9 +243,10 @@ class PlaceMap:
         matched = match_by_distance(
             old, [r.centre for r in regions], self.config.placeholder_match_distance
         )
-        events, kept = [], set()
-        for i, region in enumerate(regions):
-            pid = matched.get(i) or self._new_id("placeholder")
+        ids = [matched.get(i) or self._new_id("placeholder") for i in range(len(regions))]
+        events = self._doors_toward(grid, regions, ids, time)
+        kept = set()
+        for pid, region in zip(ids, regions, strict=True):
             kept.add(pid)
             new = self._placeholder(pid, region)
             prev = self.placeholders.get(pid)
@@ -253,10 +261,46 @@ class PlaceMap:
             events.append(MapEvent(EntityKind.PLACEHOLDER, Change.VANISHED, pid, gone, time))
         return events
 
+    def _doors_toward(
+        self, grid: OccupancyGrid, regions: list[FrontierRegion], ids: list[str], time: float
+    ) -> list[MapEvent]:
+        """Door hypotheses (not yet passed) on the way from a place to a new or moved frontier,
+        like the seed's per-scan door detector; passing through later confirms them."""
+        probes = []
+        for pid, region in zip(ids, regions, strict=True):
+            prev = self.placeholders.get(pid)
+            if prev is not None and math.dist(prev.position, region.standpoint) <= 0.2:
+                continue
+            probes.append(self._approach(region))
+        if not probes:
+            return []
+        points = np.vstack(probes)
+        cells = grid.to_cell(points)
+        standable = grid.inside(cells)
+        standable[standable] = grid.traversable(self.config.robot_radius)[
+            cells[standable, 0], cells[standable, 1]
+        ]
+        points = points[standable]  # a robot could pass here, as through a door
+        found = openings_along(grid, points, self.config, in_wall=True)
+        return self._add_openings(found, points[:0], time)
+
+    def _approach(self, region: FrontierRegion) -> np.ndarray:
+        """Points every 10 cm from the nearest place via the standpoint to the frontier."""
+        place, _ = self._nearest_place(np.asarray(region.standpoint))
+        corners = [region.standpoint, region.centre]
+        if place is not None:
+            corners.insert(0, self.places[place].position)
+        return _densify(np.asarray(corners, dtype=float), 0.1)
+
     def _placeholder(self, pid: str, region: FrontierRegion) -> Placeholder:
+        approach = self._approach(region)
         place, _ = self._nearest_place(np.asarray(region.standpoint))
         near_door = next(
-            (d.id for d in self.doors.values() if math.dist(d.centre, region.centre) <= 1.0),
+            (
+                d.id
+                for d in self.doors.values()
+                if math.dist(d.centre, region.centre) <= 1.0 or path_crosses(approach, d.ends)
+            ),
             None,
         )
         return Placeholder(
@@ -312,6 +356,16 @@ class PlaceMap:
             grid, labels, [self.places[p].position for p in sorted(members)]
         )
         return Room(rid, frozenset(members), frozenset(doors), round(area, 3), round(elongation, 3))
+
+
+def _densify(corners: np.ndarray, step: float) -> np.ndarray:
+    """Points at most `step` apart along the polyline through `corners` (K, 2)."""
+    out = [corners[:1]]
+    for a, b in zip(corners[:-1], corners[1:], strict=True):
+        n = max(1, int(math.ceil(np.linalg.norm(b - a) / step)))
+        t = np.linspace(0.0, 1.0, n + 1)[1:, None]
+        out.append(a * (1 - t) + b * t)
+    return np.vstack(out)
 
 
 def _moved(prev: Placeholder, new: Placeholder) -> bool:
