@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import signal
@@ -17,22 +18,34 @@ from pathlib import Path
 
 import pytest
 
-from avs_planner.cli import EXIT_BAD_INPUT, main
+from avs_planner.cli import EXIT_BAD_INPUT, main, serve
 
 FAKE_RUNNER = f"{Path(__file__).with_name('api_fake_runner.py').resolve()}:run"
 
 
-def test_open_service_refuses_public_bind(
+def _args(*argv: str) -> argparse.Namespace:
+    parser = argparse.ArgumentParser()
+    serve.register(parser.add_subparsers())
+    return parser.parse_args(["serve", *argv])
+
+
+def test_open_service_refuses_public_bind(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("AVS_API_KEY", raising=False)
+    with pytest.raises(serve.ServeError, match="without an API key"):
+        serve.run(_args("--host", "0.0.0.0"))
+
+
+def test_bad_settings_are_bad_input() -> None:
+    with pytest.raises(serve.ServeError, match="workers"):
+        serve.run(_args("--workers", "0"))
+
+
+def test_cli_maps_serve_errors_to_exit_1(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    monkeypatch.delenv("AVS_API_KEY", raising=False)
-    assert main(["serve", "--host", "0.0.0.0"]) == EXIT_BAD_INPUT
-    assert "without an API key" in capsys.readouterr().err
-
-
-def test_bad_settings_are_bad_input(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["serve", "--workers", "0"]) == EXIT_BAD_INPUT
-    assert "workers" in capsys.readouterr().err
+    monkeypatch.setattr(serve, "_serve", lambda settings, level: pytest.fail("must not serve"))
+    assert main(["serve", "--port", "-1"]) == EXIT_BAD_INPUT
+    assert "port" in capsys.readouterr().err
 
 
 def _free_port() -> int:
