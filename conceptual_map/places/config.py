@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
+
+from conceptual_map.errors import MapError
 
 
 @dataclass(frozen=True)
@@ -21,3 +23,11 @@ class PlaceMapConfig:
     open_space_radius: float = 3.0
     placeholder_match_distance: float = 1.0
     trajectory_step: float = 0.05
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if not value > 0:
+                raise MapError(f"PlaceMapConfig.{f.name} must be positive, got {value!r}")
+        if self.door_min_width >= self.door_max_width:
+            raise MapError("PlaceMapConfig: door_min_width must be below door_max_width")

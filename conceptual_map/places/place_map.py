@@ -12,6 +12,7 @@ from collections.abc import Sequence
 import networkx as nx
 import numpy as np
 
+from conceptual_map.errors import MapError
 from conceptual_map.metric.grid2d import OccupancyGrid
 from conceptual_map.places.config import PlaceMapConfig
 from conceptual_map.places.doors import Opening, openings_along, path_crosses
@@ -59,13 +60,17 @@ class PlaceMap:
         self, grid: OccupancyGrid, poses: Sequence[Pose], time: float = 0.0
     ) -> list[MapEvent]:
         """The robot drove through `poses` in order; grow the map and report what changed."""
+        if not poses:
+            return []
+        for k, pose in enumerate(poses):
+            if len(pose) < 2 or not all(math.isfinite(v) for v in pose[:2]):
+                raise MapError(f"PlaceMap.follow: pose {k} must start with finite x, y: {pose!r}")
         events: list[MapEvent] = []
         points = self._trajectory(poses)
         events += self._grow_places(grid, points, time)
         events += self._find_doors(grid, points, time)
         self._mark_door_edges()
-        if poses:
-            events += self._refresh_placeholders(grid, poses[-1][:2], time)
+        events += self._refresh_placeholders(grid, poses[-1][:2], time)
         events += self._refresh_rooms(grid, time)
         return events
 

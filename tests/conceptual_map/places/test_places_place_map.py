@@ -149,3 +149,24 @@ def _walls_with_passage(length: float) -> list[tuple[float, float, float, float]
         (e - t, t, e + t, 1.0), (e - t, 2.0, e + t, 3 - t),  # passage mouth, east
         (w, 1.0 - t, e, 1.0 + t), (w, 2.0 - t, e, 2.0 + t),  # passage sides
     ]  # fmt: skip
+
+
+def test_bad_poses_and_settings_are_errors_naming_them() -> None:
+    from conceptual_map.errors import MapError
+    from conceptual_map.places import PlaceMapConfig
+
+    with pytest.raises(MapError, match="pose 1 must start with finite x, y"):
+        PlaceMap().follow(OccupancyGrid(), [(0.0, 0.0, 0.0), (float("nan"), 1.0, 0.0)])
+    with pytest.raises(MapError, match="place_spacing must be positive"):
+        PlaceMapConfig(place_spacing=0.0)
+    assert PlaceMap().follow(OccupancyGrid(), []) == []
+
+
+def test_room_split_by_a_new_door_is_reported(run: Run) -> None:
+    rooms = [e for batch in run.events for e in batch if e.kind is EntityKind.ROOM]
+    appeared = [e for e in rooms if e.change is Change.APPEARED]
+    assert len(appeared) == 3  # the corridor first, then one room behind each door
+    door_times = sorted(
+        e.time for b in run.events for e in b if e.kind is EntityKind.DOOR and e.entity.confirmed
+    )
+    assert all(any(abs(a.time - t) <= 1.0 for t in door_times) for a in appeared[1:])
