@@ -130,6 +130,7 @@ class _MessagePlan:
     reverse: np.ndarray
     potentials: np.ndarray
     incoming: sparse.csr_matrix
+    shared: np.ndarray | None
 
     @property
     def n_messages(self) -> int:
@@ -145,7 +146,7 @@ class _MessagePlan:
         incoming = sparse.csr_matrix(
             (np.ones(2 * n_edges), (dst, np.arange(2 * n_edges))), shape=(mrf.n_nodes, 2 * n_edges)
         )
-        return _MessagePlan(src, reverse, potentials, incoming)
+        return _MessagePlan(src, reverse, potentials, incoming, _shared_symmetric(mrf.pairwise))
 
     def log_beliefs(self, log_unary: np.ndarray, messages: np.ndarray) -> np.ndarray:
         return log_unary + self.incoming @ np.log(np.maximum(messages, _TINY))
@@ -155,8 +156,20 @@ class _MessagePlan:
         log_messages = np.log(np.maximum(messages, _TINY))
         log_b = log_unary + self.incoming @ log_messages
         cavity = log_b[self.src] - log_messages[self.reverse]
-        out = np.einsum("dk,dkl->dl", _softmax(cavity), self.potentials)
-        return _normalise(out)
+        weights = _softmax(cavity)
+        if self.shared is not None:
+            return _normalise(weights @ self.shared)
+        return _normalise(np.einsum("dk,dkl->dl", weights, self.potentials))
+
+
+def _shared_symmetric(pairwise: np.ndarray) -> np.ndarray | None:
+    """The one symmetric potential every edge uses (phi_rc in the chain graph), else None."""
+    if pairwise.shape[0] == 0:
+        return None
+    first = pairwise[0]
+    if np.array_equal(first, first.T) and (pairwise == first).all():
+        return first
+    return None
 
 
 def _initial_messages(plan: _MessagePlan, states: int, init: np.ndarray | None) -> np.ndarray:
@@ -171,11 +184,14 @@ def _initial_messages(plan: _MessagePlan, states: int, init: np.ndarray | None) 
 def _normalise(values: np.ndarray) -> np.ndarray:
     """Rows scaled to sum 1; an all-zero row (contradiction) becomes uniform."""
     sums = values.sum(axis=1, keepdims=True)
+    if sums.min() > 0:
+        return values / sums
     uniform = np.full_like(values, 1.0 / values.shape[1])
     return np.divide(values, sums, out=uniform, where=sums > 0)
 
 
 def _softmax(log_values: np.ndarray) -> np.ndarray:
     top = log_values.max(axis=1, keepdims=True)
-    top = np.where(np.isfinite(top), top, 0.0)
+    if not np.isfinite(top).all():
+        top = np.where(np.isfinite(top), top, 0.0)
     return _normalise(np.exp(log_values - top))

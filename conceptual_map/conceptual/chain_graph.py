@@ -8,7 +8,7 @@ turns it into the pairwise network loopy BP runs on, recomputing only rooms that
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 
 import numpy as np
 from pgmpy.factors.discrete import DiscreteFactor
@@ -43,6 +43,7 @@ class ChainGraph:
         self._neighbours: dict[str, set[str]] = {}
         self._evidence: dict[str, dict[str, np.ndarray]] = {}
         self._likelihood: dict[str, dict[str, DiscreteFactor]] = {}
+        self._place_log: dict[str, np.ndarray] = {}
         self._room_evidence: dict[str, np.ndarray] = {}
         self._unary: dict[str, np.ndarray] = {}
 
@@ -103,6 +104,7 @@ class ChainGraph:
         del self._room_of[place]
         self._evidence.pop(place, None)
         self._likelihood.pop(place, None)
+        self._place_log.pop(place, None)
         self._touch(room)
 
     def connect(self, a: str, b: str) -> None:
@@ -161,6 +163,11 @@ class ChainGraph:
         self._likelihood.setdefault(place, {})[kind] = _reduced_property_factor(
             model.table, kind, weights
         )
+        with np.errstate(divide="ignore"):
+            self._place_log[place] = sum(
+                (np.log(f.values) for f in self._likelihood[place].values()),
+                start=np.zeros(len(self.knowledge.categories)),
+            )
         self._touch(room)
 
     def set_room_evidence(self, room: str, likelihood: np.ndarray | float) -> None:
@@ -172,62 +179,81 @@ class ChainGraph:
 
     # -- compiled views --------------------------------------------------------------------
 
+    def invalidate(self) -> None:
+        """Drop every cached unary (the next `compile()` recomputes all rooms)."""
+        self._unary.clear()
+
     def unary(self, room: str) -> np.ndarray:
         """Normalised product of prior, property likelihoods and object evidence of `room`."""
-        cached = self._unary.get(room)
-        if cached is None:
-            cached = self._compute_unary(room)
-            self._unary[room] = cached
-        return cached
-
-    def _compute_unary(self, room: str) -> np.ndarray:
         self.require_room(room)
-        log_unary = np.log(self.knowledge.prior).copy()
-        with np.errstate(divide="ignore"):
-            for factor in self._room_factors(room):
-                log_unary += np.log(factor)
-        top = log_unary.max()
-        if not np.isfinite(top):
-            return np.full_like(log_unary, 1.0 / log_unary.size)
-        unary = np.exp(log_unary - top)
-        return unary / unary.sum()
+        if room not in self._unary:
+            self._refresh_unaries([room])
+        return self._unary[room]
 
-    def _room_factors(self, room: str) -> Iterable[np.ndarray]:
-        for place in self._places_of[room]:
-            for factor in self._likelihood.get(place, {}).values():
-                yield factor.values
-        if room in self._room_evidence:
-            yield self._room_evidence[room]
+    def _refresh_unaries(self, rooms: list[str]) -> None:
+        """Recompute the unaries of `rooms` in one vectorised pass (sums of log-likelihoods)."""
+        index = {room: i for i, room in enumerate(rooms)}
+        log_unary = np.tile(np.log(self.knowledge.prior), (len(rooms), 1))
+        owners = [index[self._room_of[p]] for r in rooms for p in self._places_of[r]
+                  if p in self._place_log]
+        if owners:
+            logs = [self._place_log[p] for r in rooms for p in self._places_of[r]
+                    if p in self._place_log]
+            np.add.at(log_unary, owners, np.array(logs))
+        with np.errstate(divide="ignore"):
+            for room in rooms:
+                if room in self._room_evidence:
+                    log_unary[index[room]] += np.log(self._room_evidence[room])
+        for room, row in zip(rooms, _row_softmax(log_unary), strict=True):
+            self._unary[room] = row
 
     def compile(self) -> tuple[PairwiseMRF, list[str]]:
         """The pairwise network over room categories (rooms in `self.rooms` order)."""
         rooms = self.rooms
+        stale = [room for room in rooms if room not in self._unary]
+        if stale:
+            self._refresh_unaries(stale)
         index = {room: i for i, room in enumerate(rooms)}
         states = len(self.knowledge.categories)
-        unary = np.array([self.unary(room) for room in rooms]).reshape(-1, states)
+        unary = np.array([self._unary[room] for room in rooms]).reshape(-1, states)
         pairs = [(index[a], index[b]) for a in rooms for b in self._neighbours[a]]
         edges = np.array([p for p in pairs if p[0] < p[1]], dtype=np.int64).reshape(-1, 2)
         pairwise = np.broadcast_to(self.knowledge.connectivity, (len(edges), states, states))
         return PairwiseMRF(unary, edges, pairwise), rooms
 
-    def factors(self, explicit_properties: bool = False) -> list[DiscreteFactor]:
+    def factors(
+        self, explicit_properties: bool = False, merged: bool = False
+    ) -> list[DiscreteFactor]:
         """The chain graph as pgmpy factors (for exact inference and inspection).
 
         With `explicit_properties`, every observed place property is its own variable with the
-        full P(value | category) factor plus an evidence factor; otherwise the reduced form.
+        full P(value | category) factor plus an evidence factor; otherwise the reduced form
+        (likelihood vectors over the room category, scaled to a maximum of 1). `merged` gives
+        one unary per room instead (all its evidence multiplied), which keeps exact inference
+        on large maps from underflowing.
         """
         states = len(self.knowledge.categories)
         order = {room: i for i, room in enumerate(self.rooms)}
         factors = []
         for room in order:
             variable = category_variable(room)
-            factors.append(DiscreteFactor([variable], [states], self.knowledge.prior.copy()))
-            factors.extend(self._property_factors(room, explicit_properties))
-            if room in self._room_evidence:
-                factors.append(DiscreteFactor([variable], [states], self._room_evidence[room]))
+            if merged:
+                factors.append(DiscreteFactor([variable], [states],
+                                              _max_normalised(self.unary(room))))
+            else:
+                factors.extend(self._room_unaries(room, explicit_properties))
             for other in self._neighbours[room]:
                 if order[other] > order[room]:
                     factors.append(self._phi_factor(room, other))
+        return factors
+
+    def _room_unaries(self, room: str, explicit: bool) -> list[DiscreteFactor]:
+        variable, states = category_variable(room), len(self.knowledge.categories)
+        factors = [DiscreteFactor([variable], [states], self.knowledge.prior.copy())]
+        factors.extend(self._property_factors(room, explicit))
+        if room in self._room_evidence:
+            values = _max_normalised(self._room_evidence[room])
+            factors.append(DiscreteFactor([variable], [states], values))
         return factors
 
     def _property_factors(self, room: str, explicit: bool) -> list[DiscreteFactor]:
@@ -236,8 +262,8 @@ class ChainGraph:
         for place in sorted(self._places_of[room]):
             for kind, weights in self._evidence.get(place, {}).items():
                 if not explicit:
-                    values = self._likelihood[place][kind].values
-                    result.append(DiscreteFactor([variable], [states], values.copy()))
+                    values = _max_normalised(self._likelihood[place][kind].values)
+                    result.append(DiscreteFactor([variable], [states], values))
                     continue
                 prop = property_variable(place, kind)
                 table = self.knowledge.properties[kind].table
@@ -250,6 +276,21 @@ class ChainGraph:
         return DiscreteFactor(
             [category_variable(a), category_variable(b)], list(phi.shape), phi.copy()
         )
+
+
+def _row_softmax(log_values: np.ndarray) -> np.ndarray:
+    """Rows exp-normalised; a row with no possible state (contradiction) becomes uniform."""
+    top = log_values.max(axis=1, keepdims=True)
+    finite = np.isfinite(top)
+    values = np.exp(log_values - np.where(finite, top, 0.0))
+    values[~finite[:, 0]] = 1.0
+    return values / values.sum(axis=1, keepdims=True)
+
+
+def _max_normalised(values: np.ndarray) -> np.ndarray:
+    """Scaled so the largest entry is 1: same evidence, no underflow in long products."""
+    top = values.max()
+    return values / top if top > 0 else values.copy()
 
 
 def _evidence_vector(values: tuple[str, ...], kind: str, value: PropertyValue) -> np.ndarray:

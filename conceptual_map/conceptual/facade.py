@@ -164,9 +164,15 @@ class ConceptualMap:
 
     # -- inference -------------------------------------------------------------------------
 
-    def update(self, force: bool = False) -> BPResult:
-        """Rerun loopy BP if anything changed (or `force`); returns the run's result."""
-        if self._dirty or force or self.last_result is None:
+    def update(self, force: bool = False, cold: bool = False) -> BPResult:
+        """Rerun loopy BP if anything changed (or `force`); returns the run's result.
+
+        `cold` also recomputes every room's unary and starts BP from uniform messages.
+        """
+        if cold:
+            self.graph.invalidate()
+            self._messages = {}
+        if self._dirty or force or cold or self.last_result is None:
             mrf, rooms = self.graph.compile()
             result = loopy_bp(mrf, self.settings, self._warm_start(mrf, rooms))
             self._store(mrf, rooms, result)
@@ -241,9 +247,11 @@ class ConceptualMap:
             raise ConceptualError(str(exc.args[0])) from None
         return float(p_at_least_one(lam[column]))
 
-    def factors(self, explicit_properties: bool = False) -> list[DiscreteFactor]:
+    def factors(
+        self, explicit_properties: bool = False, merged: bool = False
+    ) -> list[DiscreteFactor]:
         """The current chain graph as pgmpy factors (see `ChainGraph.factors`)."""
-        return self.graph.factors(explicit_properties)
+        return self.graph.factors(explicit_properties, merged)
 
 
 def _as_location(location: Location | tuple[str, str]) -> Location:

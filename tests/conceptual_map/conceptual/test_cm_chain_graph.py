@@ -105,3 +105,12 @@ def test_remove_place_drops_its_evidence():
 def test_bad_events_raise_clear_errors(action, message):
     with pytest.raises(ConceptualError, match=message):
         action(_building())
+
+
+def test_merged_factors_give_the_same_exact_marginals():
+    cmap = _building()
+    reduced = exact_marginals(cmap.factors())
+    merged = exact_marginals(cmap.factors(merged=True))
+    assert len(cmap.factors(merged=True)) == len(cmap.graph.rooms) + 3
+    for variable, values in reduced.items():
+        np.testing.assert_allclose(merged[variable], values, atol=1e-10)
