@@ -4,11 +4,13 @@ from __future__ import annotations
 
 from fastapi import APIRouter, HTTPException, status
 
-from api.deps import ManagerDep, WriteAccess
+from api.deps import ManagerDep, SettingsDep, WriteAccess
 from api.routes.jobs import pddl_422, run_job
 from api.schemas import Message, PlanCreate, PlanPublic
 
 router = APIRouter(prefix="/plans", tags=["plans"])
+
+PLANNER_SHARE = 0.8  # of the job's wall-clock limit; the rest is reading and grounding
 
 
 @router.post(
@@ -18,9 +20,16 @@ router = APIRouter(prefix="/plans", tags=["plans"])
         429: {"model": Message}, 503: {"model": Message}, 504: {"model": Message},
     },
 )
-async def create_plan(body: PlanCreate, owner: WriteAccess, manager: ManagerDep) -> PlanPublic:
-    """Plan: 200 with status (solved, unsolvable, timeout, ...) and the plan; 422 for bad PDDL."""
+async def create_plan(
+    body: PlanCreate, owner: WriteAccess, manager: ManagerDep, settings: SettingsDep
+) -> PlanPublic:
+    """Plan: 200 with status (solved, unsolvable, timeout, ...) and the plan; 422 for bad PDDL.
+
+    The planner's own timeout is capped below the job's wall-clock limit, so a long search
+    ends as status `timeout` rather than a killed job (504)."""
     options = body.model_dump(include={"reward", "weight", "timeout_s"}, exclude_none=True)
+    cap = settings.plan_time_limit_s * PLANNER_SHARE
+    options["timeout_s"] = min(options.get("timeout_s", cap), cap)
     payload = {"domain_text": body.domain, "problem_text": body.problem, "options": options}
     value = await run_job(manager, "plan", payload)
     if value.get("status") == "invalid":

@@ -96,3 +96,12 @@ def test_domain_check_reports_diagnostics(client: TestClient) -> None:
 def test_domain_check_of_garbage(client: TestClient) -> None:
     body = client.post("/v1/domains/check", json={"domain": "(define (domain"}).json()
     assert body["ok"] is False and body["diagnostics"][0]["file"] == "domain"
+
+
+def test_plan_job_over_its_wall_clock_is_504(tmp_path: Path) -> None:
+    settings = Settings(data_dir=tmp_path, worlds_dir=tmp_path, plan_time_limit_s=0.05,
+                        preload_planner=False)
+    with TestClient(create_app(settings)) as client:
+        response = client.post("/v1/plans", json={"domain": DOMAIN, "problem": PROBLEM})
+        assert response.status_code == 504 and "wall-clock limit" in response.json()["detail"]
+        assert client.get("/v1/health").status_code == 200  # the killed worker is replaced
