@@ -22,6 +22,8 @@ IMPLIES: dict[str, set[str]] = {
     ":fluents": {":numeric-fluents", ":object-fluents", ":action-costs"},
     ":numeric-fluents": {":action-costs"},
 }
+# Valid PDDL flags that unified-planning's reader does not accept.
+UNSUPPORTED = {":object-fluents", ":derived-predicates"}
 KNOWN = {
     *IMPLIES[":adl"],
     ":adl",
@@ -70,7 +72,13 @@ def _missing_message(node, flag: str) -> str:  # noqa: ANN001
 
 def _unknown(domain: Domain, report: Report) -> None:
     for atom in domain.requirements:
-        if atom.text not in KNOWN:
+        if atom.text in UNSUPPORTED:
+            report.add(
+                atom,
+                "unsupported-requirement",
+                f"requirement {atom.text} is valid PDDL but avs-planner cannot read it",
+            )
+        elif atom.text not in KNOWN:
             hint = did_you_mean(atom.text, KNOWN)
             report.add(atom, "unknown-requirement", f"unknown requirement '{atom.text}'{hint}")
 
@@ -83,7 +91,7 @@ def _typing_usage(domain: Domain, usage: Usage) -> None:
 def _unused(domain: Domain, usage: Usage, report: Report) -> None:
     used = set(usage.requirements)
     for atom in domain.requirements:
-        if atom.text == ":strips" or atom.text not in KNOWN:
+        if atom.text == ":strips" or atom.text not in KNOWN or atom.text in UNSUPPORTED:
             continue
         if not ({atom.text} | IMPLIES.get(atom.text, set())) & used:
             report.add(
