@@ -45,6 +45,7 @@ class ChainGraph:
         self._likelihood: dict[str, dict[str, DiscreteFactor]] = {}
         self._place_log: dict[str, np.ndarray] = {}
         self._room_evidence: dict[str, np.ndarray] = {}
+        self._room_properties: dict[str, dict[str, tuple[np.ndarray, DiscreteFactor]]] = {}
         self._unary: dict[str, np.ndarray] = {}
 
     # -- structure -------------------------------------------------------------------------
@@ -143,7 +144,9 @@ class ChainGraph:
             self.remove_place(place)
         for other in list(self._neighbours[room]):
             self.disconnect(room, other)
-        for table in (self._places_of, self._neighbours, self._room_evidence, self._unary):
+        tables = (self._places_of, self._neighbours, self._room_evidence, self._room_properties,
+                  self._unary)
+        for table in tables:
             table.pop(room, None)
 
     def _touch(self, room: str) -> None:
@@ -154,21 +157,34 @@ class ChainGraph:
     def observe_property(self, place: str, kind: str, value: PropertyValue) -> None:
         """Evidence on a place property; replaces earlier evidence of that kind at the place."""
         room = self.room_of(place)
-        model = self.knowledge.properties.get(kind)
-        if model is None:
-            known = ", ".join(self.knowledge.properties)
-            raise ConceptualError(f"unknown property kind {kind!r} (known: {known})")
-        weights = _evidence_vector(model.values, kind, value)
+        weights, factor = self._property_evidence(kind, value)
         self._evidence.setdefault(place, {})[kind] = weights
-        self._likelihood.setdefault(place, {})[kind] = _reduced_property_factor(
-            model.table, kind, weights
-        )
+        self._likelihood.setdefault(place, {})[kind] = factor
         with np.errstate(divide="ignore"):
             self._place_log[place] = sum(
                 (np.log(f.values) for f in self._likelihood[place].values()),
                 start=np.zeros(len(self.knowledge.categories)),
             )
         self._touch(room)
+
+    def observe_room_property(self, room: str, kind: str, value: PropertyValue) -> None:
+        """Evidence on a property of a whole room (e.g. its area from the place map).
+
+        Replaces earlier room-level evidence of that kind; dropped when the room is merged away.
+        """
+        self.require_room(room)
+        self._room_properties.setdefault(room, {})[kind] = self._property_evidence(kind, value)
+        self._touch(room)
+
+    def _property_evidence(
+        self, kind: str, value: PropertyValue
+    ) -> tuple[np.ndarray, DiscreteFactor]:
+        model = self.knowledge.properties.get(kind)
+        if model is None:
+            known = ", ".join(self.knowledge.properties)
+            raise ConceptualError(f"unknown property kind {kind!r} (known: {known})")
+        weights = _evidence_vector(model.values, kind, value)
+        return weights, _reduced_property_factor(model.table, kind, weights)
 
     def set_room_evidence(self, room: str, likelihood: np.ndarray | float) -> None:
         """Replace the object/search likelihood vector over `room`'s category (owned by caller)."""
@@ -202,6 +218,8 @@ class ChainGraph:
             np.add.at(log_unary, owners, np.array(logs))
         with np.errstate(divide="ignore"):
             for room in rooms:
+                for _weights, factor in self._room_properties.get(room, {}).values():
+                    log_unary[index[room]] += np.log(factor.values)
                 if room in self._room_evidence:
                     log_unary[index[room]] += np.log(self._room_evidence[room])
         for room, row in zip(rooms, _row_softmax(log_unary), strict=True):
@@ -251,25 +269,39 @@ class ChainGraph:
         variable, states = category_variable(room), len(self.knowledge.categories)
         factors = [DiscreteFactor([variable], [states], self.knowledge.prior.copy())]
         factors.extend(self._property_factors(room, explicit))
+        for kind, (weights, factor) in self._room_properties.get(room, {}).items():
+            factors.extend(self._evidence_factors(room, f"room:{room}", kind, weights, factor,
+                                                  explicit))
         if room in self._room_evidence:
             values = _max_normalised(self._room_evidence[room])
             factors.append(DiscreteFactor([variable], [states], values))
         return factors
 
     def _property_factors(self, room: str, explicit: bool) -> list[DiscreteFactor]:
-        variable, states = category_variable(room), len(self.knowledge.categories)
         result = []
         for place in sorted(self._places_of[room]):
             for kind, weights in self._evidence.get(place, {}).items():
-                if not explicit:
-                    values = _max_normalised(self._likelihood[place][kind].values)
-                    result.append(DiscreteFactor([variable], [states], values))
-                    continue
-                prop = property_variable(place, kind)
-                table = self.knowledge.properties[kind].table
-                result.append(DiscreteFactor([variable, prop], list(table.shape), table.copy()))
-                result.append(DiscreteFactor([prop], [len(weights)], weights.copy()))
+                factor = self._likelihood[place][kind]
+                result += self._evidence_factors(room, place, kind, weights, factor, explicit)
         return result
+
+    def _evidence_factors(
+        self,
+        room: str,
+        holder: str,
+        kind: str,
+        weights: np.ndarray,
+        reduced: DiscreteFactor,
+        explicit: bool,
+    ) -> list[DiscreteFactor]:
+        """Reduced likelihood over the room category, or the CPD plus an evidence factor."""
+        variable, states = category_variable(room), len(self.knowledge.categories)
+        if not explicit:
+            return [DiscreteFactor([variable], [states], _max_normalised(reduced.values))]
+        prop = property_variable(holder, kind)
+        table = self.knowledge.properties[kind].table
+        return [DiscreteFactor([variable, prop], list(table.shape), table.copy()),
+                DiscreteFactor([prop], [len(weights)], weights.copy())]
 
     def _phi_factor(self, a: str, b: str) -> DiscreteFactor:
         phi = self.knowledge.connectivity

@@ -127,6 +127,11 @@ class ConceptualMap:
         self.graph.observe_property(place, kind, value)
         self._dirty = True
 
+    def observe_room_property(self, room: str, kind: str, value: PropertyValue) -> None:
+        """Property evidence about a whole room (e.g. size from its area); replaces older."""
+        self.graph.observe_room_property(room, kind, value)
+        self._dirty = True
+
     def observe_object(
         self,
         label: str,

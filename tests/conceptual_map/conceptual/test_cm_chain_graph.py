@@ -20,6 +20,8 @@ def _building() -> ConceptualMap:
     cmap.observe_property("r1_p0", "appearance", "kitchen_like")
     cmap.observe_property("r2_p1", "size", "small")
     cmap.observe_object("desk", "r3")
+    cmap.observe_room_property("corr", "size", "large")
+    cmap.observe_room_property("r2", "shape", {"square": 0.6, "rectangular": 0.4})
     return cmap
 
 
@@ -48,6 +50,7 @@ def test_explicit_factors_hold_property_variables_and_evidence():
     scopes = [tuple(f.scope()) for f in factors]
     assert (category_variable("r1"), "appearance[r1_p0]") in scopes
     assert ("appearance[r1_p0]",) in scopes
+    assert (category_variable("corr"), "size[room:corr]") in scopes
 
 
 def test_events_rerun_inference_only_when_something_changed():
