@@ -1,9 +1,10 @@
-"""Door hypotheses from the robot's own path: a short narrowing it passes through (seed 003 §2).
+"""Door hypotheses from the robot's own grid: a short narrowing in a wall (seed 003 §2).
 
-At each point of the path, chords through the point are probed in many directions up to the
-first occupied cell. The shortest chord is the opening's width across; it is a door when it is
-narrower than ~1.1 m yet widens again a wall's thickness before and after (a narrow corridor
-or a gap between furniture stays narrow for longer).
+At each probe point, chords through the point are probed in many directions up to the first
+occupied cell. The shortest chord is the opening's width across; it is a door when it is
+narrower than ~1.1 m, widens again a wall's thickness before and after (a narrow corridor or
+a gap beside a long piece of furniture stays narrow for longer), and its jambs continue as
+walls along the chord's line.
 """
 
 from __future__ import annotations
@@ -64,13 +65,12 @@ def chord_extents(
 
 
 def openings_along(
-    grid: OccupancyGrid, points: np.ndarray, config: PlaceMapConfig, in_wall: bool = False
+    grid: OccupancyGrid, points: np.ndarray, config: PlaceMapConfig
 ) -> list[Opening]:
     """Door-like openings at the given points (at most one per point).
 
-    With `in_wall`, the jambs must also continue as straight walls along the chord: a stricter
-    test for hypotheses from partly seen space, where a diagonal across a half-seen corner
-    can look like a short narrow opening.
+    The jambs must also continue as straight walls along the chord: otherwise the gap between
+    a table's corner and a wall, or a diagonal across a half-seen corner, looks like a door.
     """
     if points.shape[0] == 0:
         return []
@@ -88,7 +88,7 @@ def openings_along(
         axis = np.array([np.cos(angle), np.sin(angle)])
         centre = points[k] + axis * 0.5 * (plus[k, best[k]] - minus[k, best[k]])
         opening = Opening(centre, float(narrow[k]), angle)
-        if _is_short(grid, opening, config) and (not in_wall or _in_wall(grid, opening)):
+        if _is_short(grid, opening, config) and _in_wall(grid, opening):
             found.append(opening)
     return found
 
@@ -122,9 +122,9 @@ def _is_short(grid: OccupancyGrid, opening: Opening, config: PlaceMapConfig) -> 
     return bool(np.all(plus[:, 0] + minus[:, 0] >= opening.width + _WIDENING))
 
 
-def path_crosses(points: np.ndarray, ends: tuple[np.ndarray, np.ndarray]) -> bool:
-    """Does the polyline through `points` (K, 2) cross the door chord? Points exactly on the
-    door line count as on its positive side, so every place belongs to exactly one side."""
+def crossings(points: np.ndarray, ends: tuple[np.ndarray, np.ndarray]) -> int:
+    """How often the polyline through `points` (K, 2) crosses the door chord. Points exactly on
+    the door line count as on its positive side, so every place belongs to exactly one side."""
     pts = np.asarray(points, dtype=float)
     p, q = np.asarray(ends[0], dtype=float), np.asarray(ends[1], dtype=float)
     d = q - p
@@ -133,8 +133,8 @@ def path_crosses(points: np.ndarray, ends: tuple[np.ndarray, np.ndarray]) -> boo
     a, b = side[:-1], side[1:]
     switch = (a >= 0) != (b >= 0)
     if not switch.any():
-        return False
+        return 0
     t = a[switch] / (a[switch] - b[switch])
     x = pts[:-1][switch] + t[:, None] * (pts[1:][switch] - pts[:-1][switch])
     u = (x - p) @ d / (d @ d)
-    return bool(np.any((u >= -0.05) & (u <= 1.05)))
+    return int(np.count_nonzero((u >= -0.05) & (u <= 1.05)))

@@ -14,6 +14,7 @@ from typing import Protocol
 
 import numpy as np
 
+from conceptual_map.errors import MapError
 from conceptual_map.metric.grid2d import OccupancyGrid
 from conceptual_map.metric.path_planning import distance_field, plan_path
 from conceptual_map.metric.sensors import LaserScanLike
@@ -64,6 +65,7 @@ class Explorer:
     step: float = 0.5
     max_moves: int = 300
     max_tries: int = 2  # visits to a placeholder that stays unexplored before giving it up
+    max_legs: int = 60  # legs of one visit before giving up on it
 
     def __post_init__(self) -> None:
         self._radius = self.place_map.config.robot_radius
@@ -111,26 +113,36 @@ class Explorer:
         return best
 
     def _visit(self, target: str) -> None:
+        """Drive leg by leg towards a placeholder, replanning after each scan (new obstacles)."""
         self._tries[target] = self._tries.get(target, 0) + 1
-        goal = self.place_map.placeholders[target].position
-        path = plan_path(self.grid, self.robot.pose[:2], goal, self._radius)
-        if not path.found:
-            return
-        for leg in _legs(path.waypoints, self.step):
-            here = self.robot.pose[:2]
-            try:
-                self.robot.move_along(leg)
-            except Exception as exc:  # noqa: BLE001 - the adapter's own "blocked" error
-                self._result.failures.append(f"{target}: {exc}")
+        for _ in range(self.max_legs):
+            placeholder = self.place_map.placeholders.get(target)
+            if placeholder is None:
+                return  # explored on the way
+            if math.dist(self.robot.pose[:2], placeholder.position) < 0.5 * self.grid.resolution:
                 break
-            self._result.moves += 1
-            self._result.distance += sum(
-                math.dist(a, b) for a, b in zip([here, *leg], leg, strict=False)
-            )
-            self._sense([(x, y, self.robot.pose[2]) for x, y in leg])
-            if target not in self.place_map.placeholders:
+            try:
+                path = plan_path(self.grid, self.robot.pose[:2], placeholder.position, self._radius)
+            except MapError as exc:
+                self._result.failures.append(f"{target}: {exc}")
+                return
+            if not path.found or not self._drive(target, _legs(path.waypoints, self.step)[0]):
                 return
         self._look_around()
+
+    def _drive(self, target: str, leg: list[tuple[float, float]]) -> bool:
+        here = self.robot.pose[:2]
+        try:
+            self.robot.move_along(leg)
+        except Exception as exc:  # noqa: BLE001 - the adapter's own "blocked" error
+            self._result.failures.append(f"{target}: {exc}")
+            return False
+        self._result.moves += 1
+        self._result.distance += sum(
+            math.dist(a, b) for a, b in zip([here, *leg], leg, strict=False)
+        )
+        self._sense([(x, y, self.robot.pose[2]) for x, y in leg])
+        return True
 
 
 def _legs(

@@ -16,6 +16,7 @@ from conceptual_map.metric.logodds import CellState
 from conceptual_map.places.config import PlaceMapConfig
 
 _EIGHT = np.ones((3, 3), dtype=bool)
+_STANDPOINT_MARGIN = 0.1  # prefer standpoints this far beyond the robot radius from obstacles
 
 
 @dataclass(frozen=True)
@@ -89,9 +90,11 @@ def _describe(
     config: PlaceMapConfig,
 ) -> FrontierRegion | None:
     medoid = cells[np.argmin(np.linalg.norm(cells - cells.mean(axis=0), axis=1))]
-    stand = _nearest_true(
-        reachable, medoid, int(np.ceil(2 * config.reach_tolerance / grid.resolution))
-    )
+    window = int(np.ceil(2 * config.reach_tolerance / grid.resolution))
+    roomy = reachable & (grid.clearance() >= config.robot_radius + _STANDPOINT_MARGIN)
+    stand = _nearest_true(roomy, medoid, window)
+    if stand is None:
+        stand = _nearest_true(reachable, medoid, window)
     if stand is None:
         return None
     standpoint = grid.to_world(np.asarray([stand]))[0]

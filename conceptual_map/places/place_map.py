@@ -15,7 +15,7 @@ import numpy as np
 from conceptual_map.errors import MapError
 from conceptual_map.metric.grid2d import OccupancyGrid
 from conceptual_map.places.config import PlaceMapConfig
-from conceptual_map.places.doors import Opening, openings_along, path_crosses
+from conceptual_map.places.doors import Opening, crossings, openings_along
 from conceptual_map.places.frontiers import FrontierRegion, frontier_regions
 from conceptual_map.places.model import (
     Change,
@@ -160,7 +160,8 @@ class PlaceMap:
 
     def _find_doors(self, grid: OccupancyGrid, points: np.ndarray, time: float) -> list[MapEvent]:
         """Openings on the path just driven (they get confirmed once the path crosses them)."""
-        return self._add_openings(openings_along(grid, points, self.config), points, time)
+        found = openings_along(grid, points, self.config)
+        return self._add_openings(found, points, time)
 
     def _add_openings(
         self, openings: list[Opening], path_points: np.ndarray, time: float
@@ -232,8 +233,10 @@ class PlaceMap:
             lines = [np.array([a, b])]
             if data["trace"] is not None:
                 lines.append(data["trace"])
-            crossed = (
-                d.id for d in self.doors.values() if any(path_crosses(ln, d.ends) for ln in lines)
+            crossed = (  # an even number of crossings comes back to the same side
+                d.id
+                for d in self.doors.values()
+                if any(crossings(ln, d.ends) % 2 == 1 for ln in lines)
             )
             data["door"] = next(crossed, None)
             data["doors_checked"] = self._door_revision
@@ -286,7 +289,7 @@ class PlaceMap:
             cells[standable, 0], cells[standable, 1]
         ]
         points = points[standable]  # a robot could pass here, as through a door
-        found = openings_along(grid, points, self.config, in_wall=True)
+        found = openings_along(grid, points, self.config)
         return self._add_openings(found, points[:0], time)
 
     def _approach(self, region: FrontierRegion) -> np.ndarray:
@@ -304,7 +307,7 @@ class PlaceMap:
             (
                 d.id
                 for d in self.doors.values()
-                if math.dist(d.centre, region.centre) <= 1.0 or path_crosses(approach, d.ends)
+                if math.dist(d.centre, region.centre) <= 1.0 or crossings(approach, d.ends) > 0
             ),
             None,
         )
