@@ -58,6 +58,9 @@ class ChainGraph:
     def has_room(self, room: str) -> bool:
         return room in self._places_of
 
+    def has_place(self, place: str) -> bool:
+        return place in self._room_of
+
     def room_of(self, place: str) -> str:
         """Room holding `place`; ConceptualError if the place is unknown."""
         try:

@@ -180,6 +180,12 @@ class ObjectLedger:
         keys = {(loc, label) for loc, counts in self._counts.items() for label in counts}
         return keys | set(self._remaining)
 
+    def forget_room(self, room: str) -> None:
+        """Drop room-level search records of a deleted room (it holds no objects)."""
+        for key in [k for k in self._remaining if k[0] == room]:
+            del self._remaining[key]
+        self._counts.pop(room, None)
+
     def move_room(self, gone: str, keep: str) -> None:
         """Objects and room-level searches of `gone` now belong to `keep` (rooms merged).
 

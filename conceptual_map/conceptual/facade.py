@@ -81,6 +81,18 @@ class ConceptualMap:
                 )
         self._refresh_object_evidence(keep)
 
+    def remove_room(self, room: str) -> None:
+        """Delete a room with its places, links and placeholders (not one holding objects)."""
+        self.graph.require_room(room)
+        held = [r.object_id for r in self.objects.objects.values() if r.room == room]
+        if held:
+            raise ConceptualError(f"room {room!r} holds objects {held}; merge it instead")
+        self.graph.remove_room(room)
+        self.objects.forget_room(room)
+        for ph in [ph for ph, ev in self._placeholders.items() if ev.room == room]:
+            del self._placeholders[ph]
+        self._dirty = True
+
     # -- placeholders ----------------------------------------------------------------------
 
     @property
