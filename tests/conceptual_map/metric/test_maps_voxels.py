@@ -104,3 +104,12 @@ def test_non_unit_directions_are_rejected() -> None:
     frame = DepthFrame(np.zeros(3), np.array([[2.0, 0.0, 0.0]]), np.array([1.0]), 4.0)
     with pytest.raises(SensorDataError, match="unit vectors"):
         VoxelMap().integrate_depth(frame)
+
+
+def test_a_growing_map_keeps_its_frontier_set_consistent(world: BoxWorld) -> None:
+    voxels = VoxelMap(origin=(1.5, 1.5, 0.0), size=(1.0, 1.0, 2.0), grow=True)
+    for frame in frames(world):
+        voxels.integrate_depth(frame)
+    assert voxels.origin[0] < 0.0 and voxels.shape[0] > 20  # grew to hold the room
+    assert voxels.frontier.shape == voxels.shape
+    assert np.array_equal(voxels.frontier, voxels.compute_frontier())

@@ -93,3 +93,24 @@ def test_every_open_door_was_found_and_passed(explored) -> None:
         ]
         assert len(near) == 1 and near[0].confirmed, door
         assert abs(near[0].width - door.width) <= 0.1
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [2, 3, 4])
+def test_other_sensor_noise_seeds_find_the_same_four_rooms(seed: int) -> None:
+    with sim.load_world("office", seed=seed) as world:
+        grid, place_map = OccupancyGrid(resolution=RES), PlaceMap(PlaceMapConfig(robot_radius=0.3))
+        result = Explorer(world.robot, grid, place_map).run()
+        spec = world.spec
+    assert result.status is ExplorationStatus.COMPLETE and place_map.placeholders == {}
+    found = set()
+    for room in place_map.rooms.values():
+        names = {
+            r.name
+            for pid in room.places
+            for r in spec.rooms
+            if r.contains(*place_map.places[pid].position, margin=0.15)
+        }
+        assert len(names) == 1
+        found |= names
+    assert len(place_map.rooms) == 4 and found == {r.name for r in spec.rooms}
