@@ -339,7 +339,10 @@ def _evidence_vector(values: tuple[str, ...], kind: str, value: PropertyValue) -
     unknown = sorted(set(value) - set(values))
     if unknown:
         raise ConceptualError(f"unknown {kind} value {unknown[0]!r} in soft evidence")
-    weights = np.array([float(value.get(v, 0.0)) for v in values])
+    try:
+        weights = np.array([float(value.get(v, 0.0)) for v in values])
+    except (TypeError, ValueError):
+        raise ConceptualError(f"{kind} soft evidence needs numbers, got {value!r}") from None
     if not np.all(np.isfinite(weights)) or weights.min() < 0 or weights.sum() <= 0:
         raise ConceptualError(f"{kind} soft evidence needs non-negative weights, got {value!r}")
     return weights

@@ -122,11 +122,15 @@ class ObjectLedger:
             return holder.room
         return location
 
-    def record_search(self, label: str, location: Location, coverage: float, p_detect: float):
+    def record_search(
+        self, label: str, location: Location, coverage: float, p_detect: float
+    ) -> None:
         """A search of `location` for `label` that found nothing."""
         self.require_label(label)
         self.room_of(location)
         for name, value in (("coverage", coverage), ("p_detect", p_detect)):
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ConceptualError(f"{name} must be a number in [0, 1], got {value!r}")
             if not 0.0 <= value <= 1.0:
                 raise ConceptualError(f"{name} must be in [0, 1], got {value!r}")
         key = (location, label)

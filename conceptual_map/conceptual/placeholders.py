@@ -48,6 +48,10 @@ class PlaceholderEvidence:
     p_door: float = 0.0
 
     def __post_init__(self) -> None:
+        for name in ("open_space_m2", "p_door"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ConceptualError(f"{name} must be a number, got {value!r}")
         if not (math.isfinite(self.open_space_m2) and self.open_space_m2 >= 0.0):
             raise ConceptualError(f"open_space_m2 must be >= 0, got {self.open_space_m2!r}")
         if not 0.0 <= self.p_door <= 1.0:

@@ -98,6 +98,8 @@ def test_remove_place_drops_its_evidence():
         (lambda m: m.observe_property("r1_p0", "smell", "coffee"), "unknown property kind"),
         (lambda m: m.observe_property("r1_p0", "size", "huge"), "unknown size value 'huge'"),
         (lambda m: m.observe_property("r1_p0", "size", {"small": -1.0}), "non-negative"),
+        (lambda m: m.observe_property("r1_p0", "size", {"small": "lots"}), "needs numbers"),
+        (lambda m: m.add_placeholder("ph", "r1", open_space_m2="big"), "must be a number"),
         (lambda m: m.connect_rooms("r1", "attic"), "unknown room 'attic'"),
         (lambda m: m.connect_rooms("r1", "r1"), "itself"),
         (lambda m: m.room_category("attic"), "unknown room 'attic'"),

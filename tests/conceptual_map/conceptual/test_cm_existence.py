@@ -104,6 +104,7 @@ def test_abstract_location_probabilities_come_from_default_knowledge():
         (lambda m: m.observe_object("cup", "attic"), "unknown room 'attic'"),
         (lambda m: m.observe_object("cup", "r", on="object9"), "unknown support object"),
         (lambda m: m.observe_search("cup", "r", 1.5, 0.8), "coverage must be in"),
+        (lambda m: m.observe_search("cup", "r", "all", 0.8), "coverage must be a number"),
         (lambda m: m.observe_search("cup", ("under", "object1"), 0.5, 0.8), "relation"),
         (lambda m: m.p_object_at("cup", ("on", "object9")), "unknown object 'object9'"),
         (lambda m: m.p_object_at("cup", 3), "location must be"),
