@@ -6,7 +6,7 @@ import logging
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 
-from fastapi import APIRouter, FastAPI, Request, status
+from fastapi import FastAPI, Request, status
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
@@ -20,6 +20,7 @@ from api.worlds import default_worlds_dir
 from avs_planner import __version__
 
 log = logging.getLogger("avs.api")
+API_PREFIX = "/v1"
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:
@@ -50,10 +51,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_middleware(BodyLimitMiddleware, max_bytes=settings.max_body_bytes)
     app.state.settings = settings
     app.state.rate_limiter = RateLimiter(settings.rate_limit_per_minute, settings.rate_limit_burst)
-    v1 = APIRouter(prefix="/v1")
     for module in (tasks, plans, domains, misc):
-        v1.include_router(module.router)
-    app.include_router(v1)
+        app.include_router(module.router, prefix=API_PREFIX)
     _add_error_handlers(app)
     return app
 

@@ -143,7 +143,7 @@ class _Slot:
         if self.pool.warm:
             try:
                 self.ensure_process()  # warm start: the first job does not pay for the spawn
-            except OSError:
+            except Exception:  # noqa: BLE001 - the first job retries and reports it
                 log.exception("could not pre-start worker %s", self.index)
         while True:
             job = self.pool.jobs.get()
