@@ -152,13 +152,19 @@ class ObjectLedger:
             return self.knowledge.relation_lambda_of(label, location.relation, support)
         return self.knowledge.room_lambda(label)
 
-    def sublocations(self, room: str) -> list[RelatedSpace]:
-        """Related spaces (in/on) of the objects detected in `room`."""
+    def sublocations(self, room: str, label: str) -> list[RelatedSpace]:
+        """Related spaces of objects in `room` where the knowledge expects `label` (in/on).
+
+        Only (label, relation, support) entries the knowledge lists count, so default lambdas
+        of unlisted pairs (a cereal box in a cup) do not pile up over many objects.
+        """
+        listed = self.knowledge.relation_lambda
         return [
             RelatedSpace(relation, record.object_id)
             for record in self.objects.values()
             if record.room == room
             for relation in RELATIONS
+            if (label, relation, record.label) in listed
         ]
 
     def room_likelihood(self, room: str) -> np.ndarray:

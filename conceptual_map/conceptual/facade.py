@@ -235,13 +235,14 @@ class ConceptualMap:
         """P(ObjectAt L): at least one `label` at a room (with its related spaces) or related space.
 
         Sums, under each room category, the lambdas left unseen by searches over L and (for a
-        room) the in/on spaces of its known objects, then averages over the category belief.
+        room) the in/on spaces of its known objects that the knowledge lists for `label`, then
+        averages 1 - exp(-lambda) over the category belief.
         """
         location = _as_location(location)
         room = self._room_of(location)
         places = [location]
         if include_sublocations and not isinstance(location, RelatedSpace):
-            places += self.objects.sublocations(room)
+            places += self.objects.sublocations(room, label)
         if any(self.objects.count(place, label) for place in places):
             return 1.0
         residual = sum(

@@ -64,15 +64,18 @@ def test_room_probability_adds_lambdas_of_its_related_spaces():
     cmap = ConceptualMap()
     cmap.add_room("r")
     table = cmap.observe_object("table", "r")
+    shelf = cmap.observe_object("shelf", "r")
+    cmap.observe_object("cup", "r", on=table)  # no cereal-box entry for cups: not summed
     knowledge = cmap.knowledge
     lam = (knowledge.room_lambda("cerealbox")
            + knowledge.relation_lambda_of("cerealbox", "on", "table")
-           + knowledge.relation_lambda_of("cerealbox", "in", "table"))
+           + knowledge.relation_lambda_of("cerealbox", "in", "shelf"))
     expected = float(cmap.room_marginal("r") @ (1 - np.exp(-lam)))
     assert cmap.p_object_at("cerealbox", "r") == pytest.approx(expected)
     direct = cmap.p_object_at("cerealbox", "r", include_sublocations=False)
     on_table = cmap.p_object_at("cerealbox", ("on", table))
-    assert cmap.p_object_at("cerealbox", "r") > max(direct, on_table)
+    in_shelf = cmap.p_object_at("cerealbox", ("in", shelf))
+    assert cmap.p_object_at("cerealbox", "r") > max(direct, on_table, in_shelf)
 
 
 def test_a_detected_object_makes_its_location_certain():
