@@ -55,7 +55,20 @@ def run(args: argparse.Namespace) -> int:
             f"refusing to listen on {settings.host} without an API key: set AVS_API_KEY "
             "(clients send it in X-API-Key) or use a loopback host such as 127.0.0.1"
         )
+    _check_data_dir(settings)
     return _serve(settings, args.log_level)
+
+
+def _check_data_dir(settings: Settings) -> None:
+    """Open the task store once, so an unusable data dir is a clear error, not a traceback."""
+    import sqlite3
+
+    from api.store import TaskStore
+
+    try:
+        TaskStore(settings.db_path).close()
+    except (OSError, sqlite3.Error) as exc:
+        raise ServeError(f"cannot use data dir {settings.data_dir}: {exc}") from exc
 
 
 def _serve(settings: Settings, log_level: str) -> int:

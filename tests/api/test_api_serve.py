@@ -113,3 +113,14 @@ def test_sigkill_mid_task_then_restart_accounts_for_it(tmp_path: Path) -> None:
         assert after["state"] == "failed" and "interrupted" in after["error"]
         health = _call(f"{base}/v1/health")
         assert (health["queued"], health["running"]) == (0, 0)
+
+
+def test_unusable_data_dir_is_bad_input(tmp_path: Path) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("not a directory")
+    with pytest.raises(serve.ServeError, match="cannot use data dir"):
+        serve.run(_args("--data-dir", str(blocker / "data")))
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "avs.sqlite3").write_text("this is not a database, just text " * 100)
+    with pytest.raises(serve.ServeError, match="cannot use data dir"):
+        serve.run(_args("--data-dir", str(tmp_path / "data")))
