@@ -131,3 +131,16 @@ def test_inline_world_file(client: TestClient, wait_for: Wait) -> None:
     body = {"target": "quick", "world_file": "name: tiny\nsize: [2, 2]\nrooms: []\n"}
     task_id = client.post("/v1/tasks", json=body).json()["id"]
     assert wait_for(client, task_id, {"succeeded"})["request"]["world_file"].startswith("name")
+
+
+def test_events_arrive_live_and_stream_ends_with_the_task(client: TestClient) -> None:
+    task_id = client.post("/v1/tasks", json=task_body("slow")).json()["id"]
+    kinds: list[str] = []
+    with client.stream("GET", f"/v1/tasks/{task_id}/events") as stream:
+        for line in stream.iter_lines():
+            if line.startswith("event:"):
+                kinds.append(line.split(":", 1)[1].strip())
+                if kinds[-1] == "action" and kinds.count("action") == 3:
+                    client.app.state.manager.cancel(task_id)  # the episode is live: stop it
+    assert kinds[:2] == ["state", "state"] and kinds[-1] == "state"
+    assert client.get(f"/v1/tasks/{task_id}").json()["state"] == "cancelled"
