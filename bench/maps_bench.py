@@ -116,7 +116,8 @@ def office_run() -> dict[str, float] | None:
     return {
         "status": result.status.value, "scans": result.scans, "moves": result.moves,
         "distance_m": result.distance, "sim_s": result.sim_time, "wall_s": wall,
-        "mapping_s": result.mapping_wall_time, "rooms": len(place_map.rooms),
+        "mapping_s": result.mapping_wall_time, "mapping_cpu_s": result.mapping_cpu_time,
+        "rooms": len(place_map.rooms),
         "doors": len(place_map.doors), "places": len(place_map.places),
     }  # fmt: skip
 
@@ -148,11 +149,13 @@ def main() -> None:
         print("office exploration: skipped (sim not importable)")
         return
     per_scan = office["mapping_s"] / max(office["scans"], 1) * 1000
+    per_scan_cpu = office["mapping_cpu_s"] / max(office["scans"], 1) * 1000
     print(
         f"office exploration ({office['status']}): {office['scans']} scans, "
         f"{office['moves']} moves, {office['distance_m']:.1f} m, {office['sim_s']:.0f} sim-s, "
         f"{office['wall_s']:.1f} wall-s of which maps {office['mapping_s']:.1f} s "
-        f"({per_scan:.0f} ms per scan: grid + place map); found {office['rooms']} rooms, "
+        f"({per_scan:.0f} ms wall, {per_scan_cpu:.0f} ms CPU per scan: grid + place map); "
+        f"found {office['rooms']} rooms, "
         f"{office['doors']} doors, {office['places']} places"
     )
 

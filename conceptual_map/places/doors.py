@@ -74,6 +74,15 @@ def openings_along(
     """
     if points.shape[0] == 0:
         return []
+    cells = grid.to_cell(points)
+    inside = grid.inside(cells)
+    near_wall = np.zeros(points.shape[0], dtype=bool)  # a point mid-door is near both jambs
+    near_wall[inside] = (
+        grid.clearance()[cells[inside, 0], cells[inside, 1]] <= 0.5 * config.door_max_width
+    )
+    points = points[near_wall]
+    if points.shape[0] == 0:
+        return []
     plus, minus = chord_extents(grid, points, _ANGLES, config.probe_range)
     # the probe stops at the near border of a jamb's cell; the surface lies, on average,
     # half a cell further in on each side

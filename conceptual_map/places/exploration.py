@@ -50,6 +50,7 @@ class ExplorationResult:
     distance: float
     sim_time: float
     mapping_wall_time: float  # seconds spent in grid and place-map updates
+    mapping_cpu_time: float  # the same, in CPU seconds of this process (robust to a busy machine)
     scans: int
     events: list[MapEvent] = field(default_factory=list)
     failures: list[str] = field(default_factory=list)
@@ -69,7 +70,7 @@ class Explorer:
 
     def __post_init__(self) -> None:
         self._radius = self.place_map.config.robot_radius
-        self._result = ExplorationResult(ExplorationStatus.COMPLETE, 0, 0.0, 0.0, 0.0, 0)
+        self._result = ExplorationResult(ExplorationStatus.COMPLETE, 0, 0.0, 0.0, 0.0, 0.0, 0)
         self._tries: dict[str, int] = {}
 
     def run(self) -> ExplorationResult:
@@ -89,10 +90,11 @@ class Explorer:
 
     def _sense(self, poses: list[tuple[float, float, float]]) -> None:
         scan = self.robot.scan()
-        began = wallclock.perf_counter()
+        began, began_cpu = wallclock.perf_counter(), wallclock.process_time()
         self.grid.integrate_scan(scan)
         events = self.place_map.follow(self.grid, poses, self.robot.clock)
         self._result.mapping_wall_time += wallclock.perf_counter() - began
+        self._result.mapping_cpu_time += wallclock.process_time() - began_cpu
         self._result.scans += 1
         self._result.events.extend(events)
 

@@ -61,13 +61,14 @@ def frontier_regions(
     labels, _ = ndimage.label(frontier, structure=_EIGHT)
     sizes = np.bincount(labels.ravel())
     unknown_labels, _ = ndimage.label(grid.state_grid() == CellState.UNKNOWN)
+    roomy = reachable & (grid.clearance() >= config.robot_radius + _STANDPOINT_MARGIN)
     offset = np.array([window[0].start, window[1].start])
     regions = []
     for k, box in enumerate(ndimage.find_objects(labels), start=1):
         if sizes[k] * grid.resolution < config.min_frontier_length:
             continue
         cells = np.argwhere(labels[box] == k) + [box[0].start, box[1].start] + offset
-        region = _describe(grid, cells, reachable, unknown_labels, config)
+        region = _describe(grid, cells, (roomy, reachable), unknown_labels, config)
         if region is not None and region.open_space >= config.min_open_space:
             regions.append(region)
     return regions
@@ -85,16 +86,19 @@ def _bounding_window(mask: np.ndarray, margin: int, shape: tuple[int, ...]) -> t
 def _describe(
     grid: OccupancyGrid,
     cells: np.ndarray,
-    reachable: np.ndarray,
+    stand_masks: tuple[np.ndarray, ...],
     unknown_labels: np.ndarray,
     config: PlaceMapConfig,
 ) -> FrontierRegion | None:
+    """Where to stand (the first mask, in order of preference, with a cell near the frontier's
+    medoid), the frontier's centre and length, and the open space behind it."""
     medoid = cells[np.argmin(np.linalg.norm(cells - cells.mean(axis=0), axis=1))]
     window = int(np.ceil(2 * config.reach_tolerance / grid.resolution))
-    roomy = reachable & (grid.clearance() >= config.robot_radius + _STANDPOINT_MARGIN)
-    stand = _nearest_true(roomy, medoid, window)
-    if stand is None:
-        stand = _nearest_true(reachable, medoid, window)
+    stand = None
+    for mask in stand_masks:
+        stand = _nearest_true(mask, medoid, window)
+        if stand is not None:
+            break
     if stand is None:
         return None
     standpoint = grid.to_world(np.asarray([stand]))[0]
