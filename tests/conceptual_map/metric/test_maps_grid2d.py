@@ -31,12 +31,14 @@ def visibility(world: BoxWorld, grid: OccupancyGrid, poses: list) -> np.ndarray:
     )
     flat = pts.reshape(-1, 2)
     seen = np.zeros(flat.shape[0], dtype=bool)
+    # outside the outer walls nothing is visible: cast only from points inside the building
+    building = np.all((flat > -0.06) & (flat < [6.06, 4.06]), axis=1)
     for x, y, _ in poses:
-        vec = flat - [x, y]
+        vec = flat[building] - [x, y]
         dist = np.linalg.norm(vec, axis=1)
         dirs = np.column_stack([vec / dist[:, None], np.zeros(len(vec))])
         hit = world.cast(np.array([x, y, 0.3]), dirs, MAX_RANGE)
-        seen |= (dist < MAX_RANGE - 0.01) & (hit > dist)
+        seen[building] |= (dist < MAX_RANGE - 0.01) & (hit > dist)
     return seen.reshape(grid.shape + (16,))
 
 
