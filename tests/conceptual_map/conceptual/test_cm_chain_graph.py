@@ -119,3 +119,35 @@ def test_merged_factors_give_the_same_exact_marginals():
     assert len(cmap.factors(merged=True)) == len(cmap.graph.rooms) + 3
     for variable, values in reduced.items():
         np.testing.assert_allclose(merged[variable], values, atol=1e-10)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_random_event_sequences_keep_tree_beliefs_exact(seed):
+    """Random adds, moves, observations and merges on a tree of rooms, checked after each batch."""
+    rng = np.random.default_rng(seed)
+    cmap = ConceptualMap()
+    knowledge = cmap.knowledge
+    cmap.add_place("p0", "room0")
+    for step in range(1, 40):
+        rooms = cmap.graph.rooms
+        action = rng.integers(4)
+        if action == 0 and len(rooms) < 8:
+            parent = rooms[int(rng.integers(len(rooms)))]
+            cmap.add_place(f"p{step}", f"room{step}")
+            cmap.connect_rooms(parent, f"room{step}")
+        elif action == 1:
+            cmap.add_place(f"p{step}", rooms[int(rng.integers(len(rooms)))])
+        elif action == 2:
+            places = sorted(p for r in rooms for p in cmap.graph.places_of(r))
+            kind = str(rng.choice(list(knowledge.properties)))
+            value = str(rng.choice(knowledge.properties[kind].values))
+            cmap.observe_property(places[int(rng.integers(len(places)))], kind, value)
+        elif len(rooms) > 2:
+            # merging two adjacent rooms keeps the room graph a tree
+            keep = rooms[int(rng.integers(len(rooms)))]
+            neighbours = sorted(cmap.graph.neighbours(keep))
+            if neighbours:
+                cmap.merge_rooms(keep, neighbours[0])
+        if step % 10 == 0:
+            _assert_matches_exact(cmap, explicit=False, atol=1e-6)
+    _assert_matches_exact(cmap, explicit=False, atol=1e-6)
