@@ -115,9 +115,7 @@ def _check_domain(domain: Domain, report: Report, usage: Usage) -> None:
 def _parameters(params: list, checker: FormulaChecker, report: Report) -> dict[str, str]:
     scope: dict[str, str] = {}
     for param in params:
-        if not param.name.startswith("?"):
-            report.add(param.atom, "syntax", f"parameter must be a variable, not '{param.name}'")
-        elif param.name in scope:
+        if param.name in scope:
             report.add(param.atom, "duplicate", f"parameter '{param.name}' is declared twice")
         checker.known_type(param.type_node, param.type)
         scope[param.name] = param.type

@@ -105,8 +105,6 @@ class FormulaChecker:
         return inner
 
     def _variable(self, entry: Typed) -> None:
-        if not entry.name.startswith("?"):
-            self.report.add(entry.atom, "syntax", f"expected a variable (?x), not '{entry.name}'")
         self.known_type(entry.type_node, entry.type)
 
     def known_type(self, node: Node, type_name: str) -> None:
@@ -157,9 +155,7 @@ class FormulaChecker:
             )
         self.report.add(head, "unknown-predicate", msg)
 
-    def arguments(
-        self, node: SList, params: list[Typed], scope: dict[str, str], what: str
-    ) -> None:
+    def arguments(self, node: SList, params: list[Typed], scope: dict[str, str], what: str) -> None:
         """Arity and argument types of a predicate or function application."""
         args = node.items[1:]
         if len(args) != len(params):
@@ -211,8 +207,9 @@ class FormulaChecker:
         """A numeric expression: number, function term or arithmetic."""
         if isinstance(node, Atom):
             if not is_number(node.text):
-                self.report.add(node, "syntax", f"expected a number or a function term, not "
-                                f"'{node.text}'")
+                self.report.add(
+                    node, "syntax", f"expected a number or a function term, not '{node.text}'"
+                )
             return
         head = node.head()
         if head in ARITHMETIC:
@@ -327,4 +324,3 @@ def _number(text: str) -> Fraction | None:
         return Fraction(text)
     except (ValueError, ZeroDivisionError):
         return None
-

@@ -10,6 +10,7 @@ from avs_planner.pddl.diagnostics import Diagnostic
 from avs_planner.pddl.formulas import FormulaChecker, Usage
 from avs_planner.pddl.sexpr import Atom, Node, SList, is_number, parse_sexprs
 from avs_planner.pddl.structure import (
+    OBJECT,
     Domain,
     Problem,
     Report,
@@ -64,8 +65,16 @@ def _check_header(domain: Domain, problem: Problem, report: Report) -> None:
         )
     checker = FormulaChecker(domain, report, {}, Usage())
     taken = set(domain.predicates) | set(domain.functions) | set(domain.actions)
+    object_used = _object_type_used(domain)
     for name, entry in problem.objects.items():
         checker.known_type(entry.type_node, entry.type)
+        if entry.type == OBJECT and not object_used:
+            report.add(
+                entry.type_node,
+                "untyped-object",
+                f"object '{name}' has type 'object', which no predicate, function, constant or "
+                "action of the domain uses; give it one of the domain's types",
+            )
         if name in domain.constants:
             report.add(entry.atom, "duplicate", f"object '{name}' is already a domain constant")
         elif name in taken or name in domain.type_atoms:
@@ -74,6 +83,14 @@ def _check_header(domain: Domain, problem: Problem, report: Report) -> None:
                 "name-clash",
                 f"object '{name}' has the same name as a type, predicate, function or action",
             )
+
+
+def _object_type_used(domain: Domain) -> bool:
+    """unified-planning only knows the type 'object' when the domain itself uses it."""
+    entries = [*domain.constants.values()]
+    for sig in [*domain.predicates.values(), *domain.functions.values(), *domain.actions.values()]:
+        entries += sig.params
+    return any(entry.type == OBJECT for entry in entries)
 
 
 def _check_init(problem: Problem, checker: FormulaChecker) -> InitValues:

@@ -6,6 +6,7 @@ so one run of `avs domain check` reports as much as it can.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 from avs_planner.pddl.diagnostics import Diagnostic, Severity
@@ -13,6 +14,22 @@ from avs_planner.pddl.sexpr import Atom, Node, SList
 
 OBJECT = "object"
 NUMBER = "number"
+_NAME = re.compile(r"[a-z][a-z0-9_-]*")
+
+
+def check_name(atom: Atom, report: Report, variable: bool = False) -> None:
+    """PDDL names start with a letter and continue with letters, digits, '-' and '_';
+    variables are such a name after '?'."""
+    text = atom.text[1:] if variable and atom.text.startswith("?") else atom.text
+    if variable and not atom.text.startswith("?"):
+        report.add(atom, "syntax", f"expected a variable (?x), not '{atom.text}'")
+    elif not _NAME.fullmatch(text):
+        what = "variable" if variable else "name"
+        report.add(
+            atom,
+            "bad-name",
+            f"'{atom.text}' is not a valid {what} (a letter, then letters, digits, '-' or '_')",
+        )
 
 
 @dataclass
@@ -116,6 +133,8 @@ def find_define(nodes: list[Node], kind: str, report: Report) -> SList | None:
         if isinstance(node, SList) and node.head() == "define":
             header = node.items[1] if len(node) > 1 else None
             if isinstance(header, SList) and header.head() == kind and len(header) == 2:
+                for extra in nodes[nodes.index(node) + 1 :]:
+                    report.add(extra, "syntax", "unexpected text after the (define ...) form")
                 return node
             report.add(header or node, "syntax", f"expected ({kind} NAME) after define")
             return None
@@ -125,7 +144,9 @@ def find_define(nodes: list[Node], kind: str, report: Report) -> SList | None:
     return None
 
 
-def typed_list(items: list[Node], report: Report, default: str = OBJECT) -> list[Typed]:
+def typed_list(
+    items: list[Node], report: Report, default: str = OBJECT, variables: bool = True
+) -> list[Typed]:
     """Parse `a b - t c` into Typed entries; `(either ...)` and stray lists are reported."""
     result: list[Typed] = []
     pending: list[Atom] = []
@@ -143,6 +164,7 @@ def typed_list(items: list[Node], report: Report, default: str = OBJECT) -> list
         if isinstance(item, SList):
             report.add(item, "syntax", "expected a name here, not a parenthesised list")
         else:
+            check_name(item, report, variables)
             pending.append(item)
         i += 1
     return result + [Typed(a, default) for a in pending]
@@ -163,12 +185,38 @@ def _type_after_dash(items: list[Node], i: int, report: Report) -> str:
         else:
             report.add(node, "syntax", "expected a type name after '-'")
         return OBJECT
+    check_name(node, report)
     return node.text
+
+
+DOMAIN_ORDER = [":requirements", ":types", ":constants", ":predicates", ":functions", ":action"]
+PROBLEM_ORDER = [":domain", ":requirements", ":objects", ":init", ":goal", ":metric"]
+
+
+def check_order(sections: list[Node], order: list[str], report: Report) -> None:
+    """unified-planning reads sections only in the standard order, each at most once."""
+    latest: tuple[int, str] = (-1, "")
+    seen: set[str] = set()
+    for section in sections:
+        if not isinstance(section, SList):
+            continue
+        head = ":action" if section.head() == ":durative-action" else section.head()
+        if head not in order:
+            continue
+        rank = order.index(head)
+        if head in seen and head != ":action":
+            report.add(section, "duplicate", f"section '{head}' appears twice")
+        elif rank < latest[0]:
+            report.add(section, "syntax", f"section '{head}' must come before '{latest[1]}'")
+        seen.add(head)
+        if rank > latest[0]:
+            latest = (rank, head)
 
 
 def read_domain(define: SList, report: Report) -> Domain:
     """Collect a domain's declarations from its `(define ...)` form."""
     domain = Domain(report.file)
+    check_order(define.items[2:], DOMAIN_ORDER, report)
     header = define.items[1]
     if isinstance(header, SList) and isinstance(header.items[1], Atom):
         domain.name = header.items[1]
@@ -195,7 +243,7 @@ def _requirements(domain: Domain, section: SList, report: Report) -> None:
 
 def _types(domain: Domain, section: SList, report: Report) -> None:
     domain.uses_typing = domain.uses_typing or section
-    for entry in typed_list(section.items[1:], report):
+    for entry in typed_list(section.items[1:], report, variables=False):
         if entry.name in domain.type_atoms or entry.name == OBJECT:
             if entry.name != OBJECT:
                 report.add(entry.atom, "duplicate", f"type '{entry.name}' is declared twice")
@@ -224,7 +272,7 @@ def _constants(domain: Domain, section: SList, report: Report) -> None:
 
 
 def _typed_into(table: dict[str, Typed], section: SList, report: Report, what: str) -> None:
-    for entry in typed_list(section.items[1:], report):
+    for entry in typed_list(section.items[1:], report, variables=False):
         if entry.name in table:
             report.add(entry.atom, "duplicate", f"{what} '{entry.name}' is declared twice")
         else:
@@ -239,6 +287,7 @@ def _signatures(section: SList, report: Report, functions: bool) -> list[Signatu
     while i < len(items):
         item = items[i]
         if isinstance(item, SList) and item.items and isinstance(item.items[0], Atom):
+            check_name(item.items[0], report)
             result.append(Signature(item.items[0], typed_list(item.items[1:], report)))
         elif functions and isinstance(item, Atom) and item.text == "-":
             after = items[i + 1] if i + 1 < len(items) else item
@@ -275,6 +324,7 @@ def _action(domain: Domain, section: SList, report: Report) -> None:
         report.add(section, "syntax", "expected (:action NAME :parameters (...) ...)")
         return
     action = Action(section.items[1], [])
+    check_name(action.atom, report)
     items = section.items[2:]
     for i in range(0, len(items), 2):
         key = items[i]
@@ -322,6 +372,7 @@ _DOMAIN_SECTIONS = {
 def read_problem(define: SList, report: Report) -> Problem:
     """Collect a problem's declarations from its `(define ...)` form."""
     problem = Problem(report.file)
+    check_order(define.items[2:], PROBLEM_ORDER, report)
     header = define.items[1]
     if isinstance(header, SList) and isinstance(header.items[1], Atom):
         problem.name = header.items[1]
@@ -330,8 +381,13 @@ def read_problem(define: SList, report: Report) -> Problem:
             report.add(section, "syntax", "expected a section such as (:init ...)")
             continue
         _problem_section(problem, section, report)
-    if problem.goal_node is None:
-        report.add(define, "syntax", "the problem has no (:goal ...) section")
+    for part, what in (
+        (problem.domain_ref, "(:domain NAME)"),
+        (problem.init_node, "(:init ...)"),
+        (problem.goal_node, "(:goal ...)"),
+    ):
+        if part is None:
+            report.add(define, "syntax", f"the problem has no {what} section")
     return problem
 
 
