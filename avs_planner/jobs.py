@@ -95,6 +95,15 @@ def _invalid(file: str, line: int, column: int, message: str) -> dict[str, Any]:
     return {"status": "invalid", "errors": [error]}
 
 
+def episode_runner_available() -> bool:
+    """Whether `avs_planner.episode.run_episode` can be imported (imports it to find out)."""
+    try:
+        episode = importlib.import_module("avs_planner.episode")
+    except ImportError:
+        return False
+    return callable(getattr(episode, "run_episode", None))
+
+
 def run_episode(spec: Mapping[str, Any], emit: Emit, should_stop: ShouldStop) -> dict[str, Any]:
     """Run one search episode (the switching loop), streaming trace events through `emit` and
     stopping early when `should_stop()`; returns the summary (`outcome`: found/gave_up/timeout).

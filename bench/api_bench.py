@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import importlib.util
 import json
 import os
 import socket
@@ -26,6 +25,8 @@ import urllib.request
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from avs_planner.jobs import episode_runner_available
 
 TARGET_RPS = 300.0
 TARGET_P99_MS = 50.0
@@ -187,7 +188,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--connections", type=int, default=4)
     args = parser.parse_args(argv)
     requests = args.requests or (800 if args.quick else 4000)
-    real = importlib.util.find_spec("avs_planner.episode") is not None
+    real = episode_runner_available()
     runner = "avs_planner.jobs:run_episode" if real else SYNTHETIC_RUNNER
     with tempfile.TemporaryDirectory(prefix="avs-api-bench-") as tmp:
         worlds = None
@@ -229,7 +230,7 @@ def _phases(
 
 def _report(phases: list[Phase], real: bool, requests: int, connections: int) -> None:
     source = "the real episode runner" if real else (
-        "a SYNTHETIC episode runner (avs_planner/episode.py does not exist yet)")
+        "a SYNTHETIC episode runner (avs_planner.episode.run_episode does not exist yet)")
     print(f"GET /v1/tasks/{{id}}: {requests} requests/phase (3 rounds, median req/s) over "
           f"{connections} keep-alive connections; episodes from {source}; "
           f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}")

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 from collections.abc import Callable
 
 import pytest
@@ -13,7 +12,7 @@ from api.main import create_app
 from api.worker_process import resolve
 from avs_planner import jobs
 
-EPISODE_MISSING = importlib.util.find_spec("avs_planner.episode") is None
+EPISODE_MISSING = not jobs.episode_runner_available()
 
 
 @pytest.mark.skipif(not EPISODE_MISSING, reason="the episode runner exists now")
