@@ -37,6 +37,7 @@ class Settings(BaseSettings):
     episode_runner: str = Field(
         DEFAULT_EPISODE_RUNNER, description="'module:function' or '/path/file.py:function'"
     )
+    warm_workers: bool = Field(True, description="start episode workers before the first task")
     preload_planner: bool = Field(True, description="import the planner in job workers at start")
     worlds_dir: Path | None = Field(None, description="built-in worlds; default: sim/worlds")
 

@@ -61,7 +61,7 @@ class TaskManager:
         self.store = store
         self.episodes = WorkerPool(
             "episodes", settings.workers, settings.memory_limit_mb, settings.episode_runner,
-            settings.cancel_grace_s, nice=settings.worker_nice,
+            settings.cancel_grace_s, nice=settings.worker_nice, warm=settings.warm_workers,
         )
         self.jobs = WorkerPool(
             "jobs", settings.plan_workers, settings.memory_limit_mb, settings.episode_runner,

@@ -66,8 +66,8 @@ def _fuzz(
 
 
 def test_no_server_errors_small(make_settings: Callable[..., Settings]) -> None:
-    failures, sent = _fuzz_all(make_settings, examples=5)
-    assert sent > 60
+    failures, sent = _fuzz_all(make_settings, examples=4)
+    assert sent > 50
     assert not failures, "\n".join(failures[:10])
 
 
