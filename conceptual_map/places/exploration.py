@@ -115,22 +115,41 @@ class Explorer:
         return best
 
     def _visit(self, target: str) -> None:
-        """Drive leg by leg towards a placeholder, replanning after each scan (new obstacles)."""
+        """Drive leg by leg towards a placeholder; replan when a scan blocks the rest of the path
+        or the placeholder moved."""
         self._tries[target] = self._tries.get(target, 0) + 1
+        legs: list[list[tuple[float, float]]] = []
+        goal = None
         for _ in range(self.max_legs):
             placeholder = self.place_map.placeholders.get(target)
             if placeholder is None:
                 return  # explored on the way
             if math.dist(self.robot.pose[:2], placeholder.position) < 0.5 * self.grid.resolution:
                 break
-            try:
-                path = plan_path(self.grid, self.robot.pose[:2], placeholder.position, self._radius)
-            except MapError as exc:
-                self._result.failures.append(f"{target}: {exc}")
-                return
-            if not path.found or not self._drive(target, _legs(path.waypoints, self.step)[0]):
+            if not legs or goal != placeholder.position or not self._still_clear(legs):
+                goal = placeholder.position
+                legs = self._plan_legs(target, goal)
+                if not legs:
+                    return
+            if not self._drive(target, legs.pop(0)):
                 return
         self._look_around()
+
+    def _plan_legs(self, target: str, goal: tuple[float, float]) -> list[list[tuple[float, float]]]:
+        try:
+            path = plan_path(self.grid, self.robot.pose[:2], goal, self._radius)
+        except MapError as exc:
+            self._result.failures.append(f"{target}: {exc}")
+            return []
+        return _legs(path.waypoints, self.step) if path.found else []
+
+    def _still_clear(self, legs: list[list[tuple[float, float]]]) -> bool:
+        """The rest of the planned path still keeps the robot radius from what is now known."""
+        mask = self.grid.traversable(self._radius)
+        points = [self.robot.pose[:2], *(p for leg in legs for p in leg)]
+        return all(
+            self.grid.segment_clear(a, b, mask) for a, b in zip(points, points[1:], strict=False)
+        )
 
     def _drive(self, target: str, leg: list[tuple[float, float]]) -> bool:
         here = self.robot.pose[:2]
