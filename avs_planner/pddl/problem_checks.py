@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 from itertools import product
+from typing import TYPE_CHECKING
 
 from avs_planner.errors import PddlError
 from avs_planner.pddl.diagnostics import Diagnostic
@@ -19,10 +20,13 @@ from avs_planner.pddl.structure import (
     read_problem,
 )
 
+if TYPE_CHECKING:
+    from avs_planner.pddl.check import PddlSource
+
 GroundAtom = tuple[str, ...]
 
 
-def check_problem(domain: Domain, source, usage: Usage) -> list[Diagnostic]:  # noqa: ANN001
+def check_problem(domain: Domain, source: PddlSource, usage: Usage) -> list[Diagnostic]:
     """Diagnostics for one problem; goal usage is added to `usage` (requirements, predicates)."""
     report = Report(source.name)
     try:

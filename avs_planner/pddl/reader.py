@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pyparsing
 from unified_planning.io import PDDLReader
-from unified_planning.model import FNode, Problem
+from unified_planning.model import Action, FNode, Problem
 
 from avs_planner.errors import PddlError
 from avs_planner.pddl.check import first_error
@@ -95,10 +95,12 @@ def _success_expression(problem: Problem, action: str, nodes: list[Node], file: 
     em = problem.environment.expression_manager
     up_action = problem.action(action)
     factors = [_term(problem, up_action, node, file) for node in nodes]
-    return factors[0] if len(factors) == 1 else em.Times(*factors)
+    if len(factors) == 1:
+        return factors[0]
+    return problem.environment.simplifier.simplify(em.Times(*factors))
 
 
-def _term(problem: Problem, action, node: Node, file: str) -> FNode:  # noqa: ANN001
+def _term(problem: Problem, action: Action, node: Node, file: str) -> FNode:
     em = problem.environment.expression_manager
     if isinstance(node, Atom):
         if not is_number(node.text):
@@ -112,7 +114,7 @@ def _term(problem: Problem, action, node: Node, file: str) -> FNode:  # noqa: AN
     return _fluent_term(problem, action, node, file)
 
 
-def _fluent_term(problem: Problem, action, node: SList, file: str) -> FNode:  # noqa: ANN001
+def _fluent_term(problem: Problem, action: Action, node: SList, file: str) -> FNode:
     name = node.head()
     if not name or not problem.has_fluent(name):
         raise PddlError(f"unknown function '{name}' in probability", file, node.line, node.column)
@@ -122,7 +124,7 @@ def _fluent_term(problem: Problem, action, node: SList, file: str) -> FNode:  # 
         if not isinstance(arg, Atom):
             raise PddlError("probability arguments must be names", file, arg.line, arg.column)
         if arg.text.startswith("?"):
-            args.append(em_param(action, arg, file))
+            args.append(_parameter_exp(action, arg, file))
         elif problem.has_object(arg.text):
             args.append(problem.environment.expression_manager.ObjectExp(problem.object(arg.text)))
         else:
@@ -130,7 +132,7 @@ def _fluent_term(problem: Problem, action, node: SList, file: str) -> FNode:  # 
     return problem.environment.expression_manager.FluentExp(fluent, args)
 
 
-def em_param(action, arg: Atom, file: str) -> FNode:  # noqa: ANN001
+def _parameter_exp(action: Action, arg: Atom, file: str) -> FNode:
     """A UP parameter expression for `?name` of `action`."""
     name = arg.text[1:]
     for param in action.parameters:

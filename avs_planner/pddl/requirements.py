@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from avs_planner.pddl.diagnostics import Diagnostic, did_you_mean
 from avs_planner.pddl.formulas import Usage
+from avs_planner.pddl.sexpr import Node, SList
 from avs_planner.pddl.structure import Domain, Report
 
 QUANTIFIED = {":universal-preconditions", ":existential-preconditions"}
@@ -65,8 +66,8 @@ def check_requirements(domain: Domain, usage: Usage) -> list[Diagnostic]:
     return report.items
 
 
-def _missing_message(node, flag: str) -> str:  # noqa: ANN001
-    construct = node.head() if hasattr(node, "head") else node.text
+def _missing_message(node: Node, flag: str) -> str:
+    construct = node.head() if isinstance(node, SList) else node.text
     return f"'{construct}' needs requirement {flag}, which the domain does not declare"
 
 
