@@ -41,7 +41,8 @@ PROBLEM = """(define (problem two-rooms)
 @pytest.fixture(scope="module")
 def client(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestClient]:
     data = tmp_path_factory.mktemp("plans")
-    settings = Settings(data_dir=data, workers=1, plan_workers=1, worlds_dir=Path(data))
+    settings = Settings(data_dir=data, workers=1, plan_workers=1, worlds_dir=Path(data),
+                        api_key=None, warm_workers=False)
     with TestClient(create_app(settings)) as test_client:
         yield test_client
 
@@ -100,7 +101,7 @@ def test_domain_check_of_garbage(client: TestClient) -> None:
 
 def test_plan_job_over_its_wall_clock_is_504(tmp_path: Path) -> None:
     settings = Settings(data_dir=tmp_path, worlds_dir=tmp_path, plan_time_limit_s=0.05,
-                        preload_planner=False)
+                        api_key=None, preload_planner=False)
     with TestClient(create_app(settings)) as client:
         response = client.post("/v1/plans", json={"domain": DOMAIN, "problem": PROBLEM})
         assert response.status_code == 504 and "wall-clock limit" in response.json()["detail"]
