@@ -35,17 +35,24 @@ async def require_write_access(
     settings: SettingsDep,
     x_api_key: Annotated[str | None, Header(description="required when AVS_API_KEY is set")] = None,
 ) -> str:
-    """Check the API key (401) and the caller's rate limit (429); returns the caller's owner id."""
+    """Check the API key (401) and the caller's rate limit (429); returns the caller's owner id.
+
+    Failed key checks count against the caller's host, so guessing keys is rate limited too."""
+    host = request.client.host if request.client else "unknown"
+    limiter: RateLimiter = request.app.state.rate_limiter
     if settings.api_key and not key_matches(x_api_key, settings.api_key):
+        _limit(limiter.acquire(owner_of(None, host)), settings)
         raise HTTPException(
             status.HTTP_401_UNAUTHORIZED,
             detail="missing or wrong X-API-Key header (this service requires an API key)",
             headers={"WWW-Authenticate": "X-API-Key"},
         )
-    host = request.client.host if request.client else "unknown"
     owner = owner_of(x_api_key if settings.api_key else None, host)
-    limiter: RateLimiter = request.app.state.rate_limiter
-    wait = limiter.acquire(owner)
+    _limit(limiter.acquire(owner), settings)
+    return owner
+
+
+def _limit(wait: float, settings: Settings) -> None:
     if wait > 0:
         raise HTTPException(
             status.HTTP_429_TOO_MANY_REQUESTS,
@@ -53,7 +60,6 @@ async def require_write_access(
             f"retry in {wait:.1f} s",
             headers={"Retry-After": str(math.ceil(wait))},
         )
-    return owner
 
 
 WriteAccess = Annotated[str, Depends(require_write_access)]

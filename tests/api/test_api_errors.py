@@ -132,3 +132,15 @@ def test_lists_elide_inline_world_files(client: TestClient) -> None:
     assert listed == f"<inline, {len(world)} chars>"
     assert client.get(f"/v1/tasks/{task_id}").json()["request"]["world_file"] == world
     client.delete(f"/v1/tasks/{task_id}")
+
+
+def test_key_guessing_is_rate_limited(make_settings: Make) -> None:
+    settings = make_settings(api_key="s3cret", rate_limit_per_minute=1, rate_limit_burst=2)
+    with TestClient(create_app(settings)) as client:
+        guesses = [
+            client.delete(f"/v1/tasks/{UNKNOWN}", headers={"X-API-Key": f"guess{i}"}).status_code
+            for i in range(3)
+        ]
+        assert guesses == [401, 401, 429]
+        right = client.delete(f"/v1/tasks/{UNKNOWN}", headers={"X-API-Key": "s3cret"})
+        assert right.status_code == 404  # the key holder has a bucket of its own
