@@ -43,7 +43,10 @@ Source = PddlSource | str | Path
 
 def check(domain: Source, problems: Sequence[Source] = ()) -> list[Diagnostic]:
     """All findings for a domain and its problems; str/Path arguments are file paths."""
-    domain_source = _source(domain)
+    try:
+        domain_source = _source(domain)
+    except PddlError as exc:
+        return [Diagnostic.from_error(exc, "unreadable")]
     report = Report(domain_source.name)
     parsed = _read_domain(domain_source, report)
     if parsed is None:
@@ -52,7 +55,10 @@ def check(domain: Source, problems: Sequence[Source] = ()) -> list[Diagnostic]:
     _check_domain(parsed, report, usage)
     diagnostics = report.items
     for problem in problems:
-        diagnostics += check_problem(parsed, _source(problem), usage)
+        try:
+            diagnostics += check_problem(parsed, _source(problem), usage)
+        except PddlError as exc:
+            diagnostics.append(Diagnostic.from_error(exc, "unreadable"))
     diagnostics += check_requirements(parsed, usage)
     diagnostics += _unused_predicates(parsed, usage, report.file)
     return _sorted(diagnostics)

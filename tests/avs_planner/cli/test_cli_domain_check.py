@@ -80,5 +80,9 @@ def test_goal_already_true_is_a_warning(tmp_path: Path, capsys: pytest.CaptureFi
 
 
 def test_missing_file_is_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["domain", "check", str(tmp_path / "none.pddl")]) == 1
-    assert "cannot read file" in capsys.readouterr().err
+    missing = tmp_path / "none.pddl"
+    assert main(["domain", "check", str(missing)]) == 1
+    assert f"{missing}:1:1: error: cannot read file" in capsys.readouterr().out
+    args = ["domain", "check", str(DATA / "base-domain.pddl"), str(missing)]
+    assert main(args) == 1
+    assert f"{missing}:1:1: error: cannot read file" in capsys.readouterr().out
