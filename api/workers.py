@@ -160,6 +160,7 @@ class _Slot:
                 result = self.run(job)
             except Exception as exc:  # noqa: BLE001 - a slot thread must never die silently
                 log.exception("worker slot %s failed", self.index)
+                self.kill()  # its process may still be busy with this job
                 result = JobResult(JobOutcome.CRASHED, error=f"internal error: {exc}")
             job.future.set_result(result)
 
