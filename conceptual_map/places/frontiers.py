@@ -30,11 +30,14 @@ class FrontierRegion:
 
 
 def reachable_mask(grid: OccupancyGrid, robot: tuple[float, float], radius: float) -> np.ndarray:
-    """Traversable cells connected to the robot (or to the traversable cell nearest to it)."""
+    """Traversable cells connected to the robot (or to the traversable cell nearest to it).
+
+    4-connected: exactly the cells A* (8 moves, no corner cutting) can reach.
+    """
     traversable = grid.traversable(radius)
     if not traversable.any():
         return traversable
-    labels, _ = ndimage.label(traversable, structure=_EIGHT)
+    labels, _ = ndimage.label(traversable)
     cell = grid.cell_of(robot)
     if not grid.contains(cell) or not traversable[cell]:
         _, idx = ndimage.distance_transform_edt(~traversable, return_indices=True)
