@@ -233,7 +233,7 @@ def _goal(problem: Problem, structure: GroundStructure) -> tuple[int, int, bool]
                 neg |= 1 << i
             else:
                 pos |= 1 << i
-    return pos, neg, impossible
+    return pos, neg, impossible or bool(pos & neg)
 
 
 def _flatten(node: FNode) -> list[FNode]:

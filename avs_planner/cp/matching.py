@@ -1,10 +1,11 @@
 """Matching newly observed real objects to the virtual objects a plan assumed.
 
-The plan's assumptive steps describe each virtual object by the atoms they add about it
-(e.g. `(label-of new-object1 table)`, `(related new-object1 in room3)`). A real object matches
-when, with its name put in place of the virtual one, every described atom of a predicate the
-observation speaks about is among the observed atoms. Matching is one-to-one and follows the
-plan's order, so it is deterministic.
+The plan's assumptive steps describe each virtual object by the atoms they add with it as the
+subject, i.e. first argument (e.g. `(label-of new-object1 table)`, `(related new-object1 in
+room3)`; not `(related new-object2 on new-object1)`, which describes new-object2). A real
+object matches when, with its name put in place of the virtual one, every described atom of a
+predicate the observation speaks about is among the observed atoms. Matching is one-to-one
+and follows the plan's order, so it is deterministic.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ def is_virtual_name(name: str) -> bool:
 def assumed_descriptions(
     plan: Sequence[PlanStep], task: GroundTask, is_virtual: Callable[[str], bool]
 ) -> dict[str, set[Atom]]:
-    """For each virtual object in the plan (plan order), the atoms assumptive steps add."""
+    """For each virtual object in the plan (plan order), the atoms assumptive steps add about
+    it as their subject."""
     described: dict[str, set[Atom]] = {}
     for step in plan:
         for arg in step.args:
@@ -37,9 +39,8 @@ def assumed_descriptions(
             continue
         for i in action.add_facts:
             atom = task.facts[i]
-            for x in atom[1:]:
-                if x in described:
-                    described[x].add(atom)
+            if len(atom) > 1 and atom[1] in described:
+                described[atom[1]].add(atom)
     return described
 
 

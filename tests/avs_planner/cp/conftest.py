@@ -55,7 +55,7 @@ def random_problem(seed: int, n_fluents: int = 4, n_actions: int = 6) -> Probabi
     return ProbabilisticProblem(problem, success)
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def corridor():
     from avs_planner.pddl import read_files
 
