@@ -1,0 +1,320 @@
+"""The executor: runs the physical and sensing steps of a plan through the robot adapter.
+
+MOVE drives A* legs on the robot's own grid, scanning and growing the maps after each leg;
+CREATEVIEWCONES samples cones; SEARCHFOROBJECT runs a DT session against the detector;
+REPORTPOSITION ends the task. Assumptive steps never reach the executor.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any, Protocol
+
+import numpy as np
+
+from avs_planner.cp.search import PlanStep
+from avs_planner.cp.task import Atom
+from avs_planner.dt import DetectorModel, DTRewards, DTSession, DTStatus, SearchBudget
+from avs_planner.dt.domain import ActionKind
+from avs_planner.episode.mind import KnownObject, Mind
+from avs_planner.episode.state_builder import AvsState, StateBuilder
+from avs_planner.episode.viewcones import CameraModel, ConeSet, room_cones, support_cones
+from conceptual_map.errors import MapError
+from conceptual_map.metric import plan_path
+
+Event = Callable[..., None]
+
+
+class SeenLike(Protocol):
+    label: str
+    position: tuple[float, float, float]
+    id: int
+
+
+class StepStatus(Enum):
+    DONE = "done"
+    FAILED = "failed"
+    FOUND = "found"  # REPORTPOSITION of a confirmed object
+
+
+@dataclass
+class StepOutcome:
+    """What one executed step did; `observed` holds atoms about newly confirmed objects."""
+
+    status: StepStatus
+    detail: str = ""
+    observed: dict[str, set[Atom]] = field(default_factory=dict)
+    reported: KnownObject | None = None
+
+
+@dataclass
+class ExecutorConfig:
+    leg: float = 0.5  # m driven between scans
+    arrive: float = 0.35  # m from a MOVE's goal counts as there
+    max_legs: int = 40
+    dt_policy: str = "pouct"
+    dt_sims: int = 150
+    # a look counts as a detection only when a second frame sees the label again within
+    # `agree` m (a phantom rarely repeats), so misses are likelier and phantoms rarer than
+    # the camera's own 0.2 / 0.05
+    detector: DetectorModel = field(
+        default_factory=lambda: DetectorModel(false_negative=0.36, false_positive=0.01))
+    agree: float = 0.3
+    miss_penalty: float = 500.0  # s of robot time: the CP's goal reward R
+    support_radius: float = 0.9  # m: a detection this near a support is "on" it
+    above_support: tuple[float, float] = (-0.15, 0.45)  # m around the support's top
+
+
+@dataclass
+class Stats:
+    distance: float = 0.0
+    dt_calls: int = 0
+    dt_decisions: list[float] = field(default_factory=list)
+    views: int = 0
+    path: list[tuple[float, float, float, str]] = field(default_factory=list)
+    detections: list[tuple[float, float, str, bool]] = field(default_factory=list)
+    found_sid: int | None = None
+
+
+class Executor:
+    """Runs plan steps; `emit(type, **fields)` records trace events."""
+
+    def __init__(self, robot: Any, mind: Mind, builder: StateBuilder, camera: CameraModel,
+                 emit: Event, config: ExecutorConfig | None = None, seed: int = 0):
+        self.robot, self.mind, self.builder = robot, mind, builder
+        self.camera, self.emit = camera, emit
+        self.config = config or ExecutorConfig()
+        self.seed = seed
+        self.cones: dict[tuple[str, str, str], ConeSet] = {}
+        self.found_sids: dict[str, int] = {}
+        self.stats = Stats()
+
+    # ---- sensing along the way --------------------------------------------------------------
+
+    def look_around(self) -> None:
+        """Scan, turn half round, scan again: the first view of a place."""
+        self._sense([self.robot.pose])
+        self.robot.turn_to(self.robot.pose[2] + math.pi)
+        self._sense([self.robot.pose])
+
+    def _sense(self, poses: list[tuple[float, float, float]]) -> None:
+        before = self.mind.place_map.current_place
+        events = self.mind.sense(self.robot.scan(), poses, self.robot.clock)
+        place = self.mind.place_map.current_place
+        if place is not None and (place != before or place not in self.mind.classified):
+            observed = self.robot.classify_place()
+            if observed is not None:
+                self.mind.observe_appearance(observed)
+        if events:
+            kinds: dict[str, int] = {}
+            for e in events:
+                key = f"{e.kind.value}_{e.change.value}"
+                kinds[key] = kinds.get(key, 0) + 1
+            self.emit("belief", map_events=kinds)
+        self._record_pose()
+
+    def _record_pose(self) -> None:
+        x, y, yaw = self.robot.pose
+        room = self.mind.room_at((x, y))
+        category = ""
+        if room is not None and self.mind.cmap.graph.has_room(room):
+            belief = self.mind.cmap.room_category(room)
+            category = max(belief, key=belief.get)
+        self.stats.path.append((x, y, yaw, category))
+
+    # ---- steps ------------------------------------------------------------------------------
+
+    def run(self, step: PlanStep, state: AvsState) -> StepOutcome:
+        name = step.name.lower()
+        if name == "move":
+            return self.move(step.args[1], state)
+        if name.startswith("createviewcones"):
+            return self.create_cones(step.args[0], name.rsplit("-", 1)[1], step.args[1])
+        if name.startswith("searchforobject"):
+            relation = name.rsplit("-", 1)[1]
+            return self.search(step.args[0], relation, step.args[1])
+        if name == "reportposition":
+            obj = self.mind.objects.get(step.args[0])
+            if obj is None:
+                return StepOutcome(StepStatus.FAILED, f"{step.args[0]} is not a known object")
+            return StepOutcome(StepStatus.FOUND, f"{obj.label} at {obj.position}", reported=obj)
+        return StepOutcome(StepStatus.FAILED, f"no skill executes {step.name}")
+
+    def move(self, target: str, state: AvsState) -> StepOutcome:
+        goal = state.positions.get(target)
+        if goal is None:
+            return StepOutcome(StepStatus.FAILED, f"{target} has no position")
+        is_placeholder = target in self.mind.place_map.placeholders
+        if is_placeholder:
+            self.mind.tried_placeholders[target] = self.mind.tried_placeholders.get(target, 0) + 1
+        status = self.drive_to(goal, stop=lambda: is_placeholder and
+                               target not in self.mind.place_map.placeholders)
+        if status.status is StepStatus.DONE and is_placeholder:
+            self.look_around()
+        return status
+
+    def drive_to(self, goal: tuple[float, float], stop: Callable[[], bool] = lambda: False
+                 ) -> StepOutcome:
+        """Drive leg by leg to `goal`, re-planning the path on the growing grid."""
+        cfg = self.config
+        for _ in range(cfg.max_legs):
+            if stop():
+                return StepOutcome(StepStatus.DONE, "explored on the way")
+            here = self.robot.pose
+            if math.dist(here[:2], goal) <= cfg.arrive:
+                return StepOutcome(StepStatus.DONE)
+            try:
+                path = plan_path(self.mind.grid, here[:2], goal, self.mind.config.robot_radius)
+            except MapError as exc:
+                nearby = self._free_near(goal)
+                if nearby is None:
+                    return StepOutcome(StepStatus.FAILED, str(exc))
+                goal = nearby
+                continue
+            if not path.found:
+                return StepOutcome(StepStatus.FAILED, f"no path to {goal}")
+            leg = _first_leg(path.waypoints, cfg.leg)
+            if not self.robot.move_along(leg):
+                return StepOutcome(StepStatus.FAILED, "blocked")
+            self.stats.distance += sum(math.dist(a, b) for a, b in
+                                       zip([here[:2], *leg], leg, strict=False))
+            self._sense([(x, y, self.robot.pose[2]) for x, y in leg])
+        return StepOutcome(StepStatus.FAILED, "too many legs")
+
+    def _free_near(self, goal: tuple[float, float], reach: float = 0.6
+                   ) -> tuple[float, float] | None:
+        """The traversable cell nearest to a blocked goal, within `reach` metres."""
+        grid = self.mind.grid
+        free = grid.traversable(self.mind.config.robot_radius)
+        cells = np.argwhere(free)
+        if len(cells) == 0:
+            return None
+        points = grid.to_world(cells)
+        d = np.linalg.norm(points - np.asarray(goal), axis=1)
+        best = int(np.argmin(d))
+        return (float(points[best, 0]), float(points[best, 1])) if d[best] <= reach else None
+
+    def create_cones(self, label: str, relation: str, location: str) -> StepOutcome:
+        key = f"{label}-{relation}-{location}"
+        if relation == "on":
+            support = self.mind.objects.get(location)
+            if support is None:
+                return StepOutcome(StepStatus.FAILED, f"{location} is not a known object")
+            p = self.mind.cmap.p_object_at(label, ("on", location))
+            made = support_cones(self.mind, support, p, self.camera, key)
+        else:
+            if location not in self.mind.place_map.rooms:
+                return StepOutcome(StepStatus.FAILED, f"{location} is not a known room")
+            p = self.mind.cmap.p_object_at(label, location)
+            made = room_cones(self.mind, location, label, p, self.camera, key)
+        self.cones[(label, relation, location)] = made
+        self.mind.cones_made.add((label, relation, location))
+        self.emit("action", action="createviewcones", cones=len(made.cones),
+                  coverage=round(made.coverage, 3), probability=round(p, 4))
+        if not made.cones:
+            return StepOutcome(StepStatus.FAILED, "no view cone reachable")
+        return StepOutcome(StepStatus.DONE, f"{len(made.cones)} cones")
+
+    def search(self, label: str, relation: str, location: str) -> StepOutcome:
+        made = self.cones.get((label, relation, location))
+        if made is None or not made.cones:
+            return StepOutcome(StepStatus.FAILED, "no view cones for this search")
+        self.stats.dt_calls += 1
+        session = DTSession(made.cones, self.config.detector, self.robot.pose,
+                            policy=self.config.dt_policy,
+                            budget=SearchBudget(num_sims=self.config.dt_sims),
+                            rewards=DTRewards(self.config.miss_penalty,
+                                              self.config.miss_penalty),
+                            seed=self.seed + self.stats.dt_calls)
+        while True:
+            action = session.next_action()
+            if session.finished:
+                break
+            cone = session.cone(action)
+            if action.kind is ActionKind.MOVE:
+                self.drive_to(cone.pose[:2])
+                self.robot.turn_to(cone.pose[2])
+                self.robot.look(*(cone.head or (0.0, 0.0)))
+                session.update(action)
+                continue
+            match = self._look(label, relation, location)
+            session.update(action, match is not None, detection=match)
+        result = session.result
+        self.stats.dt_decisions.extend(result.decision_times_s)
+        self.emit("dt", label=label, relation=relation, location=location,
+                  result=result.status.value, probability=round(result.probability, 4),
+                  steps=len(result.trace), cones=len(made.cones))
+        return self._conclude(result, label, relation, location, made)
+
+    def _look(self, label: str, relation: str, location: str) -> SeenLike | None:
+        """PROCESSVIEWCONE: a detection in the searched location, seen twice."""
+        self.stats.views += 1
+        match = self._detect_once(label, relation, location)
+        if match is None:
+            self.emit("observation", label=label, detected=False)
+            return None
+        again = self._detect_once(label, relation, location)
+        agreed = again is not None and math.dist(again.position, match.position) <= \
+            self.config.agree
+        self.emit("observation", label=label, detected=agreed,
+                  position=[round(v, 2) for v in match.position])
+        return match if agreed else None
+
+    def _detect_once(self, label: str, relation: str, location: str) -> SeenLike | None:
+        seen = [s for s in self.robot.detect([label]) if s.label == label]
+        matches = [s for s in seen if self._inside(s, relation, location)]
+        for s in seen:
+            self.stats.detections.append((s.position[0], s.position[1], label, s in matches))
+        return matches[0] if matches else None
+
+    def _inside(self, seen: SeenLike, relation: str, location: str) -> bool:
+        if relation == "on":
+            support = self.mind.objects[location]
+            top = 2.0 * support.position[2]
+            low, high = self.config.above_support
+            near = math.dist(seen.position[:2], support.position[:2]) <= self.config.support_radius
+            return near and top + low <= seen.position[2] <= top + high
+        return self.mind.room_at(seen.position[:2]) == location
+
+    def _conclude(self, result, label: str, relation: str, location: str,  # noqa: ANN001
+                  made: ConeSet) -> StepOutcome:
+        if result.status is DTStatus.CONFIRMED and result.detection is not None:
+            seen = result.detection
+            support = location if relation == "on" else None
+            obj = self.mind.add_object(label, seen.position, support)
+            self.found_sids[obj.id] = seen.id
+            atoms = {("label-of", obj.id, label), ("detected", obj.id),
+                     ("related", obj.id, relation, location)}
+            return StepOutcome(StepStatus.DONE, f"confirmed {obj.id}", {obj.id: atoms})
+        looked = {s.action.cone for s in result.trace if s.action.kind is not ActionKind.MOVE}
+        mass = sum(made.cones[i].probability for i in looked)
+        coverage = made.coverage * mass / made.probability if made.probability > 0 else 0.0
+        if coverage > 0.0:
+            p_detect = 1.0 - self.config.detector.false_negative
+            self.mind.failed_search(label, relation, location, coverage, p_detect)
+        if relation == "on":
+            self.builder.failed_on.add((label, location))
+        else:
+            key = (label, location)
+            self.builder.failed_in[key] = self.builder.failed_in.get(key, 0) + 1
+        return StepOutcome(StepStatus.DONE, "rejected" if coverage > 0 else
+                           "rejected without looking")
+
+
+def _first_leg(waypoints: tuple[tuple[float, float], ...], step: float
+               ) -> list[tuple[float, float]]:
+    """The waypoints of the first ~`step` metres of a path (the robot stands at the first)."""
+    leg: list[tuple[float, float]] = []
+    budget = step
+    for a, b in zip(waypoints, waypoints[1:], strict=False):
+        length = math.dist(a, b)
+        if length > budget:
+            t = budget / length
+            leg.append((a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t))
+            return leg
+        leg.append((float(b[0]), float(b[1])))
+        budget -= length
+    return leg

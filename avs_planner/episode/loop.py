@@ -1,0 +1,147 @@
+"""The switching loop (seed 003): plan with assumptions, execute, monitor, replan, give up.
+
+Assumptive steps stay in the plan and are re-checked by the monitor against every new belief
+state; physical and sensing steps are executed and removed. The CP replans when the monitor
+reports a broken plan (a placeholder explored, a search rejected, a probability moved) and the
+episode gives up when no plan reaches the success threshold.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any
+
+from avs_planner.cp.continual import ContinualPlanner, Decision
+from avs_planner.cp.search import PlanResult, PlanStep, SearchOptions
+from avs_planner.episode.executor import Executor, StepOutcome, StepStatus
+from avs_planner.episode.mind import KnownObject
+from avs_planner.episode.state_builder import AvsState, StateBuilder
+from avs_planner.episode.trace import Trace
+
+
+class Outcome(Enum):
+    FOUND = "found"
+    GAVE_UP = "gave_up"
+    TIMEOUT = "timeout"
+
+
+@dataclass(frozen=True)
+class LoopConfig:
+    """Planner settings and budgets (simulated seconds, wall seconds, executed steps)."""
+
+    reward: float = 500.0
+    weight: float = 3.0
+    min_success: float = 0.01
+    cp_timeout_s: float = 10.0
+    time_budget_s: float = 1200.0
+    wall_budget_s: float = 600.0
+    max_steps: int = 120
+
+
+@dataclass
+class LoopResult:
+    outcome: Outcome
+    reason: str
+    found: KnownObject | None = None
+    plans: int = 0
+    replans: int = 0
+    cp_times: list[float] = field(default_factory=list)
+
+
+class SwitchingLoop:
+    """Owns the continual planner; asks the executor to run each non-assumptive step."""
+
+    def __init__(self, builder: StateBuilder, executor: Executor, trace: Trace,
+                 config: LoopConfig | None = None, should_stop: Any = None):
+        self.builder, self.executor, self.trace = builder, executor, trace
+        self.config = config or LoopConfig()
+        self.should_stop = should_stop or (lambda: False)
+        self.result = LoopResult(Outcome.GAVE_UP, "")
+        self.planner: ContinualPlanner | None = None
+        self._start_clock = executor.robot.clock
+
+    def run(self) -> LoopResult:
+        self.executor.look_around()
+        state = self.builder.build()
+        self.planner = ContinualPlanner(state.problem(), self._options(),
+                                        min_success=self.config.min_success)
+        first = self.planner.replan(state.world_state())
+        self._record_plan(first, "initial")
+        if not first.solved:
+            return self._end(Outcome.GAVE_UP, f"no plan: {first.status.value}")
+        for _ in range(self.config.max_steps):
+            stop = self._budget_spent()
+            if stop:
+                return self._end(Outcome.TIMEOUT, stop)
+            index = next((i for i, s in enumerate(self.planner.plan) if not s.assumptive), None)
+            if index is None:
+                return self._end(Outcome.GAVE_UP, "plan has no executable step")
+            step = self.planner.plan[index]
+            outcome = self._execute(step, state)
+            if outcome.status is StepStatus.FOUND:
+                self.result.found = outcome.reported
+                return self._end(Outcome.FOUND, outcome.detail)
+            self.planner.plan = self.planner.plan[:index] + self.planner.plan[index + 1:]
+            state = self.builder.build()
+            if not self._monitor(state, outcome):
+                return self._end(Outcome.GAVE_UP, "no plan above the success threshold")
+        return self._end(Outcome.TIMEOUT, f"{self.config.max_steps} steps executed")
+
+    def _options(self) -> SearchOptions:
+        cfg = self.config
+        return SearchOptions(reward=cfg.reward, weight=cfg.weight, timeout_s=cfg.cp_timeout_s)
+
+    def _execute(self, step: PlanStep, state: AvsState) -> StepOutcome:
+        self.trace.emit("action", action=step.label, status="start")
+        outcome = self.executor.run(step, state)
+        self.trace.emit("action", action=step.label, status=outcome.status.value,
+                        detail=outcome.detail)
+        return outcome
+
+    def _monitor(self, state: AvsState, outcome: StepOutcome) -> bool:
+        """Hand the new belief state to the CP; False when it gives up."""
+        assert self.planner is not None
+        update = self.planner.update(state.world_state(), state.problem(),
+                                     observed=outcome.observed or None)
+        if update.matched:
+            self.trace.emit("belief", matched=dict(update.matched))
+        if update.decision is Decision.CONTINUE:
+            return True
+        report = update.report
+        self.trace.emit("replan", status=report.status.value if report else "",
+                        action=report.action if report else None,
+                        detail=report.detail if report else "")
+        self.result.replans += 1
+        assert update.result is not None
+        self._record_plan(update.result, "replan")
+        return update.decision is Decision.REPLANNED
+
+    def _record_plan(self, result: PlanResult, why: str) -> None:
+        self.result.plans += 1
+        self.result.cp_times.append(result.planning_time_s)
+        self.trace.emit("plan", why=why, status=result.status.value,
+                        plan=[s.label for s in result.plan],
+                        probability=round(result.probability, 5), cost=round(result.cost, 2),
+                        planning_time_s=round(result.planning_time_s, 4),
+                        expanded=result.expanded)
+
+    def _budget_spent(self) -> str | None:
+        cfg = self.config
+        if self.should_stop():
+            return "stopped on request"
+        if self.executor.robot.clock - self._start_clock > cfg.time_budget_s:
+            return f"simulated time budget {cfg.time_budget_s:g} s spent"
+        if self.trace.wall > cfg.wall_budget_s:
+            return f"wall time budget {cfg.wall_budget_s:g} s spent"
+        return None
+
+    def _end(self, outcome: Outcome, reason: str) -> LoopResult:
+        self.result.outcome, self.result.reason = outcome, reason
+        self.trace.emit("done", outcome=outcome.value, reason=reason)
+        return self.result
+
+    @staticmethod
+    def now() -> float:
+        return time.perf_counter()

@@ -1,0 +1,108 @@
+"""The robot's mind during an episode: its maps, conceptual map and confirmed objects.
+
+Everything here is fed with sensor data only (scans, poses, place-classifier outputs,
+detections the DT planner confirmed); nothing reads the simulator. The state builder turns a
+`Mind` into a PDDL problem.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from conceptual_map.conceptual import ConceptualMap, RelatedSpace
+from conceptual_map.conceptual.place_events import PlaceMapFeed
+from conceptual_map.metric import OccupancyGrid
+from conceptual_map.metric.sensors import LaserScanLike
+from conceptual_map.places import MapEvent, PlaceMap, PlaceMapConfig
+
+Pose = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class KnownObject:
+    """An object the DT planner confirmed: `support` is the object it stands on, if any."""
+
+    id: str
+    label: str
+    position: tuple[float, float, float]
+    room: str
+    support: str | None = None
+
+
+@dataclass
+class Mind:
+    """Occupancy grid, place map, conceptual map (fed by place-map events), known objects."""
+
+    config: PlaceMapConfig = field(default_factory=lambda: PlaceMapConfig(robot_radius=0.3))
+    resolution: float = 0.05
+    grid: OccupancyGrid = field(init=False)
+    place_map: PlaceMap = field(init=False)
+    cmap: ConceptualMap = field(init=False)
+    objects: dict[str, KnownObject] = field(default_factory=dict)
+    cones_made: set[tuple[str, str, str]] = field(default_factory=set)
+    tried_placeholders: dict[str, int] = field(default_factory=dict)
+    classified: set[str] = field(default_factory=set)
+
+    def __post_init__(self) -> None:
+        self.grid = OccupancyGrid(resolution=self.resolution)
+        self.place_map = PlaceMap(self.config)
+        self.cmap = ConceptualMap()
+        self._feed = PlaceMapFeed(self.cmap)
+
+    def sense(self, scan: LaserScanLike, poses: list[Pose], time: float) -> list[MapEvent]:
+        """Integrate a scan taken at the end of `poses` and grow the place map along them."""
+        self.grid.integrate_scan(scan)
+        events = self.place_map.follow(self.grid, poses, time)
+        self._feed.apply(events)
+        self._drop_stale_objects()
+        return events
+
+    def observe_appearance(self, observed: str) -> bool:
+        """The place classifier said `observed` at the current place; False if not usable."""
+        place = self.place_map.current_place
+        if place is None or not self.cmap.graph.has_place(place):
+            return False
+        value = f"{observed}_like"
+        model = self.cmap.knowledge.properties.get("appearance")
+        if model is None or value not in model.values:
+            return False
+        self.cmap.observe_property(place, "appearance", value)
+        self.classified.add(place)
+        return True
+
+    def room_at(self, position: tuple[float, float]) -> str | None:
+        """The room of the place nearest to `position` (None before any room exists)."""
+        best, best_d = None, math.inf
+        for pid, place in self.place_map.places.items():
+            d = math.dist(place.position, position)
+            if d < best_d and self.place_map.room_of(pid) is not None:
+                best, best_d = pid, d
+        return self.place_map.room_of(best) if best is not None else None
+
+    def add_object(self, label: str, position: tuple[float, float, float],
+                   support: str | None = None) -> KnownObject:
+        """A confirmed detection becomes a known object (and evidence for its room)."""
+        room = (self.objects[support].room if support is not None
+                else self.room_at(position[:2]))
+        if room is None:
+            raise ValueError(f"no room known near {position[:2]}")
+        oid = f"object{len(self.objects) + 1}"
+        self.cmap.observe_object(label, room, on=support, object_id=oid)
+        known = KnownObject(oid, label, position, room, support)
+        self.objects[oid] = known
+        return known
+
+    def failed_search(self, label: str, relation: str, location: str, coverage: float,
+                      p_detect: float) -> None:
+        """A DT search that rejected: lower P(ObjectAt) of the searched location."""
+        where = RelatedSpace(relation, location) if relation == "on" else location
+        self.cmap.observe_search(label, where, min(1.0, coverage), p_detect)
+
+    def _drop_stale_objects(self) -> None:
+        """Rooms merge as the map grows: keep objects' rooms in step with the ledger."""
+        for oid, obj in list(self.objects.items()):
+            record = self.cmap.objects.objects.get(oid)
+            if record is not None and record.room != obj.room:
+                self.objects[oid] = KnownObject(oid, obj.label, obj.position, record.room,
+                                                obj.support)

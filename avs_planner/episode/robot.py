@@ -1,0 +1,131 @@
+"""The robot side: the only module of the episode package that talks to the simulator.
+
+`SimRobot` hands the mind sensor data only (pose, laser scans, detections, place-classifier
+outputs, the clock). Ground truth stays here: `truth_of` keeps each detection's world entry
+for the summary's evaluation, never for planning.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from avs_planner.episode.errors import EpisodeError
+from sim import World, load_world_spec
+from sim.errors import MotionError, SimError
+from sim.world_spec import WorldSpec
+
+
+@dataclass(frozen=True)
+class Seen:
+    """One detection as the mind sees it: label, 3D position, confidence, and an id."""
+
+    id: int
+    label: str
+    position: tuple[float, float, float]
+    confidence: float
+
+
+class SimRobot:
+    """Wraps a `sim.World`: motion, sensing and the clock, with sensor data out."""
+
+    def __init__(self, world: World):
+        self.world = world
+        self.robot = world.robot
+        self.truth_of: dict[int, str | None] = {}
+        self.model = self.robot.model.name
+
+    # ---- proprioception ---------------------------------------------------------------------
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        return tuple(float(v) for v in self.robot.pose)  # type: ignore[return-value]
+
+    @property
+    def clock(self) -> float:
+        return float(self.robot.clock)
+
+    @property
+    def odometry(self) -> float:
+        return float(self.robot.odometry)
+
+    @property
+    def camera_height(self) -> float:
+        return float(self.robot.camera_view().origin[2])
+
+    # ---- acting -----------------------------------------------------------------------------
+
+    def move_along(self, path: Sequence[tuple[float, float]]) -> bool:
+        """Drive through waypoints; False (without moving) if the path is blocked."""
+        try:
+            self.robot.move_along(list(path))
+        except MotionError:
+            return False
+        return True
+
+    def turn_to(self, yaw: float) -> None:
+        self.robot.turn_to(yaw)
+
+    def look(self, pan: float, tilt: float) -> None:
+        """Point the camera; angles are clipped to the head's limits."""
+        model = self.robot.model
+        self.robot.set_head(min(max(pan, model.pan.low), model.pan.high),
+                            min(max(tilt, model.tilt.low), model.tilt.high))
+
+    # ---- sensing ----------------------------------------------------------------------------
+
+    def scan(self):  # noqa: ANN201 - a LaserScan (sensor data class of the simulator)
+        return self.robot.scan()
+
+    def detect(self, labels: Sequence[str]) -> list[Seen]:
+        frame = self.robot.detect(list(labels))
+        seen = []
+        for d in frame.detections:
+            sid = len(self.truth_of) + 1
+            self.truth_of[sid] = d.truth_name
+            seen.append(Seen(sid, d.label, tuple(float(v) for v in d.position), d.confidence))
+        return seen
+
+    def classify_place(self) -> str | None:
+        try:
+            return self.robot.classify_place().observed
+        except SimError:
+            return None
+
+
+def load_spec(world: str | Path, robot: str | None = None, start: Sequence[float] | None = None,
+              start_room: str | None = None, closed_doors: Sequence[int] = ()) -> WorldSpec:
+    """The world spec with the robot model / start pose / door states the episode asks for."""
+    try:
+        spec = load_world_spec(world)
+    except SimError as exc:
+        raise EpisodeError(str(exc)) from exc
+    pose = tuple(spec.robot.start)
+    if start_room is not None:
+        room = spec.room(start_room)
+        if room is None:
+            raise EpisodeError(f"--start-room {start_room!r}: the world has rooms "
+                               f"{', '.join(r.name for r in spec.rooms)}")
+        pose = (*room.center, 0.0)
+    if start is not None:
+        if len(start) != 3 or not all(math.isfinite(float(v)) for v in start):
+            raise EpisodeError(f"start pose must be x,y,yaw (3 finite numbers), got {start!r}")
+        pose = tuple(float(v) for v in start)
+    robot_spec = dataclasses.replace(spec.robot, model=robot or spec.robot.model, start=pose)
+    doors = list(spec.doors)
+    for i in closed_doors:
+        if not 0 <= i < len(doors):
+            raise EpisodeError(f"closed door index {i}: the world has {len(doors)} doors")
+        doors[i] = dataclasses.replace(doors[i], open=False)
+    return dataclasses.replace(spec, robot=robot_spec, doors=tuple(doors))
+
+
+def open_world(spec: WorldSpec, seed: int) -> SimRobot:
+    """Build the PyBullet world (close it with `robot.world.close()`)."""
+    try:
+        return SimRobot(World(spec, seed))
+    except SimError as exc:
+        raise EpisodeError(str(exc)) from exc

@@ -1,0 +1,297 @@
+"""State builder: the robot's maps and conceptual map as a problem of the AVS domain.
+
+Follows domains/README.md ("What the state builder fills in"). Only a few places enter the
+problem (the robot's place, the places placeholders hang off, one place per room), connected
+by their shortest path lengths in the place graph, so replans stay small as the map grows.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import networkx as nx
+import numpy as np
+
+from avs_planner.cp.task import Atom, WorldState
+from avs_planner.episode.domain import build_problem
+from avs_planner.episode.errors import EpisodeError
+from avs_planner.episode.mind import Mind
+from avs_planner.pddl import ProbabilisticProblem
+from conceptual_map.conceptual import p_at_least_one
+
+RELATIONS = ("in", "on")
+
+
+@dataclass(frozen=True)
+class SearchTask:
+    """Report an object of `target`, optionally in a room of `category`."""
+
+    target: str
+    category: str | None = None
+
+
+@dataclass(frozen=True)
+class BuilderConfig:
+    """Sizes and static numbers of the problem (search costs/detection rates: seed 003 §4)."""
+
+    virtual_rooms: int = 1
+    virtual_objects: int = 2
+    certain_category: float = 0.9
+    max_supports: int = 2
+    max_categories: int = 2
+    max_placeholder_tries: int = 2
+    max_placeholders: int = 3
+    min_frontier_length: float = 0.5
+    placeholder_merge: float = 1.0  # m: nearer placeholders are one spot to the planner
+    max_failed_room_searches: int = 2
+    target_search_cost: tuple[float, float] = (120.0, 10.0)  # in a room, on a support
+    support_search_cost: tuple[float, float] = (40.0, 10.0)
+    target_detect: tuple[float, float] = (0.5, 0.8)
+    support_detect: tuple[float, float] = (0.8, 0.8)
+
+
+@dataclass(frozen=True)
+class AvsState:
+    """One snapshot as PDDL objects, true atoms, numeric values and goal, plus positions."""
+
+    name: str
+    objects: dict[str, list[str]]
+    atoms: frozenset[Atom]
+    values: dict[Atom, float]
+    goal: Atom
+    positions: dict[str, tuple[float, float]] = field(default_factory=dict)
+    robot_place: str = ""
+
+    def world_state(self) -> WorldState:
+        return WorldState(self.atoms, dict(self.values))
+
+    def problem(self) -> ProbabilisticProblem:
+        return build_problem(self.name, self.objects, self.atoms, self.values, self.goal)
+
+    def to_pddl(self) -> str:
+        """The same problem as PDDL text (for `avs domain check`, `avs plan` and traces)."""
+        objects = "\n".join(f"    {' '.join(names)} - {t}" for t, names in self.objects.items()
+                            if names)
+        atoms = "\n".join(f"    ({' '.join(a)})" for a in sorted(self.atoms))
+        values = "\n".join(f"    (= ({' '.join(a)}) {_num(v)})"
+                           for a, v in sorted(self.values.items()))
+        return (f"(define (problem {self.name}) (:domain avs)\n  (:objects\n{objects})\n"
+                f"  (:init\n{atoms}\n    (= (total-cost) 0)\n{values})\n"
+                f"  (:goal ({' '.join(self.goal)}))\n  (:metric minimize (total-cost)))\n")
+
+
+def _num(value: float) -> str:
+    text = f"{value:.6f}".rstrip("0").rstrip(".")
+    return text if text not in ("", "-0") else "0"
+
+
+class StateBuilder:
+    """Builds `AvsState`s for one task from a `Mind` (call `build` after every change)."""
+
+    def __init__(self, mind: Mind, task: SearchTask, config: BuilderConfig | None = None):
+        self.mind = mind
+        self.task = task
+        self.config = config or BuilderConfig()
+        knowledge = mind.cmap.knowledge
+        if task.target not in knowledge.labels:
+            raise EpisodeError(f"unknown target label {task.target!r}; the knowledge knows "
+                               f"{', '.join(sorted(knowledge.labels))}")
+        if task.category is not None and task.category not in knowledge.categories:
+            raise EpisodeError(f"unknown room category {task.category!r}; the knowledge knows "
+                               f"{', '.join(knowledge.categories)}")
+        self.supports = self._supports()
+        self.labels = [task.target, *self.supports]
+        self.categories = self._likely_categories()
+        self._current_categories = list(self.categories)
+        self.failed_on: set[tuple[str, str]] = set()
+        self.failed_in: dict[tuple[str, str], int] = {}
+        self.revision = 0
+
+    def _supports(self) -> list[str]:
+        knowledge = self.mind.cmap.knowledge
+        ranked = sorted(
+            ((float(lam.max()), support) for (label, rel, support), lam
+             in knowledge.relation_lambda.items() if label == self.task.target and rel == "on"),
+            reverse=True,
+        )
+        return [s for _, s in ranked[: self.config.max_supports]]
+
+    def _likely_categories(self) -> list[str]:
+        """Categories where the target (directly or on a support) is most expected; the
+        others only ever enter as a known room's certain category."""
+        knowledge = self.mind.cmap.knowledge
+        lam = knowledge.total_room_lambda(self.task.target)
+        order = sorted(range(len(knowledge.categories)), key=lambda k: -lam[k])
+        chosen = [knowledge.categories[k] for k in order[: self.config.max_categories]]
+        if self.task.category is not None and self.task.category not in chosen:
+            chosen[-1] = self.task.category
+        return chosen
+
+    # ---- the snapshot -----------------------------------------------------------------------
+
+    def build(self) -> AvsState:
+        pm = self.mind.place_map
+        if pm.current_place is None or not pm.rooms:
+            raise EpisodeError("the robot has no place map yet (no scan integrated)")
+        self.revision += 1
+        rooms = sorted(r for r in pm.rooms if self.mind.cmap.graph.has_room(r))
+        categories = self._categories(rooms)
+        places = self._places(rooms)
+        placeholders = self._placeholders(places)
+        objects = self._known_objects()
+        atoms: set[Atom] = set()
+        values: dict[Atom, float] = {}
+        self._topology(places, placeholders, atoms, values)
+        self._rooms(rooms, placeholders, atoms, values)
+        self._objects(objects, rooms, atoms, values)
+        self._statics(values)
+        names = {
+            "place": sorted(places), "placeholder": sorted(placeholders),
+            "room": [*rooms, *self._virtual("new-room", self.config.virtual_rooms)],
+            "visualobject": [*objects, *self._virtual("new-object", self.config.virtual_objects)],
+            "label": list(self.labels), "category": categories,
+        }
+        positions = {p: pm.places[p].position for p in places}
+        positions |= {p: pm.placeholders[p].position for p in placeholders}
+        return AvsState(f"episode-{self.revision}", names, frozenset(atoms), values,
+                        ("reported", self.task.target), positions, pm.current_place)
+
+    def _categories(self, rooms: list[str]) -> list[str]:
+        """The likely categories plus the certain category of any known room."""
+        out = list(self.categories)
+        for rid in rooms:
+            belief = self.mind.cmap.room_category(rid)
+            best = max(belief, key=belief.get)
+            if belief[best] >= self.config.certain_category and best not in out:
+                out.append(best)
+        self._current_categories = out
+        return out
+
+    @staticmethod
+    def _virtual(prefix: str, k: int) -> list[str]:
+        return [f"{prefix}{i}" for i in range(1, k + 1)]
+
+    def _places(self, rooms: list[str]) -> set[str]:
+        pm = self.mind.place_map
+        chosen = {pm.current_place}
+        chosen |= {ph.place for ph in pm.placeholders.values() if ph.place in pm.places}
+        for rid in rooms:
+            members = sorted(pm.rooms[rid].places & set(pm.places))
+            if members:
+                centre = np.mean([pm.places[p].position for p in members], axis=0)
+                chosen.add(min(members, key=lambda p: math.dist(pm.places[p].position, centre)))
+        return {p for p in chosen if pm.room_of(p) in rooms}
+
+    def _placeholders(self, places: set[str]) -> set[str]:
+        """Placeholders worth planning with: not given up on, and one per spot (the frontier
+        with the most unknown space behind it wins), at most `max_placeholders`."""
+        pm, tries, cfg = self.mind.place_map, self.mind.tried_placeholders, self.config
+        candidates = sorted(
+            (ph for pid, ph in pm.placeholders.items()
+             if ph.place in places and tries.get(pid, 0) < cfg.max_placeholder_tries
+             and pid in self.mind.cmap.placeholders
+             and ph.frontier_length >= cfg.min_frontier_length),
+            key=lambda ph: (-ph.open_space * ph.frontier_length, ph.id),
+        )
+        kept: list = []
+        for ph in candidates:
+            if all(math.dist(ph.position, k.position) > cfg.placeholder_merge for k in kept):
+                kept.append(ph)
+        return {ph.id for ph in kept[: cfg.max_placeholders]}
+
+    def _known_objects(self) -> list[str]:
+        return sorted(o.id for o in self.mind.objects.values() if o.label in self.labels
+                      and (o.support is None or o.support in self.mind.objects))
+
+    def _topology(self, places: set[str], placeholders: set[str], atoms: set[Atom],
+                  values: dict[Atom, float]) -> None:
+        pm = self.mind.place_map
+        nodes = sorted(places | placeholders)
+        atoms |= {("at", pm.current_place)} | {("visited", p) for p in places}
+        for a in nodes:
+            lengths = nx.single_source_dijkstra_path_length(pm.graph, a, weight="length")
+            for b in nodes:
+                d = lengths.get(b, math.inf) if a != b else 0.0
+                ok = a != b and math.isfinite(d) and not (a in placeholders and b in placeholders)
+                values[("move-cost", a, b)] = round(d, 3) if ok else 0.0
+                if ok:
+                    atoms.add(("connected", a, b))
+        for p in nodes:
+            atoms.add(("in-room", p, pm.room_of(p)))
+
+    def _rooms(self, rooms: list[str], placeholders: set[str], atoms: set[Atom],
+               values: dict[Atom, float]) -> None:
+        cmap = self.mind.cmap
+        for rid in rooms:
+            belief = cmap.room_category(rid)
+            best = max(belief, key=belief.get)
+            if belief[best] >= self.config.certain_category:
+                atoms |= {("has-category", rid, best), ("defined-category", rid)}
+            for c in self._current_categories:
+                values[("p-room-category", rid, c)] = belief[c]
+        for rid in self._virtual("new-room", self.config.virtual_rooms):
+            atoms.add(("virtual", rid))
+            values |= {("p-room-category", rid, c): 0.0 for c in self._current_categories}
+        for pid in placeholders:
+            belief = cmap.placeholder_category(pid)
+            for c in self._current_categories:
+                values[("p-placeholder-category", pid, c)] = belief.get(c, 0.0)
+        knowledge = cmap.knowledge
+        for label in self.labels:
+            lam = knowledge.total_room_lambda(label)
+            for rid in [*rooms, *self._virtual("new-room", self.config.virtual_rooms)]:
+                remaining = cmap.objects.remaining(rid, label) if rid in rooms else 1.0
+                p = p_at_least_one(lam * remaining)
+                for c in self._current_categories:
+                    k = knowledge.category_index(c)
+                    values[("p-obj-in", label, rid, c)] = self._restrict(c, float(p[k]))
+                if self.failed_in.get((label, rid), 0) >= self.config.max_failed_room_searches:
+                    atoms.add(("defined-exists", label, "in", rid))
+
+    def _restrict(self, category: str, p: float) -> float:
+        wanted = self.task.category
+        return p if wanted is None or wanted == category else 0.0
+
+    def _objects(self, objects: list[str], rooms: list[str], atoms: set[Atom],
+                 values: dict[Atom, float]) -> None:
+        for oid in objects:
+            obj = self.mind.objects[oid]
+            atoms |= {("label-of", oid, obj.label), ("detected", oid)}
+            if obj.support is None:
+                atoms |= {("related", oid, "in", obj.room),
+                          ("defined-exists", obj.label, "in", obj.room)}
+            else:
+                atoms |= {("related", oid, "on", obj.support),
+                          ("defined-exists", obj.label, "on", obj.support)}
+            for label in self.labels:
+                if (label, oid) in self.failed_on:
+                    atoms.add(("defined-exists", label, "on", oid))
+        for oid in self._virtual("new-object", self.config.virtual_objects):
+            atoms.add(("virtual", oid))
+        for label, rel, loc in self.mind.cones_made:
+            if loc in objects or loc in rooms:
+                atoms.add(("viewcones", label, rel, loc))
+
+    def _statics(self, values: dict[Atom, float]) -> None:
+        knowledge, cfg = self.mind.cmap.knowledge, self.config
+        for label in self.labels:
+            target = label == self.task.target
+            cost = cfg.target_search_cost if target else cfg.support_search_cost
+            detect = cfg.target_detect if target else cfg.support_detect
+            for k, rel in enumerate(RELATIONS):
+                values[("search-cost", label, rel)] = cost[k]
+                values[("p-detect", label, rel)] = detect[k]
+            for support in self.labels:
+                lam = knowledge.relation_lambda_of(label, "on", support)
+                listed = (label, "on", support) in knowledge.relation_lambda
+                p = p_at_least_one(lam) if listed else np.zeros(len(knowledge.categories))
+                for c in self._current_categories:
+                    k = knowledge.category_index(c)
+                    values[("p-obj-on", label, support, c)] = self._restrict(c, float(p[k]))
+
+    def search_detect(self, label: str, relation: str) -> float:
+        """The p-detect the problem uses for a search (the DT's evidence weight)."""
+        cfg = self.config
+        detect = cfg.target_detect if label == self.task.target else cfg.support_detect
+        return detect[RELATIONS.index(relation)]

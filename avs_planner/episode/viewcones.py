@@ -1,0 +1,122 @@
+"""CREATEVIEWCONES: candidate views for (label, relation, location), weighted and covering.
+
+In a room, views stand at the room's places and look in eight directions; the occupied and
+unknown cells near the room's places are where objects (and their supports) may be, and a
+greedy covering set keeps the views that add the most such cells, each weighted by the share
+it adds of P(ObjectAt). On a support, views stand around it, facing it, head tilted at its top.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from avs_planner.dt import ViewCone
+from avs_planner.episode.mind import KnownObject, Mind
+from conceptual_map.metric import CellState
+
+
+@dataclass(frozen=True)
+class CameraModel:
+    """What the robot knows of its own camera: height, fields of view, recognition range."""
+
+    height: float
+    hfov: float
+    detect_range: float
+    look_distance: float = 2.0  # m: where an in-room view aims its tilt
+    support_height: float = 0.7  # m: assumed top of a support before one is known
+
+
+@dataclass(frozen=True)
+class ConeSet:
+    """The cones of one CREATEVIEWCONES and the fraction of the location they cover."""
+
+    cones: tuple[ViewCone, ...]
+    coverage: float
+    probability: float
+
+
+def room_cones(mind: Mind, room: str, label: str, p_total: float, camera: CameraModel,
+               key: str, max_cones: int = 6, min_gain: float = 0.03) -> ConeSet:
+    """Greedy covering set of views from the room's places over its candidate cells."""
+    pm = mind.place_map
+    places = [pm.places[p].position for p in sorted(pm.rooms[room].places) if p in pm.places]
+    cells = _room_cells(mind, room, camera.detect_range)
+    if not places or len(cells) == 0:
+        return ConeSet((), 0.0, p_total)
+    tilt = -math.atan2(camera.height - camera.support_height, camera.look_distance)
+    candidates = [(x, y, k * math.pi / 4) for x, y in places for k in range(8)]
+    masks = [_in_wedge(cells, c, camera) for c in candidates]
+    covered = np.zeros(len(cells), dtype=bool)
+    chosen: list[tuple[tuple[float, float, float], float]] = []
+    while len(chosen) < max_cones:
+        gains = [int(np.count_nonzero(m & ~covered)) for m in masks]
+        best = int(np.argmax(gains))
+        if gains[best] < min_gain * len(cells):
+            break
+        chosen.append((candidates[best], gains[best] / len(cells)))
+        covered |= masks[best]
+    coverage = float(covered.mean())
+    cones = tuple(
+        ViewCone(f"{key}-{i}", pose, p_total * share, head=(0.0, tilt))
+        for i, (pose, share) in enumerate(chosen)
+    )
+    return ConeSet(cones, coverage, p_total)
+
+
+def support_cones(mind: Mind, support: KnownObject, p_total: float, camera: CameraModel,
+                  key: str, distances: tuple[float, ...] = (0.9, 1.2, 1.5),
+                  max_cones: int = 4) -> ConeSet:
+    """Views around a known support from traversable standpoints, facing its top; the
+    nearest standpoint per direction, then the most spread-out directions."""
+    sx, sy = support.position[:2]
+    top = max(0.3, min(2.0 * support.position[2], camera.height - 0.1))
+    free = mind.grid.traversable(mind.config.robot_radius)
+    stands = []
+    for k in range(12):
+        angle = k * math.pi / 6
+        for distance in distances:
+            x, y = sx + distance * math.cos(angle), sy + distance * math.sin(angle)
+            cell = mind.grid.cell_of((x, y))
+            if mind.grid.contains(cell) and free[cell]:
+                tilt = -math.atan2(camera.height - top, distance)
+                stands.append((x, y, math.atan2(sy - y, sx - x), tilt))
+                break
+    picked = stands[:: max(1, math.ceil(len(stands) / max_cones))][:max_cones]
+    share = p_total / len(picked) if picked else 0.0
+    cones = tuple(ViewCone(f"{key}-{i}", (x, y, yaw), share, head=(0.0, tilt))
+                  for i, (x, y, yaw, tilt) in enumerate(picked))
+    return ConeSet(cones, 0.9 if picked else 0.0, p_total)
+
+
+def _room_cells(mind: Mind, room: str, reach: float) -> np.ndarray:
+    """World centres of occupied/unknown cells next to free space, nearest to this room."""
+    grid, pm = mind.grid, mind.place_map
+    states = grid.state_grid()
+    free = states == CellState.FREE
+    near_free = np.zeros_like(free)
+    near_free[1:, :] |= free[:-1, :]
+    near_free[:-1, :] |= free[1:, :]
+    near_free[:, 1:] |= free[:, :-1]
+    near_free[:, :-1] |= free[:, 1:]
+    idx = np.argwhere(near_free & ~free)
+    if len(idx) == 0 or not pm.places:
+        return np.zeros((0, 2))
+    points = grid.to_world(idx)
+    ids = sorted(pm.places)
+    centres = np.array([pm.places[p].position for p in ids])
+    dist = np.linalg.norm(points[:, None, :] - centres[None, :, :], axis=2)
+    nearest = dist.argmin(axis=1)
+    mine = np.array([pm.room_of(p) == room for p in ids])
+    keep = mine[nearest] & (dist.min(axis=1) <= reach)
+    return points[keep][::2]
+
+
+def _in_wedge(points: np.ndarray, pose: tuple[float, float, float],
+              camera: CameraModel) -> np.ndarray:
+    d = points - np.asarray(pose[:2])
+    r = np.hypot(d[:, 0], d[:, 1])
+    bearing = np.abs((np.arctan2(d[:, 1], d[:, 0]) - pose[2] + np.pi) % (2 * np.pi) - np.pi)
+    return (r <= 0.9 * camera.detect_range) & (r >= 0.5) & (bearing <= camera.hfov / 2)
