@@ -1,12 +1,12 @@
 """HTTP service load: req/s and p50/p99 latency of GET /v1/tasks/{id} while episodes run.
 
 Starts `avs serve` on 127.0.0.1 (a free port, a temporary data dir), then measures the same
-request loop in three phases of one run: the idle service (the reference), with two episodes
-that stream events but barely use the CPU, and with two episodes that keep both cores busy (as a
-real planner would). Until `avs_planner/episode.py` exists the episodes come from the
-synthetic runner below, and the output says so.
+request loop in phases of one run: the idle service (the reference), then with two episodes
+running. Episodes come from the real runner (`avs_planner.episode.run_episode`) when it exists;
+otherwise, or with --synthetic, from the synthetic runner below, in two flavours: streaming
+events but barely using the CPU, and keeping both cores busy. The output says which.
 
-    .venv/bin/python -m bench.api_bench [--quick] [--requests N] [--connections C]
+    .venv/bin/python -m bench.api_bench [--quick] [--synthetic] [--requests N] [--connections C]
 """
 
 from __future__ import annotations
@@ -21,8 +21,9 @@ import subprocess
 import sys
 import tempfile
 import time
+import urllib.error
 import urllib.request
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -178,7 +179,11 @@ def run_episodes(port: int, target: str, world: str) -> list[str]:
 
 def stop_episodes(port: int, ids: list[str]) -> None:
     for task_id in ids:
-        _call(port, f"/v1/tasks/{task_id}", method="DELETE")
+        try:
+            _call(port, f"/v1/tasks/{task_id}", method="DELETE")
+        except urllib.error.HTTPError as exc:  # 409: it already ended
+            if exc.code != 409:
+                raise
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -186,9 +191,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="fewer requests per phase")
     parser.add_argument("--requests", type=int, help="requests per phase (default 4000)")
     parser.add_argument("--connections", type=int, default=4)
+    parser.add_argument("--synthetic", action="store_true",
+                        help="use the synthetic episodes even when the real runner exists")
     args = parser.parse_args(argv)
     requests = args.requests or (800 if args.quick else 4000)
-    real = episode_runner_available()
+    real = not args.synthetic and episode_runner_available()
     runner = "avs_planner.jobs:run_episode" if real else SYNTHETIC_RUNNER
     with tempfile.TemporaryDirectory(prefix="avs-api-bench-") as tmp:
         worlds = None
@@ -223,22 +230,23 @@ def _phases(
     for target, name in loads:
         ids = run_episodes(port, target, world)
         path = f"/v1/tasks/{ids[0]}"
-        phases.append(measure(name, server, port, path, requests, connections))
+        phase = measure(name, server, port, path, requests, connections)
+        live = sum(_call(port, f"/v1/tasks/{i}")["state"] == "running" for i in ids)
+        phases.append(replace(phase, name=f"{name} ({live}/2 still running at end)"))
         stop_episodes(port, ids)
     return phases
 
 
 def _report(phases: list[Phase], real: bool, requests: int, connections: int) -> None:
-    source = "the real episode runner" if real else (
-        "a SYNTHETIC episode runner (avs_planner.episode.run_episode does not exist yet)")
+    source = "the real episode runner" if real else "a SYNTHETIC episode runner"
     print(f"GET /v1/tasks/{{id}}: {requests} requests/phase (3 rounds, median req/s) over "
           f"{connections} keep-alive connections; episodes from {source}; "
           f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}")
     ref = phases[0]
-    print(f"{'phase':38} {'req/s':>7} {'p50 ms':>7} {'p99 ms':>7} {'err':>4} "
+    print(f"{'phase':58} {'req/s':>7} {'p50 ms':>7} {'p99 ms':>7} {'err':>4} "
           f"{'rps/ref':>7} {'p99/ref':>7} {'cpu ms/req':>10} {'cpu/ref':>7}")
     for p in phases:
-        print(f"{p.name:38} {p.rps:7.0f} {p.p50_ms:7.2f} {p.p99_ms:7.2f} {p.errors:4d} "
+        print(f"{p.name:58} {p.rps:7.0f} {p.p50_ms:7.2f} {p.p99_ms:7.2f} {p.errors:4d} "
               f"{p.rps / ref.rps:7.2f} {p.p99_ms / ref.p99_ms:7.2f} {p.server_cpu_ms:10.3f} "
               f"{p.server_cpu_ms / ref.server_cpu_ms:7.2f}")
     print(f"service CPU per request {ref.server_cpu_ms:.2f} ms idle: one free core would serve "
