@@ -10,6 +10,7 @@ import pytest
 from avs_planner.errors import PddlError
 from avs_planner.pddl import read_files, read_text
 from avs_planner.pddl.probabilistic import translate_domain
+from avs_planner.pddl.reader import _up_parse
 from avs_planner.pddl.sexpr import parse_sexprs
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -112,3 +113,31 @@ def test_text_errors_name_the_given_file() -> None:
 def test_missing_file_is_a_pddl_error(tmp_path: Path) -> None:
     with pytest.raises(PddlError, match="cannot read file"):
         read_files(tmp_path / "nope.pddl", tmp_path / "nope2.pddl")
+
+
+EDGE_DOMAIN = (Path(__file__).parent / "data" / "edge-domain.pddl").read_text()
+EDGE_PROBLEM = (Path(__file__).parent / "data" / "edge-problem.pddl").read_text()
+
+
+def test_upper_case_empty_precondition_numeric_conditions_read() -> None:
+    task = read_text(EDGE_DOMAIN, EDGE_PROBLEM)
+    assert {a.name for a in task.problem.actions} == {"noop", "go"}
+
+
+@pytest.mark.parametrize(
+    ("domain_edit", "problem_edit", "expected"),
+    [
+        (("", ""), ("(Q a b)", "(R a b)"), ("p.pddl", 4, 10)),
+        (("(P ?x))\n", "(R ?x))\n"), ("", ""), ("d.pddl", 13, 53)),
+        (("(:types thing)", "(:types thing) )"), ("", ""), ("d.pddl", 5, 3)),
+    ],
+)
+def test_up_errors_are_attributed_to_the_right_file(
+    domain_edit: tuple[str, str], problem_edit: tuple[str, str], expected: tuple[str, int, int]
+) -> None:
+    """The fallback path: what only unified-planning notices keeps UP's own position."""
+    domain = EDGE_DOMAIN.replace(*domain_edit) if domain_edit[0] else EDGE_DOMAIN
+    problem = EDGE_PROBLEM.replace(*problem_edit) if problem_edit[0] else EDGE_PROBLEM
+    with pytest.raises(PddlError) as exc:
+        _up_parse(domain, problem, "d.pddl", "p.pddl")
+    assert (exc.value.file, exc.value.line, exc.value.column) == expected

@@ -1,0 +1,5 @@
+(define (problem e1) (:domain edge)
+  (:objects A B - thing)
+  (:init (P a) (= (f a) 2) (= (f b) -1) (= (total-cost) 0))
+  (:goal (Q a b))
+  (:metric minimize (+ (total-cost) 1)))
