@@ -83,6 +83,15 @@ class PlaceMap:
                 return room.id
         return None
 
+    def room_links(self) -> dict[str, tuple[str, str]]:
+        """Door id -> the two rooms it joins (room connectivity for the conceptual map)."""
+        links = {}
+        for door_id in self.doors:
+            rooms = sorted(r.id for r in self.rooms.values() if door_id in r.doors)
+            if len(rooms) == 2:
+                links[door_id] = (rooms[0], rooms[1])
+        return links
+
     # ---- places -----------------------------------------------------------------------------
 
     def _new_id(self, prefix: str) -> str:

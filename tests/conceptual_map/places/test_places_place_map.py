@@ -170,3 +170,14 @@ def test_room_split_by_a_new_door_is_reported(run: Run) -> None:
         e.time for b in run.events for e in b if e.kind is EntityKind.DOOR and e.entity.confirmed
     )
     assert all(any(abs(a.time - t) <= 1.0 for t in door_times) for a in appeared[1:])
+
+
+def test_room_links_join_the_corridor_to_each_room_through_its_door(run: Run) -> None:
+    links = run.place_map.room_links()
+    assert len(links) == 2
+    rect = {
+        r.id: rect_of(run.place_map.places[sorted(r.places)[0]].position)
+        for r in run.place_map.rooms.values()
+    }
+    joined = sorted(tuple(sorted((rect[a], rect[b]))) for a, b in links.values())
+    assert joined == [(0, 1), (0, 2)]
