@@ -18,6 +18,7 @@ from avs_planner.dt.domain import (
     NOTHING,
     ActionKind,
     DTAction,
+    DTObservation,
 )
 from avs_planner.dt.errors import DtInputError
 from avs_planner.dt.models import valid_actions
@@ -120,3 +121,18 @@ def evaluate_policy(problem: DTProblem, policy: BeliefPolicy, belief: TargetBeli
         return memo[key]
 
     return value(belief, steps_left)
+
+
+class ExactPolicy:
+    """Optimal finite-horizon decisions (small instances only)."""
+
+    name = "exact"
+
+    def __init__(self, problem: DTProblem, max_beliefs: int = 2_000_000):
+        self.solver = ExactSolver(problem, max_beliefs)
+
+    def decide(self, belief: TargetBelief, steps_left: int) -> DTAction:
+        return self.solver.solve(belief, steps_left).action
+
+    def observe(self, action: DTAction, observation: DTObservation) -> None:
+        """Stateless: the memo is keyed by belief."""

@@ -1,5 +1,8 @@
-"""The greedy rule: look next where probability per cost is highest, stop when a look no longer
-pays (one-step lookahead on the terminal penalties).
+"""The greedy rule: look next where probability per cost is highest; stop when looking there up
+to `LOOKAHEAD` more times (then confirming or rejecting) no longer beats stopping now.
+
+Looking several times is part of the lookahead because with false negatives one more look
+rarely pays on its own, while two or three often do.
 
 It is the greedy baseline and the rollout policy of the POUCT planner, so it works on plain
 sequences (`probs`: P(target in cone i) for i < n, P(in none) last) for speed.
@@ -28,20 +31,37 @@ def stop_choice(problem: DTProblem, robot: int, detected: bool,
     return reject, REJECT
 
 
-def look_then_stop_cost(problem: DTProblem, robot: int, cone: int,
-                        probs: Sequence[float]) -> float:
-    """Expected cost of going to `cone`, processing it once, then stopping as well as possible."""
+LOOKAHEAD = 3
+
+
+def repeated_look_cost(problem: DTProblem, robot: int, cone: int, probs: Sequence[float],
+                       looks: int) -> float:
+    """Expected cost of going to `cone`, processing it `looks` times, then stopping as well as
+    possible. The belief after the looks depends only on the number of hits (and whether the
+    last look hit, which allows CONFIRM), so sequences are grouped by that."""
     hit_in, hit_out = problem.detection_rates
     miss, wrong = problem.rewards.miss_penalty, problem.rewards.false_confirm_penalty
     p, p_none = probs[cone], probs[-1]
-    cost = problem.travel_cost(robot, cone) + problem.sensing_cost
-    z = p * hit_in + (1.0 - p) * hit_out  # P(detection)
-    if z > 0.0:
-        cost += min(miss * (z - p_none * hit_out), wrong * (z - p * hit_in))
-    z = 1.0 - z
-    if z > 0.0:
-        cost += miss * (z - p_none * (1.0 - hit_out))
+    cost = problem.travel_cost(robot, cone) + looks * problem.sensing_cost
+    for hits in range(looks + 1):
+        like_in = hit_in**hits * (1.0 - hit_in) ** (looks - hits)
+        like_out = hit_out**hits * (1.0 - hit_out) ** (looks - hits)
+        joint_in, joint_none = p * like_in, p_none * like_out
+        z = joint_in + (1.0 - p) * like_out  # P(this hit count, one order)
+        if z <= 0.0:
+            continue
+        reject = miss * (z - joint_none)  # z * P(present | outcome) * miss
+        last_hit = math.comb(looks - 1, hits - 1) if hits else 0
+        last_miss = math.comb(looks - 1, hits) if hits < looks else 0
+        cost += last_miss * reject + last_hit * min(reject, wrong * (z - joint_in))
     return cost
+
+
+def look_then_stop_cost(problem: DTProblem, robot: int, cone: int,
+                        probs: Sequence[float], max_looks: int = LOOKAHEAD) -> float:
+    """Best expected cost of looking at `cone` 1..`max_looks` times and then stopping."""
+    return min(repeated_look_cost(problem, robot, cone, probs, k)
+               for k in range(1, max(1, max_looks) + 1))
 
 
 def top_cones(problem: DTProblem, robot: int, probs: Sequence[float], k: int) -> list[int]:
@@ -74,7 +94,9 @@ def greedy_action(problem: DTProblem, robot: int, detected: bool, probs: Sequenc
     candidates.discard(-1)
     best_cone, best_cost = -1, stop_cost
     for cone in sorted(candidates):
-        cost = look_then_stop_cost(problem, robot, cone, probs)
+        moving = 0 if cone == robot else 1
+        cost = look_then_stop_cost(problem, robot, cone, probs,
+                                   min(LOOKAHEAD, int(min(steps_left, 99)) - moving))
         if cost < best_cost - _EPS:
             best_cone, best_cost = cone, cost
     if best_cone < 0:

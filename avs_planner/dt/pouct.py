@@ -15,9 +15,10 @@ from dataclasses import dataclass
 import pomdp_py
 from pomdp_py.algorithms.po_uct import QNode
 
+from avs_planner.dt.agent import ViewConeAgent
 from avs_planner.dt.belief import TargetBelief
-from avs_planner.dt.domain import ActionKind
-from avs_planner.dt.greedy import stop_choice, top_cones
+from avs_planner.dt.domain import ActionKind, DTAction, DTObservation
+from avs_planner.dt.greedy import LOOKAHEAD, look_then_stop_cost, stop_choice, top_cones
 from avs_planner.dt.models import ViewConePolicyModel
 from avs_planner.dt.problem import DTProblem
 from avs_planner.dt.rollout import (
@@ -27,15 +28,19 @@ from avs_planner.dt.rollout import (
     terminal_reward,
 )
 
+TERMINAL_VISITS = 1_000_000  # CONFIRM/REJECT values are exact: never worth exploring
+
 
 @dataclass(frozen=True)
 class SearchBudget:
     """Planning budget per decision: simulations (deterministic with a seed) or seconds."""
 
-    num_sims: int = 300
+    num_sims: int = 200
     planning_time: float = -1.0  # > 0 and num_sims <= 0: plan for this many seconds
-    exploration_const: float = 0.0  # 0: scale with the terminal penalties
+    exploration_const: float = 0.0  # 0: 0.13 x the larger terminal penalty
     max_moves: int = 6  # MOVE branches per tree node: best P/cost cones (0: all)
+    prior_visits: int = 1  # pseudo-visits given to the greedy lookahead value of a new action
+    tree_depth: int = 3  # tree levels below the root; deeper is valued by rollouts (0: horizon)
 
 
 class ViewConePOUCT(pomdp_py.POUCT):
@@ -49,13 +54,15 @@ class ViewConePOUCT(pomdp_py.POUCT):
             num_sims=budget.num_sims,
             planning_time=budget.planning_time,
             discount_factor=1.0,
-            exploration_const=budget.exploration_const or 0.5 * max(penalty, 1.0),
+            exploration_const=budget.exploration_const or 0.13 * max(penalty, 1.0),
             rollout_policy=ViewConePolicyModel(problem, rng),
         )
         self._problem = problem
         self._rng = rng
         self._steps_left = steps_left
         self._max_moves = budget.max_moves
+        self._prior_visits = budget.prior_visits
+        self._tree_depth = budget.tree_depth or steps_left
         self._root_belief: TargetBelief | None = None
         self._root_len = 0
         self._beliefs = {}
@@ -85,13 +92,32 @@ class ViewConePOUCT(pomdp_py.POUCT):
         """Add the node's actions; MOVE only to the `max_moves` best cones by P/cost under the
         node's belief (the other moves are kept out of the tree, not out of the model)."""
         actions = self._policy_model.get_all_actions(state=state, history=history)
+        belief = self._node_belief(history)
         if self._max_moves > 0 and len(actions) > self._max_moves + 3:
-            belief = self._node_belief(history)
             keep = set(top_cones(self._problem, belief.robot, belief.probs, self._max_moves))
             actions = [a for a in actions if a.kind is not ActionKind.MOVE or a.cone in keep]
+        steps_left = self._steps_left - (len(history) - self._root_len)
         for action in actions:
             if vnode[action] is None:
-                vnode[action] = QNode(self.num_visits_init, self.value_init)
+                visits, value = self._action_prior(belief, action, steps_left)
+                vnode[action] = QNode(visits, value)
+
+    def _action_prior(self, belief: TargetBelief, action, steps_left: int) -> tuple[int, float]:
+        """(pseudo-visits, initial value) of a new tree action. CONFIRM/REJECT values are exact
+        (expected penalty under the node's belief), so they never need simulating; MOVE and
+        PROCESSVIEWCONE start at the value of the greedy plan "look there up to LOOKAHEAD times,
+        then stop", a value that is achievable, weighted like `prior_visits` simulations."""
+        if action.terminal:
+            return TERMINAL_VISITS, expected_terminal_reward(self._problem, belief, action)
+        if self._prior_visits <= 0:
+            return 0, 0.0
+        moving = 1 if action.kind is ActionKind.MOVE else 0
+        looks = min(LOOKAHEAD, steps_left - moving)
+        if looks < 1:
+            return self._prior_visits, -stop_choice(self._problem, belief.robot, belief.detected,
+                                                    belief.probs)[0]
+        return self._prior_visits, -look_then_stop_cost(self._problem, belief.robot, action.cone,
+                                                        belief.probs, looks)
 
     def _simulate(self, state, history, root, parent, observation, depth):
         if state.done:
@@ -99,6 +125,8 @@ class ViewConePOUCT(pomdp_py.POUCT):
         if depth >= self._steps_left:
             belief = self._node_belief(history)
             return stop_choice(self._problem, belief.robot, belief.detected, belief.probs)[0] * -1
+        if depth >= self._tree_depth:  # below the tree: value by greedy rollout only
+            return self._rollout(state, history, None, depth)
         return super()._simulate(state, history, root, parent, observation, depth)
 
     def _terminal_correction(self, state, history) -> float:
@@ -112,3 +140,28 @@ class ViewConePOUCT(pomdp_py.POUCT):
     def _rollout(self, state, history, root, depth):
         return greedy_rollout_return(self._problem, state, self._node_belief(history),
                                      self._steps_left - depth, self._rng)
+
+
+class POUCTPolicy:
+    """pomdp-py POUCT over the agent's histogram belief, reusing the search tree."""
+
+    name = "pouct"
+
+    def __init__(self, problem: DTProblem, seed: int = 0, budget: SearchBudget | None = None):
+        self.problem = problem
+        self._rng = random.Random(seed)
+        self._budget = budget or SearchBudget()
+        self.agent = ViewConeAgent(problem, self._rng)
+        self._planner: ViewConePOUCT | None = None
+        self.last_num_sims = 0
+
+    def decide(self, belief: TargetBelief, steps_left: int) -> DTAction:
+        self._planner = ViewConePOUCT(self.problem, self._rng, steps_left, self._budget)
+        action = self._planner.plan_from(self.agent, belief)
+        self.last_num_sims = self._planner.last_num_sims
+        return action
+
+    def observe(self, action: DTAction, observation: DTObservation) -> None:
+        self.agent.update(action, observation)
+        if self._planner is not None and getattr(self.agent, "tree", None) is not None:
+            self._planner.update(self.agent, action, observation)
