@@ -48,3 +48,21 @@ def test_resolve_runner_specs() -> None:
     for spec in ("no-colon", ":x", "avs_planner.jobs:"):
         with pytest.raises(ValueError, match="not 'module:function'"):
             resolve(spec)
+
+
+@pytest.mark.slow  # a real PyBullet episode: tens of seconds
+@pytest.mark.skipif(EPISODE_MISSING, reason="the episode runner has not landed")
+def test_real_episode_end_to_end(
+    make_settings: Callable[..., Settings], wait_for: Callable[..., dict]
+) -> None:
+    settings = make_settings(episode_runner=DEFAULT_EPISODE_RUNNER, worlds_dir=None)
+    body = {"target": "cerealbox", "world": "office", "seed": 1, "time_budget_s": 30}
+    with TestClient(create_app(settings)) as client:
+        task_id = client.post("/v1/tasks", json=body).json()["id"]
+        done = wait_for(client, task_id, {"succeeded", "gave_up", "timeout", "failed"}, 300)
+        events = client.get(f"/v1/tasks/{task_id}/events").text
+        picture = client.get(f"/v1/tasks/{task_id}/trajectory.png")
+    assert done["state"] != "failed", done["error"]
+    assert done["summary"]["target"] == "cerealbox"
+    assert "event: plan" in events and "event: done" in events
+    assert picture.status_code == 200 and picture.content.startswith(b"\x89PNG")
