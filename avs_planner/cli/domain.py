@@ -6,8 +6,6 @@ import argparse
 import json
 import sys
 
-from avs_planner.pddl import check
-
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add `avs domain` and its `check` subcommand."""
@@ -27,6 +25,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Print the findings; exit 1 if any is an error."""
+    from avs_planner.pddl import check
+
     diagnostics = check(args.domain, args.problems)
     if args.json:
         print(json.dumps([d.to_dict() for d in diagnostics], indent=2))

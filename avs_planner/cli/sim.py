@@ -3,16 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from sim.errors import SimError
-from sim.render import render_world
-from sim.scene import World
-from sim.world_file import builtin_worlds, load_world_spec
-from sim.world_spec import WorldSpec
+if TYPE_CHECKING:  # sim pulls in pybullet and matplotlib: import them only when a command runs
+    from sim.world_spec import WorldSpec
 
 _EXIT_OK = 0
 _EXIT_BAD_INPUT = 1
@@ -21,7 +19,7 @@ _EXIT_BAD_INPUT = 1
 def register(subparsers: Any) -> None:
     parser = subparsers.add_parser("sim", help="simulated worlds: render and check world files")
     commands = parser.add_subparsers(dest="sim_command", metavar="SIM_COMMAND", required=True)
-    worlds = ", ".join(builtin_worlds())
+    worlds = ", ".join(_builtin_world_names())
     render = commands.add_parser("render", help="draw a world top-down to a PNG")
     render.add_argument("--world", required=True, help=f"built-in name ({worlds}) or YAML path")
     render.add_argument("--out", help="PNG to write (default: WORLDNAME.png)")
@@ -32,7 +30,16 @@ def register(subparsers: Any) -> None:
     check.set_defaults(func=run_check)
 
 
+def _builtin_world_names() -> list[str]:
+    """The built-in world names, read from the package's files without importing pybullet."""
+    spec = importlib.util.find_spec("sim")  # finds the package without running its __init__
+    roots = spec.submodule_search_locations if spec else None
+    return sorted(p.stem for root in roots or () for p in Path(root, "worlds").glob("*.yaml"))
+
+
 def run_render(args: argparse.Namespace) -> int:
+    from sim.render import render_world
+
     spec = _load(args.world)
     if spec is None:
         return _EXIT_BAD_INPUT
@@ -65,6 +72,10 @@ def run_check(args: argparse.Namespace) -> int:
 
 def _load(world: str) -> WorldSpec | None:
     """Parse, validate, and build the world once (which also checks the robot's start)."""
+    from sim.errors import SimError
+    from sim.scene import World
+    from sim.world_file import load_world_spec
+
     try:
         spec = load_world_spec(world)
         World(spec).close()

@@ -77,8 +77,11 @@ def test_broken_world_names_the_entry(case: str) -> None:
 
 
 def test_unknown_world_name_lists_builtins() -> None:
-    with pytest.raises(WorldFileError, match="built-ins: flap_two_rooms, office, qsr_desks"):
+    with pytest.raises(WorldFileError, match="built-ins: ") as exc:
         load_world_spec("no_such_world")
+    listed = str(exc.value).split("built-ins: ", 1)[1]
+    for name in ("flap_two_rooms", "office", "qsr_desks"):
+        assert name in listed
 
 
 def test_on_key_is_not_a_yaml_boolean(tmp_path: Path) -> None:
