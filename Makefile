@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 
-.PHONY: run test test-all lint bench clean
+.PHONY: run test test-all lint bench serve clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -39,6 +39,10 @@ lint: $(VENV)/.installed-dev
 
 bench: $(VENV)/.installed-bench
 	$(BIN)/python -m bench
+
+## serve: the HTTP service on 127.0.0.1:8000 (see api/README.md)
+serve: $(VENV)/.installed
+	$(BIN)/avs serve
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache
