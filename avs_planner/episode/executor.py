@@ -23,7 +23,7 @@ from avs_planner.episode.mind import KnownObject, Mind
 from avs_planner.episode.state_builder import AvsState, StateBuilder
 from avs_planner.episode.viewcones import CameraModel, ConeSet, room_cones, support_cones
 from conceptual_map.errors import MapError
-from conceptual_map.metric import plan_path
+from conceptual_map.metric import distance_field, plan_path
 
 Event = Callable[..., None]
 
@@ -62,7 +62,8 @@ class ExecutorConfig:
     # the camera's own 0.2 / 0.05
     detector: DetectorModel = field(
         default_factory=lambda: DetectorModel(false_negative=0.36, false_positive=0.01))
-    agree: float = 0.3
+    agree: float = 0.6
+    squeeze: float = 0.08  # m less clearance when no path keeps the full margin
     miss_penalty: float = 500.0  # s of robot time: the CP's goal reward R
     support_radius: float = 0.9  # m: a detection this near a support is "on" it
     above_support: tuple[float, float] = (-0.15, 0.45)  # m around the support's top
@@ -127,12 +128,17 @@ class Executor:
 
     # ---- steps ------------------------------------------------------------------------------
 
-    def run(self, step: PlanStep, state: AvsState) -> StepOutcome:
+    def run(self, step: PlanStep, state: AvsState,
+            assumed: dict[str, str] | None = None) -> StepOutcome:
+        """Execute one step; `assumed` maps rooms to the category the plan assumes for them."""
         name = step.name.lower()
         if name == "move":
             return self.move(step.args[1], state)
         if name.startswith("createviewcones"):
-            return self.create_cones(step.args[0], name.rsplit("-", 1)[1], step.args[1])
+            relation = name.rsplit("-", 1)[1]
+            p = self._target_probability(step.args[0], relation, step.args[1], state,
+                                         assumed or {})
+            return self.create_cones(step.args[0], relation, step.args[1], p)
         if name.startswith("searchforobject"):
             relation = name.rsplit("-", 1)[1]
             return self.search(step.args[0], relation, step.args[1])
@@ -143,8 +149,23 @@ class Executor:
             return StepOutcome(StepStatus.FOUND, f"{obj.label} at {obj.position}", reported=obj)
         return StepOutcome(StepStatus.FAILED, f"no skill executes {step.name}")
 
+    def nearest_placeholder(self) -> str | None:
+        """The placeholder nearest by grid path that was not given up on."""
+        mind = self.mind
+        field_ = distance_field(mind.grid, self.robot.pose[:2], mind.config.robot_radius)
+        best, best_cost = None, math.inf
+        for pid, ph in mind.place_map.placeholders.items():
+            cell = mind.grid.cell_of(ph.position)
+            if mind.tried_placeholders.get(pid, 0) >= 2 or not mind.grid.contains(cell):
+                continue
+            if field_[cell] < best_cost:
+                best, best_cost = pid, float(field_[cell])
+        return best
+
     def move(self, target: str, state: AvsState) -> StepOutcome:
         goal = state.positions.get(target)
+        if goal is None and target in self.mind.place_map.placeholders:
+            goal = self.mind.place_map.placeholders[target].position
         if goal is None:
             return StepOutcome(StepStatus.FAILED, f"{target} has no position")
         is_placeholder = target in self.mind.place_map.placeholders
@@ -175,6 +196,8 @@ class Executor:
                 goal = nearby
                 continue
             if not path.found:
+                path = self._squeeze(here[:2], goal)
+            if not path.found:
                 return StepOutcome(StepStatus.FAILED, f"no path to {goal}")
             leg = _first_leg(path.waypoints, cfg.leg)
             if not self.robot.move_along(leg):
@@ -183,6 +206,15 @@ class Executor:
                                        zip([here[:2], *leg], leg, strict=False))
             self._sense([(x, y, self.robot.pose[2]) for x, y in leg])
         return StepOutcome(StepStatus.FAILED, "too many legs")
+
+    def _squeeze(self, start: tuple[float, float], goal: tuple[float, float]):  # noqa: ANN202
+        """A path with a slimmer margin (the robot may start close to furniture); the
+        simulator still refuses any motion that would collide."""
+        radius = self.mind.config.robot_radius - self.config.squeeze
+        try:
+            return plan_path(self.mind.grid, start, goal, radius)
+        except MapError:
+            return plan_path(self.mind.grid, start, start, radius)
 
     def _free_near(self, goal: tuple[float, float], reach: float = 0.6
                    ) -> tuple[float, float] | None:
@@ -197,18 +229,37 @@ class Executor:
         best = int(np.argmin(d))
         return (float(points[best, 0]), float(points[best, 1])) if d[best] <= reach else None
 
-    def create_cones(self, label: str, relation: str, location: str) -> StepOutcome:
+    def _target_probability(self, label: str, relation: str, location: str, state: AvsState,
+                            assumed: dict[str, str]) -> float | None:
+        """P(ObjectAt) of the searched location under the plan's category assumption (the
+        CP's own number); None to ask the conceptual map (no assumption about the room)."""
+        assumed = {**{a[1]: a[2] for a in state.atoms if a[0] == "has-category"}, **assumed}
+        if relation == "on":
+            support = self.mind.objects.get(location)
+            if support is None or support.room not in assumed:
+                return None
+            key = ("p-obj-on", label, support.label, assumed[support.room])
+        else:
+            if location not in assumed:
+                return None
+            key = ("p-obj-in", label, location, assumed[location])
+        return state.values.get(key)
+
+    def create_cones(self, label: str, relation: str, location: str,
+                     p: float | None = None) -> StepOutcome:
         key = f"{label}-{relation}-{location}"
         if relation == "on":
             support = self.mind.objects.get(location)
             if support is None:
                 return StepOutcome(StepStatus.FAILED, f"{location} is not a known object")
-            p = self.mind.cmap.p_object_at(label, ("on", location))
+            if p is None:
+                p = self.mind.cmap.p_object_at(label, ("on", location))
             made = support_cones(self.mind, support, p, self.camera, key)
         else:
             if location not in self.mind.place_map.rooms:
                 return StepOutcome(StepStatus.FAILED, f"{location} is not a known room")
-            p = self.mind.cmap.p_object_at(label, location)
+            if p is None:
+                p = self.mind.cmap.p_object_at(label, location)
             made = room_cones(self.mind, location, label, p, self.camera, key)
         self.cones[(label, relation, location)] = made
         self.mind.cones_made.add((label, relation, location))

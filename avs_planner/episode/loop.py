@@ -8,13 +8,12 @@ episode gives up when no plan reaches the success threshold.
 
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import Enum
 from typing import Any
 
 from avs_planner.cp.continual import ContinualPlanner, Decision
-from avs_planner.cp.search import PlanResult, PlanStep, SearchOptions
+from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep, SearchOptions
 from avs_planner.episode.executor import Executor, StepOutcome, StepStatus
 from avs_planner.episode.mind import KnownObject
 from avs_planner.episode.state_builder import AvsState, StateBuilder
@@ -33,8 +32,10 @@ class LoopConfig:
 
     reward: float = 500.0
     weight: float = 3.0
+    heuristic: str = "hadd"  # on these problems far fewer expansions than ff
     min_success: float = 0.01
-    cp_timeout_s: float = 10.0
+    cp_timeout_s: float = 4.0
+    fallback_weight: float = 20.0
     time_budget_s: float = 1200.0
     wall_budget_s: float = 600.0
     max_steps: int = 120
@@ -67,7 +68,7 @@ class SwitchingLoop:
         state = self.builder.build()
         self.planner = ContinualPlanner(state.problem(), self._options(),
                                         min_success=self.config.min_success)
-        first = self.planner.replan(state.world_state())
+        first = self._fallback(self.planner.replan(state.world_state()))
         self._record_plan(first, "initial")
         if not first.solved:
             return self._end(Outcome.GAVE_UP, f"no plan: {first.status.value}")
@@ -85,38 +86,76 @@ class SwitchingLoop:
                 return self._end(Outcome.FOUND, outcome.detail)
             self.planner.plan = self.planner.plan[:index] + self.planner.plan[index + 1:]
             state = self.builder.build()
-            if not self._monitor(state, outcome):
-                return self._end(Outcome.GAVE_UP, "no plan above the success threshold")
+            result = self._monitor(state, outcome)
+            while result is not None and result.status is PlanStatus.TIMEOUT:
+                if not self._explore_instead():
+                    return self._end(Outcome.GAVE_UP, "planner timed out, nothing to explore")
+                state = self.builder.build()
+                self.planner.update(state.world_state(), state.problem())
+                result = self._fallback(self.planner.replan())
+                self._record_plan(result, "after exploring")
+            if result is not None and not result.solved:
+                return self._end(Outcome.GAVE_UP, f"no plan above the success threshold "
+                                 f"{self.config.min_success:g} ({result.status.value})")
         return self._end(Outcome.TIMEOUT, f"{self.config.max_steps} steps executed")
+
+    def _fallback(self, result: PlanResult) -> PlanResult:
+        """A search that ran out of time is retried greedier (weight `fallback_weight`)."""
+        assert self.planner is not None
+        if result.status is not PlanStatus.TIMEOUT:
+            return result
+        self.result.cp_times.append(result.planning_time_s)
+        self.trace.emit("plan", why="timeout", status=result.status.value, plan=[],
+                        planning_time_s=round(result.planning_time_s, 4))
+        options = self.planner.options
+        self.planner.options = replace(options, weight=self.config.fallback_weight)
+        try:
+            return self.planner.replan()
+        finally:
+            self.planner.options = options
 
     def _options(self) -> SearchOptions:
         cfg = self.config
-        return SearchOptions(reward=cfg.reward, weight=cfg.weight, timeout_s=cfg.cp_timeout_s)
+        return SearchOptions(reward=cfg.reward, weight=cfg.weight, heuristic=cfg.heuristic,
+                             timeout_s=cfg.cp_timeout_s)
 
     def _execute(self, step: PlanStep, state: AvsState) -> StepOutcome:
         self.trace.emit("action", action=step.label, status="start")
-        outcome = self.executor.run(step, state)
+        outcome = self.executor.run(step, state, assumed_categories(self.planner.plan))
         self.trace.emit("action", action=step.label, status=outcome.status.value,
                         detail=outcome.detail)
         return outcome
 
-    def _monitor(self, state: AvsState, outcome: StepOutcome) -> bool:
-        """Hand the new belief state to the CP; False when it gives up."""
+    def _explore_instead(self) -> bool:
+        """The CP ran out of time: drive to the nearest placeholder (more map, smaller
+        uncertainty) and plan again. False if no placeholder is left."""
+        target = self.executor.nearest_placeholder()
+        if target is None:
+            return False
+        self.trace.emit("action", action=f"(explore {target})", status="start")
+        outcome = self.executor.move(target, self.builder.build())
+        self.trace.emit("action", action=f"(explore {target})", status=outcome.status.value,
+                        detail=outcome.detail)
+        return True
+
+    def _monitor(self, state: AvsState, outcome: StepOutcome) -> PlanResult | None:
+        """Hand the new belief state to the CP: None if the plan stands, else the new plan."""
         assert self.planner is not None
         update = self.planner.update(state.world_state(), state.problem(),
                                      observed=outcome.observed or None)
         if update.matched:
             self.trace.emit("belief", matched=dict(update.matched))
         if update.decision is Decision.CONTINUE:
-            return True
+            return None
         report = update.report
         self.trace.emit("replan", status=report.status.value if report else "",
                         action=report.action if report else None,
                         detail=report.detail if report else "")
         self.result.replans += 1
         assert update.result is not None
-        self._record_plan(update.result, "replan")
-        return update.decision is Decision.REPLANNED
+        result = self._fallback(update.result)
+        self._record_plan(result, "replan")
+        return result
 
     def _record_plan(self, result: PlanResult, why: str) -> None:
         self.result.plans += 1
@@ -142,6 +181,14 @@ class SwitchingLoop:
         self.trace.emit("done", outcome=outcome.value, reason=reason)
         return self.result
 
-    @staticmethod
-    def now() -> float:
-        return time.perf_counter()
+
+
+def assumed_categories(plan: tuple[PlanStep, ...] | list[PlanStep]) -> dict[str, str]:
+    """Room -> category the plan's assumptions give it (ASSUME-CATEGORY, -LEADS-TO-ROOM)."""
+    out: dict[str, str] = {}
+    for step in plan:
+        if step.name == "assume-category":
+            out[step.args[0]] = step.args[1]
+        elif step.name == "assume-leads-to-room":
+            out[step.args[2]] = step.args[1]
+    return out

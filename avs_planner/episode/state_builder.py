@@ -40,6 +40,7 @@ class BuilderConfig:
     certain_category: float = 0.9
     max_supports: int = 2
     max_categories: int = 2
+    min_probability: float = 0.03
     max_placeholder_tries: int = 2
     max_placeholders: int = 3
     min_frontier_length: float = 0.5
@@ -206,17 +207,23 @@ class StateBuilder:
 
     def _topology(self, places: set[str], placeholders: set[str], atoms: set[Atom],
                   values: dict[Atom, float]) -> None:
+        """A star around the robot's place: MOVE from it to every node and back, priced by
+        shortest place-graph paths. Plans that chain visits go back through the hub (an
+        over-estimate) but the planner's branching stays linear in the map size."""
         pm = self.mind.place_map
+        hub = pm.current_place
         nodes = sorted(places | placeholders)
-        atoms |= {("at", pm.current_place)} | {("visited", p) for p in places}
+        atoms |= {("at", hub)} | {("visited", p) for p in places}
+        lengths = nx.single_source_dijkstra_path_length(pm.graph, hub, weight="length")
         for a in nodes:
-            lengths = nx.single_source_dijkstra_path_length(pm.graph, a, weight="length")
             for b in nodes:
-                d = lengths.get(b, math.inf) if a != b else 0.0
-                ok = a != b and math.isfinite(d) and not (a in placeholders and b in placeholders)
-                values[("move-cost", a, b)] = round(d, 3) if ok else 0.0
-                if ok:
-                    atoms.add(("connected", a, b))
+                values[("move-cost", a, b)] = 0.0
+        for node in nodes:
+            d = lengths.get(node, math.inf)
+            if node == hub or not math.isfinite(d):
+                continue
+            values[("move-cost", hub, node)] = values[("move-cost", node, hub)] = round(d, 3)
+            atoms |= {("connected", hub, node), ("connected", node, hub)}
         for p in nodes:
             atoms.add(("in-room", p, pm.room_of(p)))
 
@@ -229,14 +236,14 @@ class StateBuilder:
             if belief[best] >= self.config.certain_category:
                 atoms |= {("has-category", rid, best), ("defined-category", rid)}
             for c in self._current_categories:
-                values[("p-room-category", rid, c)] = belief[c]
+                values[("p-room-category", rid, c)] = self._prune(belief[c])
         for rid in self._virtual("new-room", self.config.virtual_rooms):
             atoms.add(("virtual", rid))
             values |= {("p-room-category", rid, c): 0.0 for c in self._current_categories}
         for pid in placeholders:
             belief = cmap.placeholder_category(pid)
             for c in self._current_categories:
-                values[("p-placeholder-category", pid, c)] = belief.get(c, 0.0)
+                values[("p-placeholder-category", pid, c)] = self._prune(belief.get(c, 0.0))
         knowledge = cmap.knowledge
         for label in self.labels:
             lam = knowledge.total_room_lambda(label)
@@ -245,9 +252,13 @@ class StateBuilder:
                 p = p_at_least_one(lam * remaining)
                 for c in self._current_categories:
                     k = knowledge.category_index(c)
-                    values[("p-obj-in", label, rid, c)] = self._restrict(c, float(p[k]))
+                    values[("p-obj-in", label, rid, c)] = self._restrict(c, self._prune(p[k]))
                 if self.failed_in.get((label, rid), 0) >= self.config.max_failed_room_searches:
                     atoms.add(("defined-exists", label, "in", rid))
+
+    def _prune(self, p: float) -> float:
+        """Probabilities below `min_probability` become 0: the planner drops such actions."""
+        return float(p) if p >= self.config.min_probability else 0.0
 
     def _restrict(self, category: str, p: float) -> float:
         wanted = self.task.category
