@@ -265,6 +265,28 @@ def _reachable(protos: Sequence[_Proto], init: int) -> list[_Proto]:
     return kept
 
 
+def _relevant(protos: Sequence[_Proto], goal: int, goal_neg: int) -> list[_Proto]:
+    """Backward relevance: keep actions that add a fact needed true or delete one needed
+    false, where needs grow by the kept actions' conditions. Dropping the rest loses no plan
+    (they can be cut from any plan, which only lowers its cost and raises its probability)."""
+    need_true, need_false = goal, goal_neg
+    kept = [False] * len(protos)
+    changed = True
+    while changed:
+        changed = False
+        for i, proto in enumerate(protos):
+            a = proto.action
+            if kept[i] or not (a.add & need_true or a.delete & need_false):
+                continue
+            kept[i] = changed = True
+            need_true |= a.pre
+            need_false |= a.pre_neg
+            for pos, neg in a.clauses:
+                need_true |= pos
+                need_false |= neg
+    return [p for p, keep in zip(protos, kept, strict=True) if keep]
+
+
 def _instantiate(proto: _Proto, index: int, values: Mapping[Atom, float]) -> GroundAction | None:
     binding, schema = proto.binding, proto.schema
     probability = schema.probability(binding, values)
@@ -346,12 +368,13 @@ def ground(
         i = structure.fact_index.get(atom)
         if i is not None:
             init |= 1 << i
+    goal, goal_neg, impossible = _goal(pproblem.problem, structure)
+    reachable = _relevant(_reachable(structure.protos, init), goal, goal_neg)
     actions: list[GroundAction] = []
-    for proto in _reachable(structure.protos, init):
+    for proto in reachable:
         action = _instantiate(proto, len(actions), state.values)
         if action is not None:
             actions.append(action)
-    goal, goal_neg, impossible = _goal(pproblem.problem, structure)
     return GroundTask(
         facts=structure.facts, fact_index=structure.fact_index, actions=tuple(actions),
         init=init, goal=goal, goal_neg=goal_neg, goal_impossible=impossible,

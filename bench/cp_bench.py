@@ -1,0 +1,189 @@
+"""Continual planner vs Fast Downward lama-first (through UP), same run, per instance.
+
+Run: `.venv/bin/python -m bench.cp_bench [--quick]`. Instances: the AVS problems in
+domains/avs/problems, generated AVS problems of growing size (bench/avs_generator.py) and the
+IPC instances in /work/shared/ipc. Per instance it prints both times, their ratio (FD / ours,
+> 1 means we are faster), both plans' cost and, for AVS, both plans' true objective
+c + R(1 - p). FD cannot read probabilities, so for it each ground action's cost becomes
+round(100 (c + R (-ln p))) through a per-action cost fluent. Our time is `planning_time_s`
+(grounding + search, cold grounding cache) and, for AVS, also a warm replan (cache hit).
+FD's time is the wall time of `OneshotPlanner.solve` (writing PDDL, translate, search).
+Both plans are checked with UP's sequential plan validator.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import time
+from pathlib import Path
+
+from unified_planning.engines.plan_validator import SequentialPlanValidator
+from unified_planning.io import PDDLReader
+from unified_planning.model import MinimizeActionCosts, Problem
+from unified_planning.shortcuts import Fluent, IntType, OneshotPlanner, get_environment
+
+from avs_planner.cp.grounding import GroundingCache, ground
+from avs_planner.cp.planner import plan
+from avs_planner.cp.search import PlanResult, SearchOptions, objective
+from avs_planner.cp.task import GroundTask
+from avs_planner.pddl import read_text
+from avs_planner.pddl.model import ProbabilisticProblem
+from avs_planner.up_engine import to_up_plan
+from bench.avs_generator import AvsSize, generate
+
+ROOT = Path(__file__).resolve().parents[1]
+IPC = Path("/work/shared/ipc")
+REWARD = 500.0
+TIMEOUT_S = 10.0
+PROHIBITIVE = 10**7
+OPTIONS = SearchOptions(reward=REWARD, weight=2.0, heuristic="ff", timeout_s=TIMEOUT_S)
+SIZES = (AvsSize(8, 2, 2, 4), AvsSize(12, 3, 3, 6), AvsSize(20, 5, 4, 8))
+
+
+def avs_cases(quick: bool) -> list[tuple[str, ProbabilisticProblem]]:
+    domain_text = (ROOT / "domains/avs/domain.pddl").read_text()
+    cases = [
+        (f"avs/{p.stem}", read_text(domain_text, p.read_text(), "domain.pddl", p.name))
+        for p in sorted((ROOT / "domains/avs/problems").glob("*.pddl"))
+    ]
+    seeds = (0,) if quick else (0, 1, 2)
+    for size in SIZES[:2] if quick else SIZES:
+        for seed in seeds:
+            text = generate(size, seed)
+            cases.append((f"gen/{size.name}-s{seed}",
+                          read_text(domain_text, text, "domain.pddl", size.name)))
+    return cases
+
+
+def ipc_cases(quick: bool) -> list[tuple[str, ProbabilisticProblem]]:
+    cases = []
+    for domain in sorted(IPC.glob("*/domain.pddl")):
+        instances = sorted(domain.parent.glob("instance-*.pddl"),
+                           key=lambda p: int(p.stem.split("-")[1]))
+        for problem in instances[:2] if quick else instances:
+            up = PDDLReader().parse_problem(str(domain), str(problem))
+            cases.append((f"{domain.parent.name}/{problem.stem}", ProbabilisticProblem(up)))
+    return cases
+
+
+def fd_problem(pproblem: ProbabilisticProblem, task: GroundTask) -> Problem:
+    """The deterministic compilation: cost(a) = round(100 (c + R(-ln p))), per ground action.
+    Fluents only the probabilities read (fractional, which FD rejects) are left out."""
+    source = pproblem.problem
+    problem = Problem(source.name)
+    bool_fluents = [f for f in source.fluents if f.type.is_bool_type()]
+    for fluent in bool_fluents:
+        problem.add_fluent(fluent, default_initial_value=False)
+    problem.add_objects(source.all_objects)
+    problem.add_actions(source.actions)
+    for exp, value in source.explicit_initial_values.items():
+        if exp.fluent().type.is_bool_type():
+            problem.set_initial_value(exp, value)
+    for goal in source.goals:
+        problem.add_goal(goal)
+    costs = {}
+    for action in problem.actions:
+        fluent = Fluent(f"fdcost-{action.name}", IntType(),
+                        **{p.name: p.type for p in action.parameters})
+        # ground actions we pruned (p = 0, irrelevant, unreachable) get a prohibitive cost
+        problem.add_fluent(fluent, default_initial_value=PROHIBITIVE)
+        costs[action] = fluent(*action.parameters)
+    for a in task.actions:
+        value = round(100 * (a.cost + REWARD * -math.log(a.probability)))
+        fluent = problem.fluent(f"fdcost-{a.name}")
+        problem.set_initial_value(fluent(*[problem.object(x) for x in a.args]), value)
+    problem.add_quality_metric(MinimizeActionCosts(costs))
+    return problem
+
+
+def true_objective(task: GroundTask, labels: list[tuple[str, tuple[str, ...]]]) -> tuple:
+    steps = [task.action(name, args) for name, args in labels]
+    if any(s is None for s in steps):  # FD used an action we proved useless or impossible
+        return math.nan, 0.0, math.nan
+    cost = math.fsum(s.cost for s in steps)
+    p = math.prod(s.probability for s in steps)
+    return cost, p, objective(cost, p, REWARD)
+
+
+def run_fd(problem: Problem) -> tuple[float, list | None]:
+    start = time.perf_counter()
+    with OneshotPlanner(name="fast-downward",
+                        params={"fast_downward_alias": "lama-first"}) as planner:
+        result = planner.solve(problem, timeout=60)
+    elapsed = time.perf_counter() - start
+    if result.plan is None:
+        return elapsed, None
+    return elapsed, [(ai.action.name, tuple(str(p) for p in ai.actual_parameters))
+                     for ai in result.plan.actions]
+
+
+def valid(problem: Problem, up_plan) -> bool:
+    validator = SequentialPlanValidator()
+    validator.skip_checks = True  # elevators' partially defined costs trip the kind check
+    return validator.validate(problem, up_plan).status.name == "VALID"
+
+
+def bench_case(label: str, pproblem: ProbabilisticProblem, probabilistic: bool) -> dict:
+    cache = GroundingCache()
+    ours: PlanResult = plan(pproblem, OPTIONS, cache=cache)
+    warm = plan(pproblem, OPTIONS, cache=cache).planning_time_s if probabilistic else math.nan
+    task = ground(pproblem, cache=cache)
+    fd_input = fd_problem(pproblem, task) if probabilistic else pproblem.problem
+    fd_time, fd_plan = run_fd(fd_input)
+    row = {"label": label, "ours_s": ours.planning_time_s, "warm_s": warm, "fd_s": fd_time,
+           "status": ours.status.value, "expanded": ours.expanded}
+    if ours.solved:
+        row["ours_valid"] = valid(pproblem.problem, to_up_plan(pproblem.problem, ours.plan))
+        row["ours_cost"], row["ours_obj"] = ours.cost, ours.objective
+    if fd_plan is not None:
+        row["fd_cost"], _, row["fd_obj"] = true_objective(task, fd_plan)
+    return row
+
+
+def _fmt(value, spec: str) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    return format(value, spec)
+
+
+def report(rows: list[dict], title: str, probabilistic: bool) -> list[float]:
+    print(f"\n== {title}")
+    head = f"{'instance':34} {'ours ms':>9} {'warm ms':>8} {'FD ms':>8} {'FD/ours':>8} " \
+           f"{'status':>8} {'exp':>6} {'cost':>7} {'FD cost':>7}"
+    print(head + (f" {'obj':>8} {'FD obj':>8}" if probabilistic else "") + "  valid")
+    ratios = []
+    for r in rows:
+        ratio = r["fd_s"] / r["ours_s"] if r["status"] == "solved" else math.nan
+        if not math.isnan(ratio):
+            ratios.append(ratio)
+        line = (f"{r['label']:34} {r['ours_s'] * 1e3:9.1f} {_fmt(r['warm_s'] * 1e3, '8.1f')} "
+                f"{r['fd_s'] * 1e3:8.1f} {_fmt(ratio, '8.2f')} {r['status'][:8]:>8} "
+                f"{r['expanded']:6d} {_fmt(r.get('ours_cost'), '7.1f')} "
+                f"{_fmt(r.get('fd_cost'), '7.1f')}")
+        if probabilistic:
+            line += f" {_fmt(r.get('ours_obj'), '8.1f')} {_fmt(r.get('fd_obj'), '8.1f')}"
+        print(line + f"  {r.get('ours_valid', '-')}")
+    solved = [r["ours_s"] for r in rows if r["status"] == "solved"]
+    print(f"-- median ours {statistics.median([r['ours_s'] for r in rows]) * 1e3:.1f} ms "
+          f"(solved {len(solved)}/{len(rows)}), median FD/ours ratio "
+          f"{_fmt(statistics.median(ratios) if ratios else math.nan, '.2f')}")
+    return ratios
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="fewer instances")
+    args = parser.parse_args()
+    get_environment().credits_stream = None
+    print(f"options: R={OPTIONS.reward} w={OPTIONS.weight} h={OPTIONS.heuristic} "
+          f"timeout={OPTIONS.timeout_s}s; FD: lama-first through UP")
+    avs = [bench_case(label, p, True) for label, p in avs_cases(args.quick)]
+    report(avs, "AVS problems (probabilistic; FD on -ln p costs)", True)
+    ipc = [bench_case(label, p, False) for label, p in ipc_cases(args.quick)]
+    report(ipc, "IPC instances (deterministic)", False)
+
+
+if __name__ == "__main__":
+    main()
