@@ -63,7 +63,7 @@ class AvsPlanner(Engine, OneshotPlannerMixin):
         self._success: Mapping[str, FNode] = params.pop("success", {})
         self._options = SearchOptions(
             reward=float(params.pop("reward", SearchOptions.reward)),
-            weight=float(params.pop("weight", 1.0)),
+            weight=float(params.pop("weight", SearchOptions.weight)),
             heuristic=str(params.pop("heuristic", "ff")),
             node_limit=params.pop("node_limit", None),
             min_success=float(params.pop("min_success", 0.0)),

@@ -32,7 +32,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("problem", help="problem PDDL file")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
     parser.add_argument("--reward", type=float, default=DEFAULT_REWARD, help="goal reward R")
-    parser.add_argument("--weight", type=float, default=1.0, help="weight w >= 1 of A*")
+    parser.add_argument("--weight", type=float, default=SearchOptions.weight,
+                        help="weight w >= 1 on the remaining cost estimate (1: A*)")
     parser.add_argument("--timeout", type=float, default=None, help="seconds (default: none)")
     parser.add_argument("--node-limit", type=int, default=None, help="max expanded states")
     parser.add_argument("--heuristic", choices=sorted(HEURISTICS), default="ff")

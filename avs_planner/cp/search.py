@@ -35,13 +35,13 @@ class SearchOptions:
     """R (goal reward), weight w of f = g + w h, heuristic name, limits, success threshold."""
 
     reward: float = DEFAULT_REWARD
-    weight: float = 1.0
+    weight: float = 2.0
     heuristic: str = "ff"
     timeout_s: float | None = None
     node_limit: int | None = None
     min_success: float = 0.0
     symmetry: bool = True
-    lazy: bool = False
+    lazy: bool | None = None  # deferred evaluation; None: only on deterministic tasks
 
     def check(self) -> SearchOptions:
         if self.reward < 0 or not math.isfinite(self.reward):
@@ -178,7 +178,10 @@ class _Search:
         self.labels = _Labels()
         self.heap: list[tuple[float, float, int]] = []
         self.pruned_threshold = False
-        self.lazy = options.lazy and not get_heuristic(options.heuristic).admissible
+        lazy = options.lazy
+        if lazy is None:  # helps on classical tasks, hurts where R(1 - p) jumps dominate g
+            lazy = all(a.probability == 1.0 for a in task.actions)
+        self.lazy = lazy and not get_heuristic(options.heuristic).admissible
         self.h_of_node: list[float] = []
         self.evaluated: list[bool] = []
         self.commutes: dict[tuple[int, int], bool] = {}
