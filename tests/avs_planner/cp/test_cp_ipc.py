@@ -51,7 +51,7 @@ def test_ipc_plan_validates(domain, n):
 
 def test_w1_hmax_matches_known_optimum_on_blocks():
     problem = _read("blocks", 1)  # 4 blocks; optimal length 6
-    result = plan(ProbabilisticProblem(problem), SearchOptions(heuristic="hmax"))
+    result = plan(ProbabilisticProblem(problem), SearchOptions(heuristic="hmax", weight=1.0))
     assert result.cost == 6
 
 
@@ -62,7 +62,7 @@ def test_up_engine_solves_and_reports_statuses():
         result = planner.solve(problem)
     assert result.status is PlanGenerationResultStatus.SOLVED_SATISFICING
     assert _validate(problem, result.plan).status.name == "VALID"
-    with OneshotPlanner(name="avs", params={"heuristic": "hmax"}) as planner:
+    with OneshotPlanner(name="avs", params={"heuristic": "hmax", "weight": 1.0}) as planner:
         optimal = planner.solve(_read("blocks", 1))
     assert optimal.status is PlanGenerationResultStatus.SOLVED_OPTIMALLY
     assert "replanner[avs]" in get_environment().factory.engines

@@ -88,8 +88,9 @@ def test_seed_first_plan_from_corridor(corridor):
 
 @pytest.mark.slow
 def test_corridor_symmetry_pruning_keeps_the_optimum(corridor):
-    with_sym = plan(corridor, SearchOptions(reward=500.0, heuristic="hmax"))
-    without = plan(corridor, SearchOptions(reward=500.0, heuristic="hmax", symmetry=False))
+    with_sym = plan(corridor, SearchOptions(reward=500.0, heuristic="hmax", weight=1.0))
+    without = plan(corridor, SearchOptions(
+        reward=500.0, heuristic="hmax", weight=1.0, symmetry=False))
     assert with_sym.objective == pytest.approx(without.objective)
     assert with_sym.expanded < without.expanded
 
