@@ -40,7 +40,7 @@ class SearchBudget:
     exploration_const: float = 0.0  # 0: 0.13 x the larger terminal penalty
     max_moves: int = 6  # MOVE branches per tree node: best P/cost cones (0: all)
     prior_visits: int = 1  # pseudo-visits given to the greedy lookahead value of a new action
-    tree_depth: int = 3  # tree levels below the root; deeper is valued by rollouts (0: horizon)
+    tree_depth: int = 2  # looks in the tree below the root; deeper is valued by rollouts
 
 
 class ViewConePOUCT(pomdp_py.POUCT):
@@ -125,9 +125,16 @@ class ViewConePOUCT(pomdp_py.POUCT):
         if depth >= self._steps_left:
             belief = self._node_belief(history)
             return stop_choice(self._problem, belief.robot, belief.detected, belief.probs)[0] * -1
-        if depth >= self._tree_depth:  # below the tree: value by greedy rollout only
+        if self._tree_level(history) >= self._tree_depth:  # below the tree: greedy rollout
             return self._rollout(state, history, None, depth)
         return super()._simulate(state, history, root, parent, observation, depth)
+
+    def _tree_level(self, history: tuple) -> int:
+        """Decisions below the root, not counting MOVEs: a MOVE's only continuation is the
+        look there, so counting it would give moves a shallower (less diluted) subtree than
+        looking again, biasing the tree toward moving."""
+        return sum(1 for action, _ in history[self._root_len:]
+                   if action.kind is not ActionKind.MOVE)
 
     def _terminal_correction(self, state, history) -> float:
         """Swap the sampled CONFIRM/REJECT penalty (already added by pomdp-py) for its
