@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from enum import Enum
+from pathlib import Path
 from typing import Any
 
 from avs_planner.cp.continual import ContinualPlanner, Decision
@@ -39,6 +40,7 @@ class LoopConfig:
     time_budget_s: float = 1200.0
     wall_budget_s: float = 600.0
     max_steps: int = 120
+    dump_dir: str | None = None  # write problems the CP timed out on here
 
 
 @dataclass
@@ -105,14 +107,23 @@ class SwitchingLoop:
         if result.status is not PlanStatus.TIMEOUT:
             return result
         self.result.cp_times.append(result.planning_time_s)
+        dumped = self._dump_problem()
         self.trace.emit("plan", why="timeout", status=result.status.value, plan=[],
-                        planning_time_s=round(result.planning_time_s, 4))
+                        planning_time_s=round(result.planning_time_s, 4), problem=dumped)
         options = self.planner.options
         self.planner.options = replace(options, weight=self.config.fallback_weight)
         try:
             return self.planner.replan()
         finally:
             self.planner.options = options
+
+    def _dump_problem(self) -> str | None:
+        """Keep a problem the CP could not solve in time (for `avs plan`), if asked to."""
+        if self.config.dump_dir is None:
+            return None
+        path = Path(self.config.dump_dir) / f"timeout-{self.result.plans + 1}.pddl"
+        path.write_text(self.builder.build().to_pddl(), encoding="utf-8")
+        return str(path)
 
     def _options(self) -> SearchOptions:
         cfg = self.config

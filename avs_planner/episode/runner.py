@@ -108,7 +108,8 @@ class Episode:
                                  seed=spec.seed)
         self.loop = SwitchingLoop(self.builder, self.executor, self.trace,
                                   LoopConfig(time_budget_s=spec.time_budget_s,
-                                             wall_budget_s=spec.wall_budget_s), should_stop)
+                                             wall_budget_s=spec.wall_budget_s,
+                                             dump_dir=spec.output_dir), should_stop)
 
     def _world_spec(self):  # noqa: ANN202 - sim.WorldSpec
         spec = self.spec

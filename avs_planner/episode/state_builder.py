@@ -136,7 +136,7 @@ class StateBuilder:
         if pm.current_place is None or not pm.rooms:
             raise EpisodeError("the robot has no place map yet (no scan integrated)")
         self.revision += 1
-        rooms = sorted(r for r in pm.rooms if self.mind.cmap.graph.has_room(r))
+        rooms = self._relevant_rooms()
         categories = self._categories(rooms)
         places = self._places(rooms)
         placeholders = self._placeholders(places)
@@ -252,9 +252,34 @@ class StateBuilder:
                 p = p_at_least_one(lam * remaining)
                 for c in self._current_categories:
                     k = knowledge.category_index(c)
-                    values[("p-obj-in", label, rid, c)] = self._restrict(c, self._prune(p[k]))
+                    useful = label == self.task.target or self._support_useful(label, c)
+                    p_in = self._prune(p[k]) if useful else 0.0
+                    values[("p-obj-in", label, rid, c)] = self._restrict(c, p_in)
                 if self.failed_in.get((label, rid), 0) >= self.config.max_failed_room_searches:
                     atoms.add(("defined-exists", label, "in", rid))
+
+    def _relevant_rooms(self) -> list[str]:
+        """Rooms worth a planner's thought: the robot's, those holding known objects or
+        placeholders, and those that may be of a category where the target is expected."""
+        pm, cmap = self.mind.place_map, self.mind.cmap
+        keep = {pm.room_of(pm.current_place)}
+        keep |= {o.room for o in self.mind.objects.values()}
+        keep |= {pm.room_of(ph.place) for ph in pm.placeholders.values() if ph.place}
+        for rid in pm.rooms:
+            if cmap.graph.has_room(rid):
+                belief = cmap.room_category(rid)
+                if any(belief[c] >= self.config.min_probability for c in self.categories):
+                    keep.add(rid)
+        return sorted(r for r in keep if r is not None and cmap.graph.has_room(r))
+
+    def _support_useful(self, support: str, category: str) -> bool:
+        """Finding `support` in a room of `category` helps only if the target may be on it."""
+        knowledge = self.mind.cmap.knowledge
+        if (self.task.target, "on", support) not in knowledge.relation_lambda:
+            return False
+        lam = knowledge.relation_lambda_of(self.task.target, "on", support)
+        p = float(p_at_least_one(lam[knowledge.category_index(category)]))
+        return p >= self.config.min_probability
 
     def _prune(self, p: float) -> float:
         """Probabilities below `min_probability` become 0: the planner drops such actions."""
@@ -299,7 +324,7 @@ class StateBuilder:
                 p = p_at_least_one(lam) if listed else np.zeros(len(knowledge.categories))
                 for c in self._current_categories:
                     k = knowledge.category_index(c)
-                    values[("p-obj-on", label, support, c)] = self._restrict(c, float(p[k]))
+                    values[("p-obj-on", label, support, c)] = self._restrict(c, self._prune(p[k]))
 
     def search_detect(self, label: str, relation: str) -> float:
         """The p-detect the problem uses for a search (the DT's evidence weight)."""

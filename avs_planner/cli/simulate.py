@@ -1,0 +1,126 @@
+"""`avs simulate`: one headless object-search episode (the switching planner in the loop).
+
+Writes trace.jsonl, summary.json and trajectory.png to --out, prints a progress line while it
+runs and a short summary at the end. Exit codes: 0 found, 2 gave up, 3 timeout, 1 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+EXIT_FOUND, EXIT_BAD_INPUT, EXIT_GAVE_UP, EXIT_TIMEOUT = 0, 1, 2, 3
+_EXIT = {"found": EXIT_FOUND, "gave_up": EXIT_GAVE_UP, "timeout": EXIT_TIMEOUT}
+
+
+def register(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "simulate", help="run one object-search episode in a simulated world",
+        description="Run the switching planner in the loop on a simulated robot until the "
+                    "object is found, the search is hopeless, or the time budget is spent. "
+                    "Exit codes: 0 found, 1 bad input, 2 gave up, 3 timeout.")
+    parser.add_argument("--world", help="built-in world name or world YAML path (default: "
+                        "office, or the scenario's)")
+    parser.add_argument("--target", help="object label to find, e.g. cerealbox")
+    parser.add_argument("--scenario", help="a seed run a-f (or a scenario YAML path); "
+                        "other options override it")
+    parser.add_argument("--category", help="only an object in a room of this category")
+    parser.add_argument("--robot", choices=["pioneer", "pr2"])
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--start-room", help="start at the centre of this room")
+    where.add_argument("--start", help="start pose x,y,yaw (metres, radians)")
+    parser.add_argument("--seed", type=int, help="sensor noise seed (default 0)")
+    parser.add_argument("--time-budget", type=float, help="simulated seconds (default 1200)")
+    parser.add_argument("--out", default="avs-episode", help="output directory")
+    parser.add_argument("--json", action="store_true", help="print the summary as JSON")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from avs_planner.episode import EpisodeError, run_episode
+    from avs_planner.episode.scenarios import load_scenario
+
+    try:
+        base: dict[str, Any] = {}
+        if args.scenario:
+            base = load_scenario(args.scenario).spec
+        spec = _spec(args, base)
+    except (EpisodeError, ValueError) as exc:
+        print(f"avs: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    progress = _Progress(enabled=sys.stderr.isatty() or not args.json)
+    summary = run_episode(spec, progress, None)
+    progress.finish()
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        _print_summary(summary, Path(args.out))
+    return _EXIT.get(summary["outcome"], EXIT_TIMEOUT)
+
+
+def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
+    spec = dict(base)
+    for key, value in (("world", args.world), ("target", args.target),
+                       ("category", args.category), ("robot", args.robot),
+                       ("seed", args.seed), ("time_budget_s", args.time_budget)):
+        if value is not None:
+            spec[key] = value
+    if args.start_room:
+        spec.pop("start", None)
+        spec["start_room"] = args.start_room
+    if args.start:
+        spec.pop("start_room", None)
+        spec["start"] = _pose(args.start)
+    if not spec.get("target"):
+        raise ValueError("--target LABEL (or --scenario) is required")
+    spec["output_dir"] = args.out
+    return spec
+
+
+def _pose(text: str) -> list[float]:
+    parts = text.split(",")
+    try:
+        pose = [float(p) for p in parts]
+    except ValueError:
+        pose = []
+    if len(pose) != 3:
+        raise ValueError(f"--start {text!r}: expected x,y,yaw, e.g. 6.0,3.2,0")
+    return pose
+
+
+class _Progress:
+    """One overwritten status line on stderr: sim time, plans, the step being executed."""
+
+    def __init__(self, enabled: bool):
+        self.enabled = enabled
+        self.plans = 0
+        self.shown = False
+
+    def __call__(self, event: dict[str, Any]) -> None:
+        if event["type"] == "plan":
+            self.plans += 1
+        if not self.enabled or event["type"] not in ("plan", "action", "dt", "done"):
+            return
+        what = event.get("action") or event.get("result") or event.get("outcome") or ""
+        line = f"t={event['t']:7.1f}s  plans={self.plans:3d}  {event['type']:6s} {what}"
+        print("\r" + line[:100].ljust(100), end="", file=sys.stderr, flush=True)
+        self.shown = True
+
+    def finish(self) -> None:
+        if self.shown:
+            print(file=sys.stderr)
+
+
+def _print_summary(summary: dict[str, Any], out: Path) -> None:
+    obj = summary.get("object") or {}
+    found = (f"found {obj.get('label')} at ({obj['position'][0]:.2f}, {obj['position'][1]:.2f})"
+             f" in {obj.get('room')}" if obj else summary["outcome"].replace("_", " "))
+    cp = summary["cp_time_s"]
+    print(f"{summary['target']}: {found} ({summary['reason']})")
+    print(f"  simulated {summary['sim_time_s']:.1f} s, drove {summary['distance_m']:.1f} m, "
+          f"{summary['plans']} plans (CP {sum(cp):.2f} s), {summary['dt_calls']} DT searches, "
+          f"{summary['views_processed']} views, wall {summary['wall_time_s']:.1f} s")
+    print(f"  wrote {out / 'trace.jsonl'}, {out / 'summary.json'}, {out / 'trajectory.png'}")
