@@ -262,7 +262,7 @@ class _Search:
             expanded += 1
             if options.node_limit is not None and expanded > options.node_limit:
                 return self.finish(PlanStatus.NODE_LIMIT, None, expanded)
-            if options.timeout_s is not None and expanded % 64 == 0:
+            if options.timeout_s is not None:
                 if time.perf_counter() - self.start > options.timeout_s:
                     return self.finish(PlanStatus.TIMEOUT, None, expanded)
             last = self.via[node]
