@@ -1,0 +1,25 @@
+"""Fixtures for the episode tests: a mind that has looked around the office corridor once."""
+
+from __future__ import annotations
+
+import pytest
+
+from avs_planner.episode.executor import Executor
+from avs_planner.episode.mind import Mind
+from avs_planner.episode.robot import load_spec, open_world
+from avs_planner.episode.state_builder import SearchTask, StateBuilder
+from avs_planner.episode.viewcones import CameraModel
+
+
+@pytest.fixture(scope="module")
+def corridor_mind():
+    """Robot at the office corridor start, one look around; yields (mind, builder, robot)."""
+    robot = open_world(load_spec("office", start=(6.0, 3.2, 0.0)), seed=1)
+    mind = Mind()
+    builder = StateBuilder(mind, SearchTask("cerealbox"))
+    cam = robot.robot.model.camera
+    executor = Executor(robot, mind, builder, CameraModel(robot.camera_height, cam.hfov,
+                                                          cam.detect_range), lambda *a, **k: None)
+    executor.look_around()
+    yield mind, builder, robot
+    robot.world.close()

@@ -1,0 +1,46 @@
+"""`avs simulate`: bad input exits 1 with a message naming the problem; jobs call the runner."""
+
+from __future__ import annotations
+
+import pytest
+
+from avs_planner.cli import main
+from avs_planner.episode import EpisodeError, run_episode
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--target", "cerealbox", "--start", "1,2"], "expected x,y,yaw"),
+        (["--target", "cerealbox", "--world", "no_such_world"], "no_such_world"),
+        (["--target", "unicorn"], "unknown target label 'unicorn'"),
+        (["--world", "office"], "--target LABEL"),
+        (["--target", "cerealbox", "--start-room", "attic"], "attic"),
+        (["--scenario", "z"], "unknown scenario 'z'"),
+    ],
+)
+def test_bad_input_exits_1(argv, message, tmp_path, capsys) -> None:
+    code = main(["simulate", *argv, "--out", str(tmp_path)])
+    assert code == 1
+    assert message in capsys.readouterr().err
+
+
+def test_spec_errors_name_the_key() -> None:
+    with pytest.raises(EpisodeError, match="unknown keys"):
+        run_episode({"target": "cerealbox", "colour": "red"})
+    with pytest.raises(EpisodeError, match="'start' must be"):
+        run_episode({"target": "cerealbox", "start": [1, 2]})
+    with pytest.raises(EpisodeError, match="time_budget_s"):
+        run_episode({"target": "cerealbox", "time_budget_s": -1})
+
+
+def test_jobs_facade_runs_an_episode(tmp_path) -> None:
+    from avs_planner import jobs
+
+    events: list[dict] = []
+    summary = jobs.run_episode({"target": "cerealbox", "world": "office", "seed": 2,
+                                "task_id": "t1", "output_dir": str(tmp_path)},
+                               events.append, lambda: True)
+    assert summary["outcome"] == "timeout"
+    assert events[0]["type"] == "start" and events[-1]["type"] == "done"
+    assert (tmp_path / "trace.jsonl").exists() and (tmp_path / "summary.json").exists()
