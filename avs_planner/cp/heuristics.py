@@ -39,6 +39,8 @@ class RelaxedTask:
                 self.pre_of[f].append(i)
         self.no_pre = [i for i, pre in enumerate(self.pre) if not pre]
         self.goal = [i for i in range(self.n_facts) if task.goal >> i & 1]
+        self.is_goal = [bool(task.goal >> i & 1) for i in range(self.n_facts)]
+        self.pre_len = [len(p) for p in self.pre]
 
 
 def relaxed_costs(
@@ -48,34 +50,41 @@ def relaxed_costs(
     dist = [INF] * rt.n_facts
     support = [-1] * rt.n_facts
     heap: list[tuple[float, int]] = []
-    for f in range(rt.n_facts):
-        if state >> f & 1:
+    bits, f = state, 0
+    while bits:
+        if bits & 1:
             dist[f] = 0.0
             heap.append((0.0, f))
-    remaining = [len(p) for p in rt.pre]
-    value = [0.0] * len(rt.pre)
-
-    def fire(a: int, base: float) -> None:
-        nd = base + weights[a]
-        for g in rt.add[a]:
+        bits >>= 1
+        f += 1
+    remaining = rt.pre_len.copy()
+    value = [0.0] * len(remaining)
+    add, pre_of, push, pop = rt.add, rt.pre_of, heapq.heappush, heapq.heappop
+    for a in rt.no_pre:
+        nd = weights[a]
+        for g in add[a]:
             if nd < dist[g]:
                 dist[g] = nd
                 support[g] = a
-                heapq.heappush(heap, (nd, g))
-
-    for a in rt.no_pre:
-        fire(a, 0.0)
-    goals_left = set(rt.goal)
+                push(heap, (nd, g))
+    goals_left = len(rt.goal)
+    is_goal = rt.is_goal
     while heap and goals_left:
-        d, f = heapq.heappop(heap)
+        d, f = pop(heap)
         if d > dist[f]:
             continue
-        goals_left.discard(f)
-        for a in rt.pre_of[f]:
-            value[a] = max(value[a], d) if use_max else value[a] + d
+        if is_goal[f]:  # a goal fact's value is final once popped (popped once: d == dist)
+            goals_left -= 1
+        for a in pre_of[f]:
+            value[a] = (value[a] if value[a] > d else d) if use_max else value[a] + d
             remaining[a] -= 1
             if remaining[a] == 0:
-                fire(a, value[a])
+                nd = value[a] + weights[a]
+                for g in add[a]:
+                    if nd < dist[g]:
+                        dist[g] = nd
+                        support[g] = a
+                        push(heap, (nd, g))
     return dist, support
 
 

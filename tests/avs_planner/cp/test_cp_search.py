@@ -86,7 +86,6 @@ def test_seed_first_plan_from_corridor(corridor):
     assert result.cost == pytest.approx(56.0)
 
 
-@pytest.mark.slow
 def test_corridor_symmetry_pruning_keeps_the_optimum(corridor):
     with_sym = plan(corridor, SearchOptions(reward=500.0, heuristic="hmax", weight=1.0))
     without = plan(corridor, SearchOptions(
