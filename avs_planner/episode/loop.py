@@ -63,7 +63,7 @@ class SwitchingLoop:
         self.should_stop = should_stop or (lambda: False)
         self.result = LoopResult(Outcome.GAVE_UP, "")
         self.planner: ContinualPlanner | None = None
-        self._start_clock = executor.robot.clock
+        self.start_clock = executor.robot.clock
 
     def run(self) -> LoopResult:
         self.executor.look_around()
@@ -181,7 +181,7 @@ class SwitchingLoop:
         cfg = self.config
         if self.should_stop():
             return "stopped on request"
-        if self.executor.robot.clock - self._start_clock > cfg.time_budget_s:
+        if self.executor.robot.clock - self.start_clock > cfg.time_budget_s:
             return f"simulated time budget {cfg.time_budget_s:g} s spent"
         if self.trace.wall > cfg.wall_budget_s:
             return f"wall time budget {cfg.wall_budget_s:g} s spent"

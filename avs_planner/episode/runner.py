@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 import tempfile
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -147,7 +147,7 @@ class Episode:
             explore(self.executor)
             self.trace.emit("belief", pre_explored=True, places=len(self.mind.place_map.places),
                             rooms=len(self.mind.place_map.rooms))
-        self.loop._start_clock = self.robot.clock
+        self.loop.start_clock = self.robot.clock
         return self.robot.clock, self.executor.stats.distance
 
     def summary(self, result: LoopResult, start_clock: float, start_distance: float
@@ -188,7 +188,3 @@ class Episode:
         assert self.out is not None
         draw_trajectory(self.mind, self.executor.stats, self.out / "trajectory.png",
                         title=f"{self.spec.target} in {self.world_spec.name}")
-
-
-def with_output(spec: EpisodeSpec, out: str) -> EpisodeSpec:
-    return replace(spec, output_dir=out)
