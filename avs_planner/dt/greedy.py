@@ -37,12 +37,19 @@ LOOKAHEAD = 3
 def repeated_look_cost(problem: DTProblem, robot: int, cone: int, probs: Sequence[float],
                        looks: int) -> float:
     """Expected cost of going to `cone`, processing it `looks` times, then stopping as well as
-    possible. The belief after the looks depends only on the number of hits (and whether the
-    last look hit, which allows CONFIRM), so sequences are grouped by that."""
+    possible."""
+    return problem.travel_cost(robot, cone) + looks_then_stop_cost(problem, probs[cone],
+                                                                   probs[-1], looks)
+
+
+def looks_then_stop_cost(problem: DTProblem, p: float, p_none: float, looks: int) -> float:
+    """Expected cost of processing a cone with P(target) `p` `looks` times (P(nowhere) is
+    `p_none`), then stopping as well as possible. The belief after the looks depends only on
+    the number of hits (and whether the last look hit, which allows CONFIRM), so sequences are
+    grouped by that."""
     hit_in, hit_out = problem.detection_rates
     miss, wrong = problem.rewards.miss_penalty, problem.rewards.false_confirm_penalty
-    p, p_none = probs[cone], probs[-1]
-    cost = problem.travel_cost(robot, cone) + looks * problem.sensing_cost
+    cost = looks * problem.sensing_cost
     for hits in range(looks + 1):
         like_in = hit_in**hits * (1.0 - hit_in) ** (looks - hits)
         like_out = hit_out**hits * (1.0 - hit_out) ** (looks - hits)

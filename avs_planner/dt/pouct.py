@@ -27,6 +27,7 @@ from avs_planner.dt.rollout import (
     greedy_rollout_return,
     terminal_reward,
 )
+from avs_planner.dt.route import route_value
 
 TERMINAL_VISITS = 1_000_000  # CONFIRM/REJECT values are exact: never worth exploring
 
@@ -41,6 +42,8 @@ class SearchBudget:
     max_moves: int = 6  # MOVE branches per tree node: best P/cost cones (0: all)
     prior_visits: int = 1  # pseudo-visits given to the greedy lookahead value of a new action
     tree_depth: int = 2  # looks in the tree below the root; deeper is valued by rollouts
+    route_cones: int = 8  # up to this many relevant cones, leaves are valued by route-aware
+    # look sequences (exact expected cost); above it, by sampled greedy rollouts (cheaper)
 
 
 class ViewConePOUCT(pomdp_py.POUCT):
@@ -63,6 +66,8 @@ class ViewConePOUCT(pomdp_py.POUCT):
         self._max_moves = budget.max_moves
         self._prior_visits = budget.prior_visits
         self._tree_depth = budget.tree_depth or steps_left
+        self._route = len(problem.relevant_cones) <= budget.route_cones
+        self._leaf_values: dict[tuple, float] = {}
         self._root_belief: TargetBelief | None = None
         self._root_len = 0
         self._beliefs = {}
@@ -145,8 +150,23 @@ class ViewConePOUCT(pomdp_py.POUCT):
             self._problem, state, action)
 
     def _rollout(self, state, history, root, depth):
-        return greedy_rollout_return(self._problem, state, self._node_belief(history),
-                                     self._steps_left - depth, self._rng)
+        belief = self._node_belief(history)
+        if self._route:
+            return self._route_leaf_value(belief, self._steps_left - depth)
+        return greedy_rollout_return(self._problem, state, belief, self._steps_left - depth,
+                                     self._rng)
+
+    def _route_leaf_value(self, belief: TargetBelief, steps_left: int) -> float:
+        """Value of the better of stopping and the best route-aware look sequence (exact
+        expectation under the node's belief, memoised per belief)."""
+        key = (belief.key, steps_left)
+        value = self._leaf_values.get(key)
+        if value is None:
+            stop = stop_choice(self._problem, belief.robot, belief.detected, belief.probs)[0]
+            value = -route_value(self._problem, belief.robot, belief.probs, belief.after_move,
+                                 steps_left, stop)
+            self._leaf_values[key] = value
+        return value
 
 
 class POUCTPolicy:
