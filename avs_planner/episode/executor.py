@@ -62,7 +62,8 @@ class ExecutorConfig:
     # the camera's own 0.2 / 0.05
     detector: DetectorModel = field(
         default_factory=lambda: DetectorModel(false_negative=0.36, false_positive=0.01))
-    agree: float = 0.6
+    agree: tuple[float, float] = (0.25, 0.6)  # m, for the target / for supports (whose
+    # detected centre moves with the part in view)
     squeeze: float = 0.08  # m less clearance when no path keeps the full margin
     miss_penalty: float = 500.0  # s of robot time: the CP's goal reward R
     support_radius: float = 0.9  # m: a detection this near a support is "on" it
@@ -308,8 +309,8 @@ class Executor:
             self.emit("observation", label=label, detected=False)
             return None
         again = self._detect_once(label, relation, location)
-        agreed = again is not None and math.dist(again.position, match.position) <= \
-            self.config.agree
+        agree = self.config.agree[0 if label == self.builder.task.target else 1]
+        agreed = again is not None and math.dist(again.position, match.position) <= agree
         self.emit("observation", label=label, detected=agreed,
                   position=[round(v, 2) for v in match.position])
         return match if agreed else None
