@@ -209,13 +209,19 @@ class Executor:
         return StepOutcome(StepStatus.FAILED, "too many legs")
 
     def _squeeze(self, start: tuple[float, float], goal: tuple[float, float]):  # noqa: ANN202
-        """A path with a slimmer margin (the robot may start close to furniture); the
-        simulator still refuses any motion that would collide."""
-        radius = self.mind.config.robot_radius - self.config.squeeze
-        try:
-            return plan_path(self.mind.grid, start, goal, radius)
-        except MapError:
-            return plan_path(self.mind.grid, start, start, radius)
+        """A path with a slimmer margin (the robot may start close to furniture), then one
+        through unknown cells (a laser mounted ahead of the base never sees the cells under
+        and behind it); the simulator still refuses any motion that would collide."""
+        radius = self.mind.config.robot_radius
+        tries = ((radius - self.config.squeeze, False), (radius, True))
+        for margin, unknown in tries:
+            try:
+                path = plan_path(self.mind.grid, start, goal, margin, allow_unknown=unknown)
+            except MapError:
+                continue
+            if path.found:
+                return path
+        return plan_path(self.mind.grid, start, start, radius, allow_unknown=True)
 
     def _free_near(self, goal: tuple[float, float], reach: float = 0.6
                    ) -> tuple[float, float] | None:

@@ -38,3 +38,10 @@ def test_an_unseen_floor_plan() -> None:
     summary = run_episode({"target": "cerealbox", "world": str(DATA / "flat_unseen.yaml"),
                            "seed": 1}, None, None)
     assert summary["outcome"] == "found" and summary["object"]["truth"] == "cereal9"
+
+
+@pytest.mark.slow
+def test_the_pr2_finds_the_cereal_box_too() -> None:
+    summary = run_episode(load_scenario("a").episode_spec(seed=1, robot="pr2"), None, None)
+    assert summary["robot"] == "pr2"
+    assert summary["outcome"] == "found" and summary["correct"]
