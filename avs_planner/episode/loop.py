@@ -35,7 +35,7 @@ class LoopConfig:
     weight: float = 3.0
     heuristic: str = "hadd"  # on these problems far fewer expansions than ff
     min_success: float = 0.01
-    cp_timeout_s: float = 4.0
+    cp_timeout_s: float = 2.5
     fallback_weight: float = 20.0
     time_budget_s: float = 1200.0
     wall_budget_s: float = 600.0
