@@ -10,44 +10,21 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from enum import Enum
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
 from avs_planner.cp.search import PlanStep
-from avs_planner.cp.task import Atom
-from avs_planner.dt import DetectorModel, DTRewards, DTSession, DTStatus, SearchBudget
-from avs_planner.dt.domain import ActionKind
-from avs_planner.episode.mind import KnownObject, Mind
+from avs_planner.dt import DetectorModel
+from avs_planner.episode.dt_search import ViewConeSearch
+from avs_planner.episode.mind import Mind
+from avs_planner.episode.outcome import StepOutcome, StepStatus
 from avs_planner.episode.state_builder import AvsState, StateBuilder
 from avs_planner.episode.viewcones import CameraModel, ConeSet, room_cones, support_cones
 from conceptual_map.errors import MapError
 from conceptual_map.metric import distance_field, plan_path
 
 Event = Callable[..., None]
-
-
-class SeenLike(Protocol):
-    label: str
-    position: tuple[float, float, float]
-    id: int
-
-
-class StepStatus(Enum):
-    DONE = "done"
-    FAILED = "failed"
-    FOUND = "found"  # REPORTPOSITION of a confirmed object
-
-
-@dataclass
-class StepOutcome:
-    """What one executed step did; `observed` holds atoms about newly confirmed objects."""
-
-    status: StepStatus
-    detail: str = ""
-    observed: dict[str, set[Atom]] = field(default_factory=dict)
-    reported: KnownObject | None = None
 
 
 @dataclass
@@ -277,89 +254,8 @@ class Executor:
         return StepOutcome(StepStatus.DONE, f"{len(made.cones)} cones")
 
     def search(self, label: str, relation: str, location: str) -> StepOutcome:
-        made = self.cones.get((label, relation, location))
-        if made is None or not made.cones:
-            return StepOutcome(StepStatus.FAILED, "no view cones for this search")
-        self.stats.dt_calls += 1
-        session = DTSession(made.cones, self.config.detector, self.robot.pose,
-                            policy=self.config.dt_policy,
-                            budget=SearchBudget(num_sims=self.config.dt_sims),
-                            rewards=DTRewards(self.config.miss_penalty,
-                                              self.config.miss_penalty),
-                            seed=self.seed + self.stats.dt_calls)
-        while True:
-            action = session.next_action()
-            if session.finished:
-                break
-            cone = session.cone(action)
-            if action.kind is ActionKind.MOVE:
-                self.drive_to(cone.pose[:2])
-                self.robot.turn_to(cone.pose[2])
-                self.robot.look(*(cone.head or (0.0, 0.0)))
-                session.update(action)
-                continue
-            match = self._look(label, relation, location)
-            session.update(action, match is not None, detection=match)
-        result = session.result
-        self.stats.dt_decisions.extend(result.decision_times_s)
-        self.emit("dt", label=label, relation=relation, location=location,
-                  result=result.status.value, probability=round(result.probability, 4),
-                  steps=len(result.trace), cones=len(made.cones))
-        return self._conclude(result, label, relation, location, made)
-
-    def _look(self, label: str, relation: str, location: str) -> SeenLike | None:
-        """PROCESSVIEWCONE: a detection in the searched location, seen twice."""
-        self.stats.views += 1
-        match = self._detect_once(label, relation, location)
-        if match is None:
-            self.emit("observation", label=label, detected=False)
-            return None
-        again = self._detect_once(label, relation, location)
-        agree = self.config.agree[0 if label == self.builder.task.target else 1]
-        agreed = again is not None and math.dist(again.position, match.position) <= agree
-        self.emit("observation", label=label, detected=agreed,
-                  position=[round(v, 2) for v in match.position])
-        return match if agreed else None
-
-    def _detect_once(self, label: str, relation: str, location: str) -> SeenLike | None:
-        seen = [s for s in self.robot.detect([label]) if s.label == label]
-        matches = [s for s in seen if self._inside(s, relation, location)]
-        for s in seen:
-            self.stats.detections.append((s.position[0], s.position[1], label, s in matches))
-        return matches[0] if matches else None
-
-    def _inside(self, seen: SeenLike, relation: str, location: str) -> bool:
-        if relation == "on":
-            support = self.mind.objects[location]
-            top = 2.0 * support.position[2]
-            low, high = self.config.above_support
-            near = math.dist(seen.position[:2], support.position[:2]) <= self.config.support_radius
-            return near and top + low <= seen.position[2] <= top + high
-        return self.mind.room_at(seen.position[:2]) == location
-
-    def _conclude(self, result, label: str, relation: str, location: str,  # noqa: ANN001
-                  made: ConeSet) -> StepOutcome:
-        if result.status is DTStatus.CONFIRMED and result.detection is not None:
-            seen = result.detection
-            support = location if relation == "on" else None
-            obj = self.mind.add_object(label, seen.position, support)
-            self.found_sids[obj.id] = seen.id
-            atoms = {("label-of", obj.id, label), ("detected", obj.id),
-                     ("related", obj.id, relation, location)}
-            return StepOutcome(StepStatus.DONE, f"confirmed {obj.id}", {obj.id: atoms})
-        looked = {s.action.cone for s in result.trace if s.action.kind is not ActionKind.MOVE}
-        mass = sum(made.cones[i].probability for i in looked)
-        coverage = made.coverage * mass / made.probability if made.probability > 0 else 0.0
-        if coverage > 0.0:
-            p_detect = 1.0 - self.config.detector.false_negative
-            self.mind.failed_search(label, relation, location, coverage, p_detect)
-        if relation == "on":
-            self.builder.failed_on.add((label, location))
-        else:
-            key = (label, location)
-            self.builder.failed_in[key] = self.builder.failed_in.get(key, 0) + 1
-        return StepOutcome(StepStatus.DONE, "rejected" if coverage > 0 else
-                           "rejected without looking")
+        """SEARCHFOROBJECT: a DT session over the cones CREATEVIEWCONES made."""
+        return ViewConeSearch(self, label, relation, location).run()
 
 
 def _first_leg(waypoints: tuple[tuple[float, float], ...], step: float

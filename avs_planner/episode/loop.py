@@ -15,8 +15,9 @@ from typing import Any
 
 from avs_planner.cp.continual import ContinualPlanner, Decision
 from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep, SearchOptions
-from avs_planner.episode.executor import Executor, StepOutcome, StepStatus
+from avs_planner.episode.executor import Executor
 from avs_planner.episode.mind import KnownObject
+from avs_planner.episode.outcome import StepOutcome, StepStatus
 from avs_planner.episode.state_builder import AvsState, StateBuilder
 from avs_planner.episode.trace import Trace
 

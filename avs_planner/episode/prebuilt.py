@@ -3,7 +3,8 @@ with the executor's own sensing, so the maps and the conceptual map are the robo
 
 from __future__ import annotations
 
-from avs_planner.episode.executor import Executor, StepStatus
+from avs_planner.episode.executor import Executor
+from avs_planner.episode.outcome import StepStatus
 
 
 def explore(executor: Executor, max_moves: int = 60) -> int:

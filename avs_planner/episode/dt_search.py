@@ -1,0 +1,114 @@
+"""SEARCHFOROBJECT: a closed-loop DT session over the view cones, against the robot's detector.
+
+MOVE actions drive to a cone's pose and point the head; PROCESSVIEWCONE looks twice (a
+detection counts when both frames agree); a confirmation becomes a known object, a rejection
+becomes failed-search evidence in the conceptual map (coverage of the cones looked through).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from avs_planner.dt import DTRewards, DTSession, DTStatus, SearchBudget
+from avs_planner.dt.domain import ActionKind
+from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
+from avs_planner.episode.viewcones import ConeSet
+
+if TYPE_CHECKING:
+    from avs_planner.episode.executor import Executor
+
+
+class ViewConeSearch:
+    """One SEARCHFOROBJECT for `label` `relation` `location` run by an executor."""
+
+    def __init__(self, executor: Executor, label: str, relation: str, location: str):
+        self.ex = executor
+        self.label, self.relation, self.location = label, relation, location
+
+    def run(self) -> StepOutcome:
+        label, relation, location = self.label, self.relation, self.location
+        made = self.ex.cones.get((label, relation, location))
+        if made is None or not made.cones:
+            return StepOutcome(StepStatus.FAILED, "no view cones for this search")
+        self.ex.stats.dt_calls += 1
+        session = DTSession(made.cones, self.ex.config.detector, self.ex.robot.pose,
+                            policy=self.ex.config.dt_policy,
+                            budget=SearchBudget(num_sims=self.ex.config.dt_sims),
+                            rewards=DTRewards(self.ex.config.miss_penalty,
+                                              self.ex.config.miss_penalty),
+                            seed=self.ex.seed + self.ex.stats.dt_calls)
+        while True:
+            action = session.next_action()
+            if session.finished:
+                break
+            cone = session.cone(action)
+            if action.kind is ActionKind.MOVE:
+                self.ex.drive_to(cone.pose[:2])
+                self.ex.robot.turn_to(cone.pose[2])
+                self.ex.robot.look(*(cone.head or (0.0, 0.0)))
+                session.update(action)
+                continue
+            match = self._look(label, relation, location)
+            session.update(action, match is not None, detection=match)
+        result = session.result
+        self.ex.stats.dt_decisions.extend(result.decision_times_s)
+        self.ex.emit("dt", label=label, relation=relation, location=location,
+                     result=result.status.value, probability=round(result.probability, 4),
+                     steps=len(result.trace), cones=len(made.cones))
+        return self._conclude(result, label, relation, location, made)
+
+    def _look(self, label: str, relation: str, location: str) -> SeenLike | None:
+        """PROCESSVIEWCONE: a detection in the searched location, seen twice."""
+        self.ex.stats.views += 1
+        match = self._detect_once(label, relation, location)
+        if match is None:
+            self.ex.emit("observation", label=label, detected=False)
+            return None
+        again = self._detect_once(label, relation, location)
+        agree = self.ex.config.agree[0 if label == self.ex.builder.task.target else 1]
+        agreed = again is not None and math.dist(again.position, match.position) <= agree
+        self.ex.emit("observation", label=label, detected=agreed,
+                  position=[round(v, 2) for v in match.position])
+        return match if agreed else None
+
+    def _detect_once(self, label: str, relation: str, location: str) -> SeenLike | None:
+        seen = [s for s in self.ex.robot.detect([label]) if s.label == label]
+        matches = [s for s in seen if self._inside(s, relation, location)]
+        for s in seen:
+            self.ex.stats.detections.append((s.position[0], s.position[1], label, s in matches))
+        return matches[0] if matches else None
+
+    def _inside(self, seen: SeenLike, relation: str, location: str) -> bool:
+        if relation == "on":
+            support = self.ex.mind.objects[location]
+            top = 2.0 * support.position[2]
+            low, high = self.ex.config.above_support
+            reach = self.ex.config.support_radius
+            near = math.dist(seen.position[:2], support.position[:2]) <= reach
+            return near and top + low <= seen.position[2] <= top + high
+        return self.ex.mind.room_at(seen.position[:2]) == location
+
+    def _conclude(self, result, label: str, relation: str, location: str,  # noqa: ANN001
+                  made: ConeSet) -> StepOutcome:
+        if result.status is DTStatus.CONFIRMED and result.detection is not None:
+            seen = result.detection
+            support = location if relation == "on" else None
+            obj = self.ex.mind.add_object(label, seen.position, support)
+            self.ex.found_sids[obj.id] = seen.id
+            atoms = {("label-of", obj.id, label), ("detected", obj.id),
+                     ("related", obj.id, relation, location)}
+            return StepOutcome(StepStatus.DONE, f"confirmed {obj.id}", {obj.id: atoms})
+        looked = {s.action.cone for s in result.trace if s.action.kind is not ActionKind.MOVE}
+        mass = sum(made.cones[i].probability for i in looked)
+        coverage = made.coverage * mass / made.probability if made.probability > 0 else 0.0
+        if coverage > 0.0:
+            p_detect = 1.0 - self.ex.config.detector.false_negative
+            self.ex.mind.failed_search(label, relation, location, coverage, p_detect)
+        if relation == "on":
+            self.ex.builder.failed_on.add((label, location))
+        else:
+            key = (label, location)
+            self.ex.builder.failed_in[key] = self.ex.builder.failed_in.get(key, 0) + 1
+        return StepOutcome(StepStatus.DONE, "rejected" if coverage > 0 else
+                           "rejected without looking")
