@@ -1,14 +1,14 @@
 """Continual planner vs Fast Downward lama-first (through UP), same run, per instance.
 
-Run: `.venv/bin/python -m bench.cp_bench [--quick]`. Instances: the AVS problems in
-domains/avs/problems, generated AVS problems of growing size (bench/avs_generator.py) and the
-IPC instances in /work/shared/ipc. Per instance it prints both times, their ratio (FD / ours,
-> 1 means we are faster), both plans' cost and, for AVS, both plans' true objective
-c + R(1 - p). FD cannot read probabilities, so for it each ground action's cost becomes
-round(100 (c + R (-ln p))) through a per-action cost fluent. Our time is `planning_time_s`
-(grounding + search, cold grounding cache) and, for AVS, also a warm replan (cache hit).
-FD's time is the wall time of `OneshotPlanner.solve` (writing PDDL, translate, search).
-Both plans are checked with UP's sequential plan validator.
+Run: `.venv/bin/python -m bench.cp_bench [--quick | --full]` (default ~2 min; --full ~4).
+Instances: the AVS problems in domains/avs/problems, generated AVS problems of growing size
+(bench/avs_generator.py) and IPC instances from /work/shared/ipc. Per instance it prints both
+times, their ratio (FD / ours, > 1 means we are faster), both plans' cost and, for AVS, both
+plans' true objective c + R(1 - p). FD cannot read probabilities, so for it each ground
+action's cost becomes round(100 (c + R (-ln p))) through a per-action cost fluent. Our time is
+`planning_time_s` (grounding + search, cold grounding cache) and, for AVS, also a warm replan
+(cache hit). FD's time is the wall time of `OneshotPlanner.solve` (writing PDDL, translate,
+search). Our plans are checked with UP's sequential plan validator.
 """
 
 from __future__ import annotations
@@ -43,13 +43,13 @@ OPTIONS = SearchOptions(reward=REWARD, weight=2.0, heuristic="ff", timeout_s=TIM
 SIZES = (AvsSize(8, 2, 2, 4), AvsSize(12, 3, 3, 6), AvsSize(20, 5, 4, 8))
 
 
-def avs_cases(quick: bool) -> list[tuple[str, ProbabilisticProblem]]:
+def avs_cases(quick: bool, full: bool = False) -> list[tuple[str, ProbabilisticProblem]]:
     domain_text = (ROOT / "domains/avs/domain.pddl").read_text()
     cases = [
         (f"avs/{p.stem}", read_text(domain_text, p.read_text(), "domain.pddl", p.name))
         for p in sorted((ROOT / "domains/avs/problems").glob("*.pddl"))
     ]
-    seeds = (0,) if quick else (0, 1, 2)
+    seeds = (0,) if quick else (0, 1, 2) if full else (0, 2)
     for size in SIZES[:2] if quick else SIZES:
         for seed in seeds:
             text = generate(size, seed)
@@ -58,12 +58,12 @@ def avs_cases(quick: bool) -> list[tuple[str, ProbabilisticProblem]]:
     return cases
 
 
-def ipc_cases(quick: bool) -> list[tuple[str, ProbabilisticProblem]]:
+def ipc_cases(quick: bool, full: bool = False) -> list[tuple[str, ProbabilisticProblem]]:
     cases = []
     for domain in sorted(IPC.glob("*/domain.pddl")):
         instances = sorted(domain.parent.glob("instance-*.pddl"),
                            key=lambda p: int(p.stem.split("-")[1]))
-        for problem in instances[:2] if quick else instances:
+        for problem in instances if full else instances[:2] if quick else instances[::2]:
             up = PDDLReader().parse_problem(str(domain), str(problem))
             cases.append((f"{domain.parent.name}/{problem.stem}", ProbabilisticProblem(up)))
     return cases
@@ -205,6 +205,8 @@ def grounding_times(quick: bool) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer instances")
+    parser.add_argument("--full", action="store_true",
+                        help="every IPC instance and three seeds per size (~4 min)")
     parser.add_argument("--grounding-only", action="store_true",
                         help="only compare the grounders")
     args = parser.parse_args()
@@ -214,9 +216,9 @@ def main() -> None:
         return
     print(f"options: R={OPTIONS.reward} w={OPTIONS.weight} h={OPTIONS.heuristic} "
           f"timeout={OPTIONS.timeout_s}s; FD: lama-first through UP")
-    avs = [bench_case(label, p, True) for label, p in avs_cases(args.quick)]
+    avs = [bench_case(label, p, True) for label, p in avs_cases(args.quick, args.full)]
     report(avs, "AVS problems (probabilistic; FD on -ln p costs)", True)
-    ipc = [bench_case(label, p, False) for label, p in ipc_cases(args.quick)]
+    ipc = [bench_case(label, p, False) for label, p in ipc_cases(args.quick, args.full)]
     report(ipc, "IPC instances (deterministic)", False)
 
 
