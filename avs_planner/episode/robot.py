@@ -13,10 +13,13 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from matplotlib.path import Path as MplPath
+
 from avs_planner.episode.errors import EpisodeError
 from sim import World, load_world_spec
 from sim.errors import MotionError, SimError
-from sim.world_spec import WorldSpec
+from sim.robot_models import ROBOT_MODELS
+from sim.world_spec import RoomSpec, WorldSpec
 
 
 @dataclass(frozen=True)
@@ -109,7 +112,7 @@ def load_spec(world: str | Path, robot: str | None = None, start: Sequence[float
         if room is None:
             raise EpisodeError(f"--start-room {start_room!r}: the world has rooms "
                                f"{', '.join(r.name for r in spec.rooms)}")
-        pose = (*room.center, 0.0)
+        pose = (*free_spot(spec, room, robot or spec.robot.model), 0.0)
     if start is not None:
         if len(start) != 3 or not all(math.isfinite(float(v)) for v in start):
             raise EpisodeError(f"start pose must be x,y,yaw (3 finite numbers), got {start!r}")
@@ -121,6 +124,28 @@ def load_spec(world: str | Path, robot: str | None = None, start: Sequence[float
             raise EpisodeError(f"closed door index {i}: the world has {len(doors)} doors")
         doors[i] = dataclasses.replace(doors[i], open=False)
     return dataclasses.replace(spec, robot=robot_spec, doors=tuple(doors))
+
+
+def free_spot(spec: WorldSpec, room: RoomSpec, model: str,
+              step: float = 0.25) -> tuple[float, float]:
+    """The point nearest the room's centre where the robot's footprint touches nothing."""
+    radius = ROBOT_MODELS[model].footprint_radius + 0.1 if model in ROBOT_MODELS else 0.5
+    x0, y0, x1, y1 = room.rect
+    cx, cy = room.center
+    xs = [x0 + radius + spec.wall_thickness + k * step
+          for k in range(int((x1 - x0) / step) + 1)]
+    ys = [y0 + radius + spec.wall_thickness + k * step
+          for k in range(int((y1 - y0) / step) + 1)]
+    spots = sorted(((x, y) for x in xs for y in ys
+                    if x <= x1 - radius - spec.wall_thickness
+                    and y <= y1 - radius - spec.wall_thickness),
+                   key=lambda p: math.dist(p, (cx, cy)))
+    boxes = [MplPath(f.footprint()) for f in spec.furniture]
+    for spot in spots:
+        if not any(box.contains_point(spot, radius=2 * radius) or
+                   box.contains_point(spot, radius=-2 * radius) for box in boxes):
+            return spot
+    raise EpisodeError(f"room {room.name!r} has no spot free for the robot to start in")
 
 
 def open_world(spec: WorldSpec, seed: int) -> SimRobot:

@@ -116,9 +116,12 @@ class Episode:
         if spec.world_text is None:
             return load_spec(spec.world, spec.robot, spec.start, spec.start_room)
         with tempfile.TemporaryDirectory() as tmp:
-            path = Path(tmp) / "world.yaml"
+            path = Path(tmp) / "world_file.yaml"
             path.write_text(spec.world_text, encoding="utf-8")
-            return load_spec(path, spec.robot, spec.start, spec.start_room)
+            try:
+                return load_spec(path, spec.robot, spec.start, spec.start_room)
+            except EpisodeError as exc:  # name the spec key, not the temporary file
+                raise EpisodeError(str(exc).replace(str(path), "world_file")) from None
 
     def _emit(self, type_: str, **fields: Any) -> None:
         self.trace.emit(type_, **fields)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from avs_planner.cli import main
@@ -44,3 +46,17 @@ def test_jobs_facade_runs_an_episode(tmp_path) -> None:
     assert summary["outcome"] == "timeout"
     assert events[0]["type"] == "start" and events[-1]["type"] == "done"
     assert (tmp_path / "trace.jsonl").exists() and (tmp_path / "summary.json").exists()
+
+
+def test_inline_world_file_and_start_room(tmp_path) -> None:
+    world = (Path(__file__).parent / "data" / "flat_unseen.yaml").read_text()
+    summary = run_episode({"target": "cerealbox", "world": None, "world_file": world,
+                           "start_room": "lounge", "robot": "pioneer", "category": None,
+                           "start": None, "seed": 0, "time_budget_s": 600.0},
+                          None, lambda: True)
+    assert summary["world"] == "flat_unseen" and summary["outcome"] == "timeout"
+
+
+def test_broken_inline_world_names_the_entry() -> None:
+    with pytest.raises(EpisodeError, match="^world_file: .*robot"):
+        run_episode({"target": "cerealbox", "world_file": "name: x\nsize: [1, 1]\n"})
