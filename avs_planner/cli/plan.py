@@ -5,18 +5,18 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from typing import TYPE_CHECKING
 
-from avs_planner.cp.heuristics import HEURISTICS
-from avs_planner.cp.planner import plan
-from avs_planner.cp.search import DEFAULT_REWARD, PlanResult, PlanStatus, SearchOptions
-from avs_planner.pddl import read_files
+if TYPE_CHECKING:  # the planner loads unified-planning: import it only when the command runs
+    from avs_planner.cp.search import PlanResult
 
+# Exit code per PlanStatus value.
 EXIT_CODES = {
-    PlanStatus.SOLVED: 0,
-    PlanStatus.UNSOLVABLE: 2,
-    PlanStatus.NO_PLAN_ABOVE_THRESHOLD: 2,
-    PlanStatus.TIMEOUT: 3,
-    PlanStatus.NODE_LIMIT: 3,
+    "solved": 0,
+    "unsolvable": 2,
+    "no_plan_above_threshold": 2,
+    "timeout": 3,
+    "node_limit": 3,
 }
 
 
@@ -31,26 +31,33 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("domain", help="domain PDDL file")
     parser.add_argument("problem", help="problem PDDL file")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--reward", type=float, default=DEFAULT_REWARD, help="goal reward R")
-    parser.add_argument("--weight", type=float, default=SearchOptions.weight,
-                        help="weight w >= 1 on the remaining cost estimate (1: A*)")
+    parser.add_argument("--reward", type=float, default=None,
+                        help="goal reward R (default 500)")
+    parser.add_argument("--weight", type=float, default=None,
+                        help="weight w >= 1 on the remaining cost estimate (1: A*; default 2)")
     parser.add_argument("--timeout", type=float, default=None, help="seconds (default: none)")
     parser.add_argument("--node-limit", type=int, default=None, help="max expanded states")
-    parser.add_argument("--heuristic", choices=sorted(HEURISTICS), default="ff")
+    parser.add_argument("--heuristic", default="ff",
+                        help="hmax (admissible), hadd, ff (default) or blind")
     parser.add_argument("--min-success", type=float, default=0.0,
                         help="give up if the best plan's success probability is below this")
     parser.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    from avs_planner.cp.planner import plan
+    from avs_planner.cp.search import SearchOptions
+    from avs_planner.pddl import read_files
+
+    given = {"reward": args.reward, "weight": args.weight}
     options = SearchOptions(
-        reward=args.reward, weight=args.weight, heuristic=args.heuristic,
-        timeout_s=args.timeout, node_limit=args.node_limit, min_success=args.min_success,
+        heuristic=args.heuristic, timeout_s=args.timeout, node_limit=args.node_limit,
+        min_success=args.min_success, **{k: v for k, v in given.items() if v is not None},
     ).check()
     pproblem = read_files(args.domain, args.problem)
     result = plan(pproblem, options)
     print(json.dumps(result.as_json()) if args.json else _text(result))
-    return EXIT_CODES[result.status]
+    return EXIT_CODES[result.status.value]
 
 
 def _text(result: PlanResult) -> str:
