@@ -27,7 +27,7 @@ from avs_planner.dt.rollout import (
     greedy_rollout_return,
     terminal_reward,
 )
-from avs_planner.dt.route import route_value
+from avs_planner.dt.route import best_sequence, route_value
 
 TERMINAL_VISITS = 1_000_000  # CONFIRM/REJECT values are exact: never worth exploring
 
@@ -42,8 +42,10 @@ class SearchBudget:
     max_moves: int = 6  # MOVE branches per tree node: best P/cost cones (0: all)
     prior_visits: int = 1  # pseudo-visits given to the greedy lookahead value of a new action
     tree_depth: int = 2  # looks in the tree below the root; deeper is valued by rollouts
-    route_cones: int = 8  # up to this many relevant cones, leaves are valued by route-aware
-    # look sequences (exact expected cost); above it, by sampled greedy rollouts (cheaper)
+    max_backup: bool = True  # a node returns its best action's value to its parent, not the
+    # sampled return (mean backups of exploring simulations undervalue looking again)
+    route_leaves: bool = True  # leaves valued by route-aware look sequences (exact expected
+    # cost, `avs_planner.dt.route`); False: by sampled greedy p/cost rollouts
 
 
 class ViewConePOUCT(pomdp_py.POUCT):
@@ -66,7 +68,8 @@ class ViewConePOUCT(pomdp_py.POUCT):
         self._max_moves = budget.max_moves
         self._prior_visits = budget.prior_visits
         self._tree_depth = budget.tree_depth or steps_left
-        self._route = len(problem.relevant_cones) <= budget.route_cones
+        self._route = budget.route_leaves
+        self._max_backup = budget.max_backup
         self._leaf_values: dict[tuple, float] = {}
         self._root_belief: TargetBelief | None = None
         self._root_len = 0
@@ -110,13 +113,19 @@ class ViewConePOUCT(pomdp_py.POUCT):
     def _action_prior(self, belief: TargetBelief, action, steps_left: int) -> tuple[int, float]:
         """(pseudo-visits, initial value) of a new tree action. CONFIRM/REJECT values are exact
         (expected penalty under the node's belief), so they never need simulating; MOVE and
-        PROCESSVIEWCONE start at the value of the greedy plan "look there up to LOOKAHEAD times,
-        then stop", a value that is achievable, weighted like `prior_visits` simulations."""
+        PROCESSVIEWCONE start at an achievable value weighted like `prior_visits` simulations:
+        the best route-aware look sequence starting there (with `route_leaves`), else the
+        greedy plan "look there up to LOOKAHEAD times, then stop"."""
         if action.terminal:
             return TERMINAL_VISITS, expected_terminal_reward(self._problem, belief, action)
         if self._prior_visits <= 0:
             return 0, 0.0
         moving = 1 if action.kind is ActionKind.MOVE else 0
+        if self._route and steps_left - moving >= 1:
+            sequence = best_sequence(self._problem, belief.robot, belief.probs, steps_left,
+                                     forced_first=action.cone)
+            if sequence is not None:
+                return self._prior_visits, -sequence.cost
         looks = min(LOOKAHEAD, steps_left - moving)
         if looks < 1:
             return self._prior_visits, -stop_choice(self._problem, belief.robot, belief.detected,
@@ -132,7 +141,12 @@ class ViewConePOUCT(pomdp_py.POUCT):
             return stop_choice(self._problem, belief.robot, belief.detected, belief.probs)[0] * -1
         if self._tree_level(history) >= self._tree_depth:  # below the tree: greedy rollout
             return self._rollout(state, history, None, depth)
-        return super()._simulate(state, history, root, parent, observation, depth)
+        value = super()._simulate(state, history, root, parent, observation, depth)
+        if self._max_backup and root is not None:
+            visited = [q.value for q in root.children.values() if q.num_visits > 0]
+            if visited:
+                return max(visited)
+        return value
 
     def _tree_level(self, history: tuple) -> int:
         """Decisions below the root, not counting MOVEs: a MOVE's only continuation is the
@@ -192,3 +206,19 @@ class POUCTPolicy:
         self.agent.update(action, observation)
         if self._planner is not None and getattr(self.agent, "tree", None) is not None:
             self._planner.update(self.agent, action, observation)
+
+
+def pouct_decision_rule(problem: DTProblem, seed: int = 0, budget: SearchBudget | None = None):
+    """POUCT as a deterministic function of (belief, steps_left): a fresh search per decision,
+    seeded by the belief. Without tree reuse it is slightly weaker than `POUCTPolicy`, but
+    `evaluate_policy` can compute its exact expected cost (no Monte Carlo noise)."""
+    budget = budget or SearchBudget()
+
+    def decide(belief: TargetBelief, steps_left: int) -> DTAction:
+        if steps_left <= 0:  # as in a session: only the best stop is left
+            return stop_choice(problem, belief.robot, belief.detected, belief.probs)[1]
+        rng = random.Random(hash((seed, belief.key, steps_left)))
+        agent = ViewConeAgent(problem, rng, belief)
+        return ViewConePOUCT(problem, rng, steps_left, budget).plan_from(agent, belief)
+
+    return decide

@@ -16,10 +16,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from avs_planner.dt.domain import START
-from avs_planner.dt.greedy import looks_then_stop_cost
 from avs_planner.dt.problem import DTProblem
-
-CONFIRM_LOOKS = 2  # extra looks considered after a detection before confirming or rejecting
 
 
 @dataclass(frozen=True)
@@ -32,12 +29,30 @@ class LookSequence:
 
 def detected_cost(problem: DTProblem, p: float, p_none: float, steps_left: float) -> float:
     """Cheapest expected cost right after a detection at a cone with posterior `p` (nowhere:
-    `p_none`): confirm, reject, or look again 1..CONFIRM_LOOKS times and then stop."""
-    rewards = problem.rewards
-    best = min(rewards.false_confirm_penalty * (1.0 - p), rewards.miss_penalty * (1.0 - p_none))
-    for looks in range(1, int(min(CONFIRM_LOOKS, steps_left)) + 1):
-        best = min(best, looks_then_stop_cost(problem, p, p_none, looks))
-    return best
+    `p_none`): confirm, reject, or look again once or twice and then stop. Closed form of
+    `min(looks_then_stop_cost(.., k))` for k <= 2 (it runs at every step of every sequence)."""
+    miss, wrong = problem.rewards.miss_penalty, problem.rewards.false_confirm_penalty
+    best = min(wrong * (1.0 - p), miss * (1.0 - p_none))
+    if steps_left < 1:
+        return best
+    a, b = problem.detection_rates
+    p_out, sensing = 1.0 - p, problem.sensing_cost
+    # joint P(target in cone | nowhere, outcome) for each hit pattern of up to two looks
+    hit_in, hit_none, hit_z = p * a, p_none * b, p * a + p_out * b
+    miss_in, miss_none, miss_z = p - hit_in, p_none - hit_none, 1.0 - hit_z
+
+    def stop_hit(z_in: float, z_none: float, z: float) -> float:
+        return min(miss * (z - z_none), wrong * (z - z_in))
+
+    best = min(best, sensing + stop_hit(hit_in, hit_none, hit_z) + miss * (miss_z - miss_none))
+    if steps_left < 2:
+        return best
+    two = (2.0 * sensing
+           + stop_hit(hit_in * a, hit_none * b, p * a * a + p_out * b * b)  # hit, hit
+           + stop_hit(miss_in * a, miss_none * b, p * (1 - a) * a + p_out * (1 - b) * b)
+           + miss * (p * a * (1 - a) + p_out * b * (1 - b) - hit_none * (1 - b))  # hit, miss
+           + miss * ((p * (1 - a) ** 2 + p_out * (1 - b) ** 2) - miss_none * (1 - b)))
+    return min(best, two)
 
 
 def sequence_cost(problem: DTProblem, robot: int, probs: Sequence[float],
