@@ -11,7 +11,7 @@ from __future__ import annotations
 import itertools
 from collections import OrderedDict, defaultdict
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from unified_planning.model import FNode, Problem
 
@@ -287,19 +287,26 @@ def _relevant(protos: Sequence[_Proto], goal: int, goal_neg: int) -> list[_Proto
     return [p for p, keep in zip(protos, kept, strict=True) if keep]
 
 
-def _instantiate(proto: _Proto, index: int, values: Mapping[Atom, float]) -> GroundAction | None:
-    binding, schema = proto.binding, proto.schema
-    probability = schema.probability(binding, values)
+def _probability(proto: _Proto, values: Mapping[Atom, float]) -> float:
+    probability = proto.schema.probability(proto.binding, values)
     if not 0.0 <= probability <= 1.0:
         raise PlanningError(
             f"success probability of {proto.action.label} is {probability}, not in [0, 1]"
         )
-    if probability == 0.0:
-        return None
-    cost = schema.cost(binding, values)
+    return probability
+
+
+def _instantiate(
+    proto: _Proto, index: int, probability: float, values: Mapping[Atom, float]
+) -> GroundAction:
+    cost = proto.schema.cost(proto.binding, values)
     if cost < 0:
         raise PlanningError(f"cost of {proto.action.label} is negative ({cost})")
-    return replace(proto.action, index=index, cost=cost, probability=probability)
+    a = proto.action
+    return GroundAction(
+        index, a.name, a.args, a.pre, a.pre_neg, a.add, a.delete, cost, probability,
+        a.assumptive, a.pre_facts, a.add_facts, a.clauses,
+    )
 
 
 class GroundingCache:
@@ -369,12 +376,19 @@ def ground(
         if i is not None:
             init |= 1 << i
     goal, goal_neg, impossible = _goal(pproblem.problem, structure)
-    reachable = _relevant(_reachable(structure.protos, init), goal, goal_neg)
-    actions: list[GroundAction] = []
-    for proto in reachable:
-        action = _instantiate(proto, len(actions), state.values)
-        if action is not None:
-            actions.append(action)
+    # drop actions that can never succeed (p = 0), then what only they made reachable;
+    # only reachable actions are evaluated (others may read values :init does not give)
+    possible, probability = [], {}
+    for proto in _reachable(structure.protos, init):
+        p = _probability(proto, state.values)
+        if p > 0.0:
+            possible.append(proto)
+            probability[proto.action.index] = p
+    reachable = _relevant(_reachable(possible, init), goal, goal_neg)
+    actions = [
+        _instantiate(proto, i, probability[proto.action.index], state.values)
+        for i, proto in enumerate(reachable)
+    ]
     return GroundTask(
         facts=structure.facts, fact_index=structure.fact_index, actions=tuple(actions),
         init=init, goal=goal, goal_neg=goal_neg, goal_impossible=impossible,

@@ -9,6 +9,7 @@ below, so the combination is admissible for the objective. h_add and FF are not.
 
 from __future__ import annotations
 
+import copy
 import heapq
 import math
 from collections.abc import Callable
@@ -25,7 +26,7 @@ Estimator = Callable[[int], Estimate]
 class RelaxedTask:
     """Per-task arrays the relaxed heuristics iterate over (negative preconditions dropped)."""
 
-    def __init__(self, task: GroundTask, reward: float):
+    def __init__(self, task: GroundTask, reward: float, clauses: bool = False):
         self.n_facts = len(task.facts)
         self.pre = [a.pre_facts for a in task.actions]
         self.add = [a.add_facts for a in task.actions]
@@ -41,6 +42,46 @@ class RelaxedTask:
         self.goal = [i for i in range(self.n_facts) if task.goal >> i & 1]
         self.is_goal = [bool(task.goal >> i & 1) for i in range(self.n_facts)]
         self.pre_len = [len(p) for p in self.pre]
+        self.clauses = _unit_clauses(task) if clauses else []
+        self._variants: dict[tuple[bool, ...], RelaxedTask] = {}
+
+    def for_state(self, state: int) -> RelaxedTask:
+        """The task with each clause (pos or not N) whose N all hold in `state` as a plain
+        precondition `pos` (the relaxation cannot make N false, so pos is needed; an
+        estimate only: a real plan may delete N). Variants are cached by the active set."""
+        if not self.clauses:
+            return self
+        key = tuple(neg & state == neg for _, _, neg in self.clauses)
+        variant = self._variants.get(key)
+        if variant is None:
+            variant = self._variants[key] = self._with_clauses(key)
+        return variant
+
+    def _with_clauses(self, key: tuple[bool, ...]) -> RelaxedTask:
+        variant = copy.copy(self)
+        variant.clauses, variant._variants = [], {}
+        pre = [list(p) for p in self.pre]
+        for (a, f, _), active in zip(self.clauses, key, strict=True):
+            if active and f not in pre[a]:
+                pre[a].append(f)
+        variant.pre = [tuple(p) for p in pre]
+        variant.pre_of = [[] for _ in range(self.n_facts)]
+        for i, p in enumerate(variant.pre):
+            for f in p:
+                variant.pre_of[f].append(i)
+        variant.no_pre = [i for i, p in enumerate(variant.pre) if not p]
+        variant.pre_len = [len(p) for p in variant.pre]
+        return variant
+
+
+def _unit_clauses(task: GroundTask) -> list[tuple[int, int, int]]:
+    """(action, fact, negative mask) of every clause with one positive fact."""
+    out = []
+    for a in task.actions:
+        for pos, neg in a.clauses:
+            if pos and pos & (pos - 1) == 0 and neg:
+                out.append((a.index, pos.bit_length() - 1, neg))
+    return out
 
 
 def relaxed_costs(
@@ -110,9 +151,10 @@ def _hmax(task: GroundTask, reward: float) -> Estimator:
 
 
 def _hadd(task: GroundTask, reward: float) -> Estimator:
-    rt = RelaxedTask(task, reward)
+    base = RelaxedTask(task, reward, clauses=True)
 
     def estimate(state: int) -> Estimate:
+        rt = base.for_state(state)
         dist, _ = relaxed_costs(rt, state, rt.cost, False)
         hc = _goal_value(rt, dist, False)
         if hc == INF:
@@ -123,14 +165,29 @@ def _hadd(task: GroundTask, reward: float) -> Estimator:
     return estimate
 
 
-def _ff(task: GroundTask, reward: float) -> Estimator:
-    """h_add on the combined weight c(a) + R(1 - p(a)), then a relaxed plan's own c and -log p."""
-    rt = RelaxedTask(task, reward)
+class _FF:
+    """h_add on the combined weight c(a) + R(1 - p(a)), then a relaxed plan's own c and -log p.
 
-    def estimate(state: int) -> Estimate:
+    Also remembers, per evaluated state, the relaxed plan's actions applicable there: the
+    helpful actions (preferred operators) the search may try first, as LAMA does."""
+
+    def __init__(self, task: GroundTask, reward: float):
+        self.base = RelaxedTask(task, reward, clauses=True)
+        self.actions = task.actions
+        self.helpful: dict[int, frozenset[int]] = {}
+
+    def __call__(self, state: int) -> Estimate:
+        rt = self.base.for_state(state)
         dist, support = relaxed_costs(rt, state, rt.combined, False)
         if any(dist[g] == INF for g in rt.goal):
             return INF, INF
+        chosen = self._relaxed_plan(rt, state, support)
+        actions = self.actions
+        self.helpful[state] = frozenset(a for a in chosen if actions[a].applicable(state))
+        return sum(rt.cost[a] + 1.0 for a in chosen), sum(rt.neglog[a] for a in chosen)
+
+    @staticmethod
+    def _relaxed_plan(rt: RelaxedTask, state: int, support: list[int]) -> set[int]:
         chosen: set[int] = set()
         stack = [g for g in rt.goal if not state >> g & 1]
         seen: set[int] = set(stack)
@@ -143,9 +200,11 @@ def _ff(task: GroundTask, reward: float) -> Estimator:
                 if f not in seen and not state >> f & 1:
                     seen.add(f)
                     stack.append(f)
-        return sum(rt.cost[a] + 1.0 for a in chosen), sum(rt.neglog[a] for a in chosen)
+        return chosen
 
-    return estimate
+
+def _ff(task: GroundTask, reward: float) -> Estimator:
+    return _FF(task, reward)
 
 
 def _blind(task: GroundTask, reward: float) -> Estimator:

@@ -42,6 +42,7 @@ class SearchOptions:
     min_success: float = 0.0
     symmetry: bool = True
     lazy: bool | None = None  # deferred evaluation; None: only on deterministic tasks
+    preferred: bool = True  # helpful actions first (dual queue) when h is inadmissible and has them
 
     def check(self) -> SearchOptions:
         if self.reward < 0 or not math.isfinite(self.reward):
@@ -177,6 +178,15 @@ class _Search:
         self.alive: list[bool] = []
         self.labels = _Labels()
         self.heap: list[tuple[float, float, int]] = []
+        # LAMA's dual queue: successors by helpful actions also go to a preferred queue,
+        # which is popped more often (boosted whenever h improves); off when optimality counts
+        self.helpful: dict[int, frozenset[int]] | None = getattr(self.estimator, "helpful", None)
+        if not options.preferred or get_heuristic(options.heuristic).admissible:
+            self.helpful = None
+        self.pref_heap: list[tuple[float, float, int]] = []
+        self.priority = [0, 0]
+        self.best_h = math.inf
+        self.from_pref = False
         self.pruned_threshold = False
         lazy = options.lazy
         if lazy is None:  # helps on classical tasks, hurts where R(1 - p) jumps dominate g
@@ -198,7 +208,9 @@ class _Search:
         w = self.weight
         return c + w * hc + self.reward * (1.0 - p * math.exp(-hl))
 
-    def push(self, state: int, c: float, p: float, parent: int, action: int) -> None:
+    def push(
+        self, state: int, c: float, p: float, parent: int, action: int, preferred: bool = False
+    ) -> None:
         if p <= 0.0 or p < self.options.min_success:
             self.pruned_threshold |= p > 0.0
             return
@@ -219,7 +231,22 @@ class _Search:
         self.h_of_node.append(h)
         self.evaluated.append(not (self.lazy and parent >= 0))
         if h != math.inf:
-            heapq.heappush(self.heap, (g + h, h, node))
+            self.queue(g + h, h, node, preferred)
+
+    def queue(self, f: float, h: float, node: int, preferred: bool) -> None:
+        heapq.heappush(self.heap, (f, h, node))
+        if preferred:
+            heapq.heappush(self.pref_heap, (f, h, node))
+        if h < self.best_h and self.evaluated[node]:
+            self.best_h = h
+            self.priority[1] -= 1000  # progress: trust the helpful actions for a while
+
+    def pop(self) -> int:
+        """Next node: from the preferred queue or the main one, whichever has had fewer turns."""
+        use_pref = bool(self.pref_heap) and (self.priority[1] <= self.priority[0] or not self.heap)
+        self.from_pref = use_pref
+        self.priority[1 if use_pref else 0] += 1
+        return heapq.heappop(self.pref_heap if use_pref else self.heap)[2]
 
     def commute(self, i: int, j: int) -> bool:
         key = (i, j)
@@ -240,9 +267,13 @@ class _Search:
             return False
         h = f - objective(c, p, self.reward)
         self.h_of_node[node] = h
-        if self.heap and f > self.heap[0][0]:
-            heapq.heappush(self.heap, (f, h, node))
+        heap = self.pref_heap if self.from_pref else self.heap
+        if heap and f > heap[0][0]:
+            self.queue(f, h, node, self.from_pref)
             return False
+        if h < self.best_h:
+            self.best_h = h
+            self.priority[1] -= 1000
         return True
 
     def run(self) -> PlanResult:
@@ -251,13 +282,18 @@ class _Search:
         expanded = 0
         actions = task.actions
         symmetries = self.symmetries
-        while self.heap:
-            _, _, node = heapq.heappop(self.heap)
+        while self.heap or self.pref_heap:
+            node = self.pop()
             if not self.alive[node] or not self.evaluate(node):
                 continue
             self.alive[node] = False
             state, c, p = self.states[node], self.costs[node], self.probs[node]
             if task.is_goal(state):
+                if self.from_pref and self.heap and self.heap[0][0] < objective(c, p, self.reward):
+                    # a helpful-action goal is only taken if no open node promises better
+                    self.alive[node] = True
+                    heapq.heappush(self.heap, (objective(c, p, self.reward), 0.0, node))
+                    continue
                 return self.finish(PlanStatus.SOLVED, node, expanded)
             expanded += 1
             if options.node_limit is not None and expanded > options.node_limit:
@@ -266,6 +302,7 @@ class _Search:
                 if time.perf_counter() - self.start > options.timeout_s:
                     return self.finish(PlanStatus.TIMEOUT, None, expanded)
             last = self.via[node]
+            helpful = self.helpful.get(state, frozenset()) if self.helpful is not None else ()
             for a in actions:
                 if (state & a.pre) == a.pre and not (state & a.pre_neg):
                     if a.clauses and not a.applicable(state):
@@ -275,7 +312,9 @@ class _Search:
                     if symmetries.checks and symmetries.prunes(a.index, state):
                         continue  # a mirror image with a lower object is explored
                     succ = (state & ~a.delete) | a.add
-                    self.push(succ, c + a.cost, p * a.probability, node, a.index)
+                    self.push(
+                        succ, c + a.cost, p * a.probability, node, a.index, a.index in helpful
+                    )
         status = (
             PlanStatus.NO_PLAN_ABOVE_THRESHOLD if self.pruned_threshold else PlanStatus.UNSOLVABLE
         )
