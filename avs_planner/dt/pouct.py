@@ -44,6 +44,7 @@ class SearchBudget:
     tree_depth: int = 2  # looks in the tree below the root; deeper is valued by rollouts
     max_backup: bool = True  # a node returns its best action's value to its parent, not the
     # sampled return (mean backups of exploring simulations undervalue looking again)
+    route_looks: int = 16  # at most this many looks in a leaf's sequence (0: 2 per cone + 2)
     route_leaves: bool = True  # leaves valued by route-aware look sequences (exact expected
     # cost, `avs_planner.dt.route`); False: by sampled greedy p/cost rollouts
 
@@ -70,6 +71,7 @@ class ViewConePOUCT(pomdp_py.POUCT):
         self._tree_depth = budget.tree_depth or steps_left
         self._route = budget.route_leaves
         self._max_backup = budget.max_backup
+        self._route_looks = budget.route_looks
         self._leaf_values: dict[tuple, float] = {}
         self._root_belief: TargetBelief | None = None
         self._root_len = 0
@@ -105,16 +107,19 @@ class ViewConePOUCT(pomdp_py.POUCT):
             keep = set(top_cones(self._problem, belief.robot, belief.probs, self._max_moves))
             actions = [a for a in actions if a.kind is not ActionKind.MOVE or a.cone in keep]
         steps_left = self._steps_left - (len(history) - self._root_len)
+        second = 2 if len(history) == self._root_len else 0  # branch wider at the root only
         for action in actions:
             if vnode[action] is None:
-                visits, value = self._action_prior(belief, action, steps_left)
+                visits, value = self._action_prior(belief, action, steps_left, second)
                 vnode[action] = QNode(visits, value)
 
-    def _action_prior(self, belief: TargetBelief, action, steps_left: int) -> tuple[int, float]:
+    def _action_prior(self, belief: TargetBelief, action, steps_left: int,
+                      second: int = 2) -> tuple[int, float]:
         """(pseudo-visits, initial value) of a new tree action. CONFIRM/REJECT values are exact
         (expected penalty under the node's belief), so they never need simulating; MOVE and
         PROCESSVIEWCONE start at an achievable value weighted like `prior_visits` simulations:
-        the best route-aware look sequence starting there (with `route_leaves`), else the
+        the best route-aware look sequence starting there (with `route_leaves`; `second`
+        next looks tried after the first, see `best_sequence`), else the
         greedy plan "look there up to LOOKAHEAD times, then stop"."""
         if action.terminal:
             return TERMINAL_VISITS, expected_terminal_reward(self._problem, belief, action)
@@ -123,7 +128,8 @@ class ViewConePOUCT(pomdp_py.POUCT):
         moving = 1 if action.kind is ActionKind.MOVE else 0
         if self._route and steps_left - moving >= 1:
             sequence = best_sequence(self._problem, belief.robot, belief.probs, steps_left,
-                                     forced_first=action.cone)
+                                     second=second, forced_first=action.cone,
+                                     max_looks=self._route_looks)
             if sequence is not None:
                 return self._prior_visits, -sequence.cost
         looks = min(LOOKAHEAD, steps_left - moving)
@@ -178,7 +184,7 @@ class ViewConePOUCT(pomdp_py.POUCT):
         if value is None:
             stop = stop_choice(self._problem, belief.robot, belief.detected, belief.probs)[0]
             value = -route_value(self._problem, belief.robot, belief.probs, belief.after_move,
-                                 steps_left, stop)
+                                 steps_left, stop, self._route_looks)
             self._leaf_values[key] = value
         return value
 

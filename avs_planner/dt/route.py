@@ -30,39 +30,52 @@ class LookSequence:
 def detected_cost(problem: DTProblem, p: float, p_none: float, steps_left: float) -> float:
     """Cheapest expected cost right after a detection at a cone with posterior `p` (nowhere:
     `p_none`): confirm, reject, or look again once or twice and then stop. Closed form of
-    `min(looks_then_stop_cost(.., k))` for k <= 2 (it runs at every step of every sequence)."""
+    `min(looks_then_stop_cost(.., k))` for k <= 2."""
+    return joint_detected_cost(problem, p, p_none, 1.0, steps_left)
+
+
+def joint_detected_cost(problem: DTProblem, z_in: float, z_none: float, z: float,
+                        steps_left: float) -> float:
+    """`z * detected_cost(z_in / z, z_none / z)` without the divisions: for a detection branch
+    of probability `z` whose joint mass in the cone is `z_in` and nowhere `z_none` (it runs
+    at every step of every sequence, so it is written out)."""
     miss, wrong = problem.rewards.miss_penalty, problem.rewards.false_confirm_penalty
-    best = min(wrong * (1.0 - p), miss * (1.0 - p_none))
+    best = min(wrong * (z - z_in), miss * (z - z_none))
     if steps_left < 1:
         return best
     a, b = problem.detection_rates
-    p_out, sensing = 1.0 - p, problem.sensing_cost
-    # joint P(target in cone | nowhere, outcome) for each hit pattern of up to two looks
-    hit_in, hit_none, hit_z = p * a, p_none * b, p * a + p_out * b
-    miss_in, miss_none, miss_z = p - hit_in, p_none - hit_none, 1.0 - hit_z
-
-    def stop_hit(z_in: float, z_none: float, z: float) -> float:
-        return min(miss * (z - z_none), wrong * (z - z_in))
-
-    best = min(best, sensing + stop_hit(hit_in, hit_none, hit_z) + miss * (miss_z - miss_none))
+    z_out, sensing = z - z_in, problem.sensing_cost * z
+    h_in, h_none = z_in * a, z_none * b  # one more look hits
+    h = h_in + z_out * b
+    m_in, m_none = z_in - h_in, z_none - h_none  # ... or misses
+    once = (sensing + min(miss * (h - h_none), wrong * (h - h_in))
+            + miss * (z - h - m_none))
+    best = min(best, once)
     if steps_left < 2:
         return best
-    two = (2.0 * sensing
-           + stop_hit(hit_in * a, hit_none * b, p * a * a + p_out * b * b)  # hit, hit
-           + stop_hit(miss_in * a, miss_none * b, p * (1 - a) * a + p_out * (1 - b) * b)
-           + miss * (p * a * (1 - a) + p_out * b * (1 - b) - hit_none * (1 - b))  # hit, miss
-           + miss * ((p * (1 - a) ** 2 + p_out * (1 - b) ** 2) - miss_none * (1 - b)))
-    return min(best, two)
+    hh, mh = h_in * a + z_out * b * b, m_in * a + z_out * (1 - b) * b
+    hm, mm = h_in * (1 - a) + z_out * b * (1 - b), m_in * (1 - a) + z_out * (1 - b) * (1 - b)
+    twice = (2.0 * sensing
+             + min(miss * (hh - h_none * b), wrong * (hh - h_in * a))  # hit, hit
+             + min(miss * (mh - m_none * b), wrong * (mh - m_in * a))  # miss, hit
+             + miss * (hm - h_none * (1 - b)) + miss * (mm - m_none * (1 - b)))
+    return min(best, twice)
 
 
 def sequence_cost(problem: DTProblem, robot: int, probs: Sequence[float],
                   cones: Sequence[int], steps_left: float = math.inf) -> tuple[float, int]:
     """(expected cost, looks) of the best prefix (at least one look) of `cones` from `robot`
-    under `probs`; a MOVE and a look count as two steps against `steps_left`."""
-    hit_in, hit_out = problem.detection_rates
-    in_ratio = (1.0 - hit_in) / (1.0 - hit_out)
+    under `probs`; a MOVE and a look count as two steps against `steps_left`.
+
+    After a detection the sequence either stops there (confirm or reject) or, when that is
+    dearer than one more look and stopping after a second hit (perhaps after a third look),
+    verifies with that look: a second hit stops, a miss (a false alarm) carries on with the
+    rest of the sequence. That
+    is the same open-loop plan as after a plain miss, so the branch merges exactly into the
+    running belief."""
+    a, b = problem.detection_rates
     miss_penalty, sensing = problem.rewards.miss_penalty, problem.sensing_cost
-    q = list(probs)  # joint P(target, all looks so far missed) = scale * q
+    q = list(probs)  # joint P(target, search still going) = scale * q
     scale, alive, spent = 1.0, 1.0, 0.0
     best, best_len, here = math.inf, 0, robot
     for i, cone in enumerate(cones):
@@ -70,15 +83,18 @@ def sequence_cost(problem: DTProblem, robot: int, probs: Sequence[float],
         if steps_left < 0:
             break
         spent += alive * (problem.travel_cost(here, cone) + sensing)
-        q_cone = q[cone] * scale
-        found = q_cone * hit_in
-        detect = found + (alive - q_cone) * hit_out
-        if detect > 0.0:
-            spent += detect * detected_cost(problem, found / detect,
-                                            q[-1] * scale * hit_out / detect, steps_left)
-        alive -= detect
-        q[cone] *= in_ratio
-        scale *= 1.0 - hit_out
+        q_cone, q_none = q[cone] * scale, q[-1] * scale
+        others = alive - q_cone
+        stop, verify = _detection_costs(problem, q_cone, others, q_none, steps_left)
+        if verify < stop:  # continuing: a miss, or a hit then a miss
+            spent += verify
+            keep_in, keep_out = 1.0 - a * a, 1.0 - b * b
+        else:
+            spent += stop
+            keep_in, keep_out = 1.0 - a, 1.0 - b
+        alive = q_cone * keep_in + others * keep_out
+        q[cone] *= keep_in / keep_out
+        scale *= keep_out
         total = spent + miss_penalty * (alive - q[-1] * scale)
         if total < best:
             best, best_len = total, i + 1
@@ -86,16 +102,37 @@ def sequence_cost(problem: DTProblem, robot: int, probs: Sequence[float],
     return best, best_len
 
 
-def utility_sequence(problem: DTProblem, robot: int, probs: Sequence[float], first: int,
+def _detection_costs(problem: DTProblem, q_cone: float, others: float, q_none: float,
+                     steps_left: float) -> tuple[float, float]:
+    """Joint expected costs of the detection branch of a look at a cone with joint mass
+    `q_cone` (`others` elsewhere, `q_none` of it nowhere): (confirm or reject there, verify
+    with one more look: its cost plus the best stop, or third look, after a second hit).
+    The false alarms that carry on are costed by the rest of the sequence, not here."""
+    a, b = problem.detection_rates
+    found = q_cone * a
+    detect = found + others * b
+    if detect <= 0.0:
+        return 0.0, math.inf
+    stop = joint_detected_cost(problem, found, q_none * b, detect, 0)
+    if steps_left < 1:
+        return stop, math.inf
+    twice = found * a + others * b * b
+    verify = detect * problem.sensing_cost + joint_detected_cost(
+        problem, found * a, q_none * b * b, twice, min(1, steps_left - 1))
+    return stop, verify
+
+
+def utility_sequence(problem: DTProblem, probs: Sequence[float], prefix: Sequence[int],
                      length: int) -> list[int]:
-    """`first`, then `length - 1` looks each chosen by the highest utility P(detect) / cost
-    (FLAP eq. 6) from where the previous look was, with the belief after misses."""
-    hit_in, hit_out = problem.detection_rates
-    in_ratio = (1.0 - hit_in) / (1.0 - hit_out)
+    """`prefix`, then looks each chosen by the highest utility P(detect) / cost (FLAP eq. 6)
+    from where the previous look was, with the belief after misses, up to `length` looks."""
+    in_ratio = _in_ratio(problem)
     q = list(probs)  # proportional to the real belief: ratios are all the utility needs
-    cones, here = [first], first
-    q[first] *= in_ratio
-    for _ in range(length - 1):
+    cones = list(prefix)
+    for cone in cones:
+        q[cone] *= in_ratio
+    here = cones[-1]
+    for _ in range(length - len(cones)):
         best, best_util = -1, 0.0
         for cone, inverse_cost in problem.look_weights[here]:
             util = q[cone] * inverse_cost
@@ -109,25 +146,47 @@ def utility_sequence(problem: DTProblem, robot: int, probs: Sequence[float], fir
     return cones
 
 
+def _in_ratio(problem: DTProblem) -> float:
+    """How a miss scales the looked-at cone relative to the others."""
+    hit_in, hit_out = problem.detection_rates
+    return (1.0 - hit_in) / (1.0 - hit_out)
+
+
 def first_looks(problem: DTProblem, robot: int, probs: Sequence[float], count: int) -> list[int]:
-    """The `count` cones with the highest utility from `robot` (candidates for the first look)."""
+    """The `count` cones with the highest utility from `robot` (candidates for the next look)."""
     scored = sorted(((probs[c] * w, -c) for c, w in problem.look_weights[robot]), reverse=True)
     return [-neg for util, neg in scored[:count] if util > 0.0]
 
 
+def _prefixes(problem: DTProblem, robot: int, probs: Sequence[float], firsts: Sequence[int],
+              second: int) -> list[tuple[int, ...]]:
+    """Two-look prefixes: each first look with the `second` best next looks after its miss
+    (FLAP's branching to depth 2; deeper looks follow the utility greedily)."""
+    if second <= 0:
+        return [(first,) for first in firsts]
+    prefixes = []
+    for first in firsts:
+        after = list(probs)
+        after[first] *= _in_ratio(problem)
+        nexts = first_looks(problem, first, after, second)
+        prefixes.extend((first, nxt) for nxt in nexts) if nexts else prefixes.append((first,))
+    return prefixes
+
+
 def best_sequence(problem: DTProblem, robot: int, probs: Sequence[float],
-                  steps_left: float = math.inf, branches: int = 3,
-                  forced_first: int | None = None) -> LookSequence | None:
+                  steps_left: float = math.inf, branches: int = 3, second: int = 2,
+                  forced_first: int | None = None, max_looks: int = 0) -> LookSequence | None:
     """Cheapest utility-greedy sequence over `branches` first looks (or `forced_first`, e.g.
-    the cone the robot just moved to); None if no look is possible."""
-    length = int(min(steps_left, 2 * len(problem.relevant_cones) + 2))
+    the cone the robot just moved to), each with `second` second looks, of at most
+    `max_looks` looks (0: two per relevant cone, plus two); None if no look is possible."""
+    length = int(min(steps_left, max_looks or 2 * len(problem.relevant_cones) + 2))
     if forced_first is not None:
-        starts = [forced_first]
+        firsts = [forced_first]
     else:
-        starts = first_looks(problem, robot, probs, branches)
+        firsts = first_looks(problem, robot, probs, branches)
     best: LookSequence | None = None
-    for first in starts:
-        cones = utility_sequence(problem, robot, probs, first, length)
+    for prefix in _prefixes(problem, robot, probs, firsts, second if length > 1 else 0):
+        cones = utility_sequence(problem, probs, prefix, length)
         cost, looks = sequence_cost(problem, robot, probs, cones, steps_left)
         if looks and (best is None or cost < best.cost):
             best = LookSequence(tuple(cones[:looks]), cost)
@@ -135,11 +194,12 @@ def best_sequence(problem: DTProblem, robot: int, probs: Sequence[float],
 
 
 def route_value(problem: DTProblem, robot: int, probs: Sequence[float], after_move: bool,
-                steps_left: float, stop_cost: float) -> float:
+                steps_left: float, stop_cost: float, max_looks: int = 0) -> float:
     """Expected cost of the better of stopping now (`stop_cost`) and the best look sequence;
     right after a MOVE the robot must look where it is first."""
     forced = robot if after_move and robot != START else None
-    sequence = best_sequence(problem, robot, probs, steps_left, forced_first=forced)
+    sequence = best_sequence(problem, robot, probs, steps_left, forced_first=forced,
+                             max_looks=max_looks)
     if sequence is None:
         return stop_cost
     return sequence.cost if after_move else min(stop_cost, sequence.cost)
