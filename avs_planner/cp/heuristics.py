@@ -4,7 +4,9 @@ Every estimator maps a state to a pair (cost part, -log probability part) that d
 on the state; the search turns it into h(s, p) = hc + R * p * (1 - exp(-hl)) for a node that
 got to s with probability p. For h^max both parts are h^max values over action costs and over
 -log p(a) respectively, which bound any plan's cost and its -log success probability from
-below, so the combination is admissible for the objective. h_add and FF are not.
+below, so the combination is admissible for the objective. h_add and FF are not; they also
+read the clauses the grounder made from forall/imply preconditions (see `RelaxedTask.for_state`),
+which h^max must ignore to stay admissible. FF records helpful actions for the search.
 """
 
 from __future__ import annotations

@@ -34,3 +34,39 @@ def test_grounding_drops_actions_that_never_succeed(corridor):
     assert task.actions
     assert all(a.probability > 0.0 for a in task.actions)
     assert [a.index for a in task.actions] == list(range(len(task.actions)))
+
+
+FORALL_DOMAIN = """(define (domain tour)
+  (:requirements :strips :typing :negative-preconditions :disjunctive-preconditions
+                 :universal-preconditions :action-costs)
+  (:types spot)
+  (:predicates (marked ?s - spot) (visited ?s - spot) (done))
+  (:functions (total-cost) - number)
+  (:action unmark :parameters (?s - spot) :precondition (marked ?s)
+    :effect (and (not (marked ?s)) (increase (total-cost) 100)))
+  (:action visit :parameters (?s - spot) :precondition (not (visited ?s))
+    :effect (and (visited ?s) (increase (total-cost) 5)))
+  (:action finish :parameters ()
+    :precondition (forall (?s - spot) (imply (marked ?s) (visited ?s)))
+    :effect (and (done) (increase (total-cost) 1))))
+"""
+
+FORALL_PROBLEM = """(define (problem tour3) (:domain tour)
+  (:objects a b c - spot)
+  (:init (marked a) (marked b) (= (total-cost) 0))
+  (:goal (done)) (:metric minimize (total-cost)))
+"""
+
+
+def test_inadmissible_estimates_count_forall_imply_clauses_and_hmax_stays_admissible():
+    from avs_planner.pddl import read_text
+
+    pproblem = read_text(FORALL_DOMAIN, FORALL_PROBLEM, "tour.pddl", "tour3.pddl")
+    task = ground(pproblem)
+    hadd_c, _ = get_heuristic("hadd").factory(task, 500.0)(task.init)
+    ff_c, _ = get_heuristic("ff").factory(task, 500.0)(task.init)
+    hmax_c, _ = get_heuristic("hmax").factory(task, 500.0)(task.init)
+    assert hadd_c == 5 + 5 + 1  # visit a, visit b (c is not marked), finish
+    assert ff_c == (5 + 1) + (5 + 1) + (1 + 1)  # FF counts +1 per action
+    optimal = plan(pproblem, SearchOptions(weight=1.0, heuristic="hmax"))
+    assert optimal.solved and hmax_c <= optimal.cost == 11
