@@ -70,15 +70,34 @@ def sequence_cost(problem: DTProblem, robot: int, probs: Sequence[float],
     After a detection the sequence either stops there (confirm or reject) or, when that is
     dearer than one more look and stopping after a second hit (perhaps after a third look),
     verifies with that look: a second hit stops, a miss (a false alarm) carries on with the
-    rest of the sequence. That
-    is the same open-loop plan as after a plain miss, so the branch merges exactly into the
-    running belief."""
+    rest of the sequence. That is the same open-loop plan as after a plain miss, so the
+    branch merges exactly into the running belief."""
+    cost, looks, _ = _walk(problem, robot, probs, cones, len(cones), steps_left)
+    return cost, looks
+
+
+def _walk(problem: DTProblem, robot: int, probs: Sequence[float], prefix: Sequence[int],
+          length: int, steps_left: float) -> tuple[float, int, list[int]]:
+    """`sequence_cost` of `prefix` continued by the utility rule P(detect) / cost (FLAP eq. 6)
+    from where the previous look was, up to `length` looks; also returns the cones looked at.
+    One pass: choosing the next look and costing it share the belief."""
     a, b = problem.detection_rates
     miss_penalty, sensing = problem.rewards.miss_penalty, problem.sensing_cost
+    weights, known = problem.look_weights, len(prefix)
     q = list(probs)  # joint P(target, search still going) = scale * q
     scale, alive, spent = 1.0, 1.0, 0.0
-    best, best_len, here = math.inf, 0, robot
-    for i, cone in enumerate(cones):
+    best, best_len, here, cones = math.inf, 0, robot, []
+    for i in range(length):
+        if i < known:
+            cone = prefix[i]
+        else:
+            cone, best_util = -1, 0.0
+            for candidate, inverse_cost in weights[here]:
+                util = q[candidate] * inverse_cost
+                if util > best_util:
+                    cone, best_util = candidate, util
+            if cone < 0:
+                break
         steps_left -= 1 if cone == here else 2
         if steps_left < 0:
             break
@@ -99,7 +118,8 @@ def sequence_cost(problem: DTProblem, robot: int, probs: Sequence[float],
         if total < best:
             best, best_len = total, i + 1
         here = cone
-    return best, best_len
+        cones.append(cone)
+    return best, best_len, cones
 
 
 def _detection_costs(problem: DTProblem, q_cone: float, others: float, q_none: float,
@@ -120,30 +140,6 @@ def _detection_costs(problem: DTProblem, q_cone: float, others: float, q_none: f
     verify = detect * problem.sensing_cost + joint_detected_cost(
         problem, found * a, q_none * b * b, twice, min(1, steps_left - 1))
     return stop, verify
-
-
-def utility_sequence(problem: DTProblem, probs: Sequence[float], prefix: Sequence[int],
-                     length: int) -> list[int]:
-    """`prefix`, then looks each chosen by the highest utility P(detect) / cost (FLAP eq. 6)
-    from where the previous look was, with the belief after misses, up to `length` looks."""
-    in_ratio = _in_ratio(problem)
-    q = list(probs)  # proportional to the real belief: ratios are all the utility needs
-    cones = list(prefix)
-    for cone in cones:
-        q[cone] *= in_ratio
-    here = cones[-1]
-    for _ in range(length - len(cones)):
-        best, best_util = -1, 0.0
-        for cone, inverse_cost in problem.look_weights[here]:
-            util = q[cone] * inverse_cost
-            if util > best_util:
-                best, best_util = cone, util
-        if best < 0:
-            break
-        cones.append(best)
-        q[best] *= in_ratio
-        here = best
-    return cones
 
 
 def _in_ratio(problem: DTProblem) -> float:
@@ -186,8 +182,7 @@ def best_sequence(problem: DTProblem, robot: int, probs: Sequence[float],
         firsts = first_looks(problem, robot, probs, branches)
     best: LookSequence | None = None
     for prefix in _prefixes(problem, robot, probs, firsts, second if length > 1 else 0):
-        cones = utility_sequence(problem, probs, prefix, length)
-        cost, looks = sequence_cost(problem, robot, probs, cones, steps_left)
+        cost, looks, cones = _walk(problem, robot, probs, prefix, length, steps_left)
         if looks and (best is None or cost < best.cost):
             best = LookSequence(tuple(cones[:looks]), cost)
     return best
