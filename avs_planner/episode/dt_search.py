@@ -106,7 +106,8 @@ class ViewConeSearch:
             p_detect = 1.0 - self.ex.config.detector.false_negative
             self.ex.mind.failed_search(label, relation, location, coverage, p_detect)
         if relation == "on":
-            self.ex.builder.failed_on.add((label, location))
+            key = (label, location)
+            self.ex.builder.failed_on[key] = self.ex.builder.failed_on.get(key, 0) + 1
         else:
             key = (label, location)
             self.ex.builder.failed_in[key] = self.ex.builder.failed_in.get(key, 0) + 1

@@ -73,6 +73,9 @@ class SwitchingLoop:
                                         min_success=self.config.min_success)
         first = self._fallback(self.planner.replan(state.world_state()))
         self._record_plan(first, "initial")
+        first = self._explore_while_timing_out(first)
+        if first is None:
+            return self._end(Outcome.GAVE_UP, "planner timed out, nothing to explore")
         if not first.solved:
             return self._end(Outcome.GAVE_UP, f"no plan: {first.status.value}")
         for _ in range(self.config.max_steps):
@@ -90,13 +93,11 @@ class SwitchingLoop:
             self.planner.plan = self.planner.plan[:index] + self.planner.plan[index + 1:]
             state = self.builder.build()
             result = self._monitor(state, outcome)
-            while result is not None and result.status is PlanStatus.TIMEOUT:
-                if not self._explore_instead():
+            if result is not None:
+                result = self._explore_while_timing_out(result)
+                if result is None:
                     return self._end(Outcome.GAVE_UP, "planner timed out, nothing to explore")
                 state = self.builder.build()
-                self.planner.update(state.world_state(), state.problem())
-                result = self._fallback(self.planner.replan())
-                self._record_plan(result, "after exploring")
             if result is not None and not result.solved:
                 return self._end(Outcome.GAVE_UP, f"no plan above the success threshold "
                                  f"{self.config.min_success:g} ({result.status.value})")
@@ -137,6 +138,27 @@ class SwitchingLoop:
         self.trace.emit("action", action=step.label, status=outcome.status.value,
                         detail=outcome.detail)
         return outcome
+
+    def _explore_while_timing_out(self, result: PlanResult) -> PlanResult | None:
+        """While the CP times out, explore a placeholder and plan again; None when there is
+        nothing left to explore."""
+        assert self.planner is not None
+        while result.status is PlanStatus.TIMEOUT:
+            if not self._explore_instead() and not self._shrink():
+                return None
+            state = self.builder.build()
+            self.planner.update(state.world_state(), state.problem())
+            result = self._fallback(self.planner.replan())
+            self._record_plan(result, "after exploring")
+        return result
+
+    def _shrink(self) -> bool:
+        """Nothing to explore: plan with one support label fewer (a smaller problem)."""
+        dropped = self.builder.drop_support()
+        if dropped is None:
+            return False
+        self.trace.emit("belief", dropped_support=dropped, reason="planner timed out")
+        return True
 
     def _explore_instead(self) -> bool:
         """The CP ran out of time: drive to the nearest placeholder (more map, smaller

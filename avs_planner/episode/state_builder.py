@@ -38,7 +38,7 @@ class BuilderConfig:
     virtual_rooms: int = 1
     virtual_objects: int = 2
     certain_category: float = 0.9
-    max_supports: int = 2
+    max_supports: int = 3
     max_categories: int = 2
     min_probability: float = 0.03
     max_placeholder_tries: int = 2
@@ -46,6 +46,7 @@ class BuilderConfig:
     min_frontier_length: float = 0.5
     placeholder_merge: float = 1.0  # m: nearer placeholders are one spot to the planner
     max_failed_room_searches: int = 2
+    max_failed_support_searches: int = 2  # then "not on it" is taken as settled
     target_search_cost: tuple[float, float] = (120.0, 10.0)  # in a room, on a support
     support_search_cost: tuple[float, float] = (40.0, 10.0)
     target_detect: tuple[float, float] = (0.5, 0.8)
@@ -105,7 +106,7 @@ class StateBuilder:
         self.labels = [task.target, *self.supports]
         self.categories = self._likely_categories()
         self._current_categories = list(self.categories)
-        self.failed_on: set[tuple[str, str]] = set()
+        self.failed_on: dict[tuple[str, str], int] = {}
         self.failed_in: dict[tuple[str, str], int] = {}
         self.revision = 0
 
@@ -117,6 +118,26 @@ class StateBuilder:
             reverse=True,
         )
         return [s for _, s in ranked[: self.config.max_supports]]
+
+    def drop_support(self) -> str | None:
+        """Leave the least likely support label out of future problems (the CP timed out);
+        returns it, or None when only the target is left."""
+        if not self.supports:
+            return None
+        dropped = min(self.supports, key=self._support_score)
+        self.supports.remove(dropped)
+        self.labels.remove(dropped)
+        return dropped
+
+    def _support_score(self, support: str) -> float:
+        """Expected number of targets on `support`s in the rooms the robot knows, given its
+        category beliefs (lambda of the relation times lambda of the support per room)."""
+        cmap = self.mind.cmap
+        knowledge = cmap.knowledge
+        per_category = (knowledge.relation_lambda_of(self.task.target, "on", support)
+                        * knowledge.room_lambda(support))
+        rooms = [r for r in self.mind.place_map.rooms if cmap.graph.has_room(r)]
+        return float(sum(cmap.room_marginal(r) @ per_category for r in rooms))
 
     def _likely_categories(self) -> list[str]:
         """Categories where the target (directly or on a support) is most expected; the
@@ -301,7 +322,7 @@ class StateBuilder:
                 atoms |= {("related", oid, "on", obj.support),
                           ("defined-exists", obj.label, "on", obj.support)}
             for label in self.labels:
-                if (label, oid) in self.failed_on:
+                if self.failed_on.get((label, oid), 0) >= self.config.max_failed_support_searches:
                     atoms.add(("defined-exists", label, "on", oid))
         for oid in self._virtual("new-object", self.config.virtual_objects):
             atoms.add(("virtual", oid))
