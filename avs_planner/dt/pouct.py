@@ -17,9 +17,16 @@ from pomdp_py.algorithms.po_uct import QNode
 
 from avs_planner.dt.agent import ViewConeAgent
 from avs_planner.dt.belief import TargetBelief
-from avs_planner.dt.domain import ActionKind, DTAction, DTObservation
+from avs_planner.dt.domain import (
+    DETECTED,
+    NOT_DETECTED,
+    NOTHING,
+    ActionKind,
+    DTAction,
+    DTObservation,
+)
 from avs_planner.dt.greedy import LOOKAHEAD, look_then_stop_cost, stop_choice, top_cones
-from avs_planner.dt.models import ViewConePolicyModel
+from avs_planner.dt.models import ViewConePolicyModel, valid_actions
 from avs_planner.dt.problem import DTProblem
 from avs_planner.dt.rollout import (
     belief_after_history,
@@ -36,7 +43,7 @@ TERMINAL_VISITS = 1_000_000  # CONFIRM/REJECT values are exact: never worth expl
 class SearchBudget:
     """Planning budget per decision: simulations (deterministic with a seed) or seconds."""
 
-    num_sims: int = 200
+    num_sims: int = 50  # with exact observation averaging and route leaves, 50 matched 200
     planning_time: float = -1.0  # > 0 and num_sims <= 0: plan for this many seconds
     exploration_const: float = 0.0  # 0: 0.13 x the larger terminal penalty
     max_moves: int = 6  # MOVE branches per tree node: best P/cost cones (0: all)
@@ -45,6 +52,8 @@ class SearchBudget:
     max_backup: bool = True  # a node returns its best action's value to its parent, not the
     # sampled return (mean backups of exploring simulations undervalue looking again)
     route_looks: int = 16  # at most this many looks in a leaf's sequence (0: 2 per cone + 2)
+    expected_backup: bool = True  # Q = r + exact expectation over observations of the
+    # children's best values (needs route_leaves); False: pomdp-py's sampled running mean
     route_leaves: bool = True  # leaves valued by route-aware look sequences (exact expected
     # cost, `avs_planner.dt.route`); False: by sampled greedy p/cost rollouts
 
@@ -72,6 +81,7 @@ class ViewConePOUCT(pomdp_py.POUCT):
         self._route = budget.route_leaves
         self._max_backup = budget.max_backup
         self._route_looks = budget.route_looks
+        self._expected_backup = budget.expected_backup and budget.route_leaves
         self._leaf_values: dict[tuple, float] = {}
         self._root_belief: TargetBelief | None = None
         self._root_len = 0
@@ -101,8 +111,9 @@ class ViewConePOUCT(pomdp_py.POUCT):
     def _expand_vnode(self, vnode, history, state=None):
         """Add the node's actions; MOVE only to the `max_moves` best cones by P/cost under the
         node's belief (the other moves are kept out of the tree, not out of the model)."""
-        actions = self._policy_model.get_all_actions(state=state, history=history)
-        belief = self._node_belief(history)
+        belief = self._node_belief(history)  # its `after_move` holds even for a fresh agent
+        actions = valid_actions(self._problem, belief.robot, belief.detected, belief.done,
+                                belief.after_move)
         if self._max_moves > 0 and len(actions) > self._max_moves + 3:
             keep = set(top_cones(self._problem, belief.robot, belief.probs, self._max_moves))
             actions = [a for a in actions if a.kind is not ActionKind.MOVE or a.cone in keep]
@@ -142,6 +153,13 @@ class ViewConePOUCT(pomdp_py.POUCT):
     def _simulate(self, state, history, root, parent, observation, depth):
         if state.done:
             return self._terminal_correction(state, history)
+        value = self._simulate_node(state, history, root, parent, observation, depth)
+        if self._expected_backup and parent is not None:
+            return self._expected_return(history, parent, depth)
+        return value
+
+    def _simulate_node(self, state, history, root, parent, observation, depth):
+        """One simulation from the node at `history`; returns its value estimate."""
         if depth >= self._steps_left:
             belief = self._node_belief(history)
             return stop_choice(self._problem, belief.robot, belief.detected, belief.probs)[0] * -1
@@ -153,6 +171,40 @@ class ViewConePOUCT(pomdp_py.POUCT):
             if visited:
                 return max(visited)
         return value
+
+    def _expected_return(self, history: tuple, parent: QNode, depth: int) -> float:
+        """What to hand back to the parent so that pomdp-py's running-mean update sets the
+        parent's Q to r + sum_o P(o | b, a) V(child_o): the observation is averaged exactly
+        under the parent's belief instead of by the sampled frequencies (their noise flipped
+        decisions between near-equal actions)."""
+        action = history[-1][0]
+        above = history[:-1]
+        belief = self._node_belief(above)
+        if action.kind is ActionKind.MOVE:
+            reward, branches = -self._problem.travel_cost(belief.robot, action.cone), [(1.0,
+                                                                                       NOTHING)]
+        else:
+            hit = belief.p_detect(action.cone, self._problem.detector)
+            reward = -self._problem.sensing_cost
+            branches = [(hit, DETECTED), (1.0 - hit, NOT_DETECTED)]
+        expected = reward
+        for p, obs in branches:
+            if p > 0.0:
+                expected += p * self._branch_value(parent[obs], above + ((action, obs),),
+                                                   self._steps_left - depth)
+        visits = parent.num_visits + 1  # pomdp-py counts this simulation before averaging
+        return parent.value + visits * (expected - parent.value) - reward
+
+    def _branch_value(self, vnode, history: tuple, steps_left: int) -> float:
+        """Best value known at a child node: its best visited action, else its leaf value."""
+        belief = self._node_belief(history)
+        if steps_left <= 0:
+            return -stop_choice(self._problem, belief.robot, belief.detected, belief.probs)[0]
+        if vnode is not None:
+            visited = [q.value for q in vnode.children.values() if q.num_visits > 0]
+            if visited:
+                return max(visited)
+        return self._route_leaf_value(belief, steps_left)
 
     def _tree_level(self, history: tuple) -> int:
         """Decisions below the root, not counting MOVEs: a MOVE's only continuation is the
