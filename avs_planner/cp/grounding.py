@@ -58,7 +58,9 @@ def world_state(problem: Problem) -> WorldState:
 
 
 def _substitute(template: AtomTemplate, binding: Mapping[str, str]) -> Atom:
-    return (template[0], *(binding[t] if t[0] == "?" else t for t in template[1:]))
+    # a binding maps every parameter; object names never start with "?", so get(t, t) is exact
+    get = binding.get
+    return (template[0], *map(get, template[1:], template[1:]))
 
 
 class _StaticIndex:
@@ -138,17 +140,18 @@ class _FactTable:
         self.index: dict[Atom, int] = {}
 
     def bits(self, atoms) -> tuple[int, tuple[int, ...]]:
-        ids = []
+        index, facts = self.index, self.facts
+        ids = set()
         for atom in atoms:
-            i = self.index.get(atom)
+            i = index.get(atom)
             if i is None:
-                i = self.index[atom] = len(self.facts)
-                self.facts.append(atom)
-            ids.append(i)
+                i = index[atom] = len(facts)
+                facts.append(atom)
+            ids.add(i)
         mask = 0
         for i in ids:
             mask |= 1 << i
-        return mask, tuple(sorted(set(ids)))
+        return mask, tuple(sorted(ids))
 
 
 def build_structure(
