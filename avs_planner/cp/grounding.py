@@ -299,16 +299,28 @@ def _probability(proto: _Proto, values: Mapping[Atom, float]) -> float:
     return probability
 
 
+def _read_mask(protos: Sequence[_Proto], goal: int) -> int:
+    """Every fact some action's precondition or the goal reads."""
+    read = goal
+    for proto in protos:
+        read |= proto.action.reads
+    return read
+
+
 def _instantiate(
-    proto: _Proto, index: int, probability: float, values: Mapping[Atom, float]
+    proto: _Proto, index: int, probability: float, values: Mapping[Atom, float], read: int
 ) -> GroundAction:
+    """The ground action with cost and probability; effects on facts nothing reads are
+    dropped (e.g. `visited` of ordinary places), so states differing only there merge."""
     cost = proto.schema.cost(proto.binding, values)
     if cost < 0:
         raise PlanningError(f"cost of {proto.action.label} is negative ({cost})")
     a = proto.action
+    add = a.add & read
+    add_facts = a.add_facts if add == a.add else tuple(f for f in a.add_facts if read >> f & 1)
     return GroundAction(
-        index, a.name, a.args, a.pre, a.pre_neg, a.add, a.delete, cost, probability,
-        a.assumptive, a.pre_facts, a.add_facts, a.clauses,
+        index, a.name, a.args, a.pre, a.pre_neg, add, a.delete & read, cost, probability,
+        a.assumptive, a.pre_facts, add_facts, a.clauses,
     )
 
 
@@ -388,8 +400,9 @@ def ground(
             possible.append(proto)
             probability[proto.action.index] = p
     reachable = _relevant(_reachable(possible, init), goal, goal_neg)
+    read = _read_mask(reachable, goal | goal_neg)
     actions = [
-        _instantiate(proto, i, probability[proto.action.index], state.values)
+        _instantiate(proto, i, probability[proto.action.index], state.values, read)
         for i, proto in enumerate(reachable)
     ]
     return GroundTask(

@@ -40,12 +40,12 @@ FORALL_DOMAIN = """(define (domain tour)
   (:requirements :strips :typing :negative-preconditions :disjunctive-preconditions
                  :universal-preconditions :action-costs)
   (:types spot)
-  (:predicates (marked ?s - spot) (visited ?s - spot) (done))
+  (:predicates (marked ?s - spot) (visited ?s - spot) (seen ?s - spot) (done))
   (:functions (total-cost) - number)
   (:action unmark :parameters (?s - spot) :precondition (marked ?s)
     :effect (and (not (marked ?s)) (increase (total-cost) 100)))
   (:action visit :parameters (?s - spot) :precondition (not (visited ?s))
-    :effect (and (visited ?s) (increase (total-cost) 5)))
+    :effect (and (visited ?s) (seen ?s) (increase (total-cost) 5)))
   (:action finish :parameters ()
     :precondition (forall (?s - spot) (imply (marked ?s) (visited ?s)))
     :effect (and (done) (increase (total-cost) 1))))
@@ -70,3 +70,15 @@ def test_inadmissible_estimates_count_forall_imply_clauses_and_hmax_stays_admiss
     assert ff_c == (5 + 1) + (5 + 1) + (1 + 1)  # FF counts +1 per action
     optimal = plan(pproblem, SearchOptions(weight=1.0, heuristic="hmax"))
     assert optimal.solved and hmax_c <= optimal.cost == 11
+
+
+def test_effects_on_facts_nothing_reads_are_dropped():
+    from avs_planner.pddl import read_text
+
+    task = ground(read_text(FORALL_DOMAIN, FORALL_PROBLEM, "tour.pddl", "tour3.pddl"))
+    seen = task.fact_index[("seen", "a")]
+    visited = task.fact_index[("visited", "a")]
+    visit = task.action("visit", ["a"])
+    assert visit is not None
+    assert not visit.add >> seen & 1 and visit.add >> visited & 1
+    assert seen not in visit.add_facts
