@@ -1,10 +1,13 @@
-"""POUCT for view-cone search: pomdp-py's POUCT with greedy rollouts and a hard horizon.
+"""POUCT for view-cone search: pomdp-py's POUCT with route-aware leaves and a hard horizon.
 
-pomdp-py runs the tree (UCB1, node statistics, tree reuse). Two hooks are ours: a simulation
-stops at CONFIRM/REJECT (pomdp-py has no terminal states) and at the step budget, where the
-best stop action is forced; and the rollout is the greedy policy run in a tight loop
-(pomdp-py's generic rollout would step the models until `max_depth` even after the episode
-ended).
+pomdp-py runs the tree (UCB1, node statistics, tree reuse). The hooks are ours:
+- a simulation stops at CONFIRM/REJECT (pomdp-py has no terminal states) and at the step
+  budget, where the best stop action is forced;
+- leaves are valued by the cheapest route-aware look sequence (`avs_planner.dt.route`, exact
+  expected cost under the leaf's belief), new actions start from the same values;
+- backups are exact over observations and take each child's best action (the sampled
+  running mean was noisy and undervalued looking again).
+With `route_leaves=False` the leaves are sampled greedy p/cost rollouts, as before.
 """
 
 from __future__ import annotations
