@@ -36,7 +36,10 @@ class LoopConfig:
     weight: float = 3.0
     heuristic: str = "hadd"  # on these problems far fewer expansions than ff
     min_success: float = 0.01
-    cp_timeout_s: float = 2.5
+    # the CP stops after this many expansions (deterministic for a seed, whatever the load)
+    # or this many seconds (a safety net); either counts as "timed out" below
+    cp_node_limit: int = 4000
+    cp_timeout_s: float = 20.0
     fallback_weight: float = 20.0
     time_budget_s: float = 1200.0
     wall_budget_s: float = 600.0
@@ -106,7 +109,7 @@ class SwitchingLoop:
     def _fallback(self, result: PlanResult) -> PlanResult:
         """A search that ran out of time is retried greedier (weight `fallback_weight`)."""
         assert self.planner is not None
-        if result.status is not PlanStatus.TIMEOUT:
+        if not _timed_out(result):
             return result
         self.result.cp_times.append(result.planning_time_s)
         dumped = self._dump_problem()
@@ -130,7 +133,7 @@ class SwitchingLoop:
     def _options(self) -> SearchOptions:
         cfg = self.config
         return SearchOptions(reward=cfg.reward, weight=cfg.weight, heuristic=cfg.heuristic,
-                             timeout_s=cfg.cp_timeout_s)
+                             node_limit=cfg.cp_node_limit, timeout_s=cfg.cp_timeout_s)
 
     def _execute(self, step: PlanStep, state: AvsState) -> StepOutcome:
         self.trace.emit("action", action=step.label, status="start")
@@ -143,7 +146,7 @@ class SwitchingLoop:
         """While the CP times out, explore a placeholder and plan again; None when there is
         nothing left to explore."""
         assert self.planner is not None
-        while result.status is PlanStatus.TIMEOUT:
+        while _timed_out(result):
             if not self._explore_instead() and not self._shrink():
                 return None
             state = self.builder.build()
@@ -215,6 +218,10 @@ class SwitchingLoop:
         self.trace.emit("done", outcome=outcome.value, reason=reason)
         return self.result
 
+
+
+def _timed_out(result: PlanResult) -> bool:
+    return result.status in (PlanStatus.TIMEOUT, PlanStatus.NODE_LIMIT)
 
 
 def assumed_categories(plan: tuple[PlanStep, ...] | list[PlanStep]) -> dict[str, str]:
