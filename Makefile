@@ -22,9 +22,10 @@ $(VENV)/.installed-bench: pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install -q -e '.[dev,bench]'
 	touch $@
 
-## run: set up .venv and run the main job on the built-in defaults
+## run: set up .venv and run the main job: one object-search episode in the built-in office
+## world (seed 003, Fig. 3a: start in the corridor, find the cereal box), outputs in runs/
 run: $(VENV)/.installed
-	$(BIN)/avs plan domains/avs/domain.pddl domains/avs/problems/corridor.pddl
+	$(BIN)/avs simulate --scenario a --seed 1 --out runs/office-cerealbox
 
 ## test: set up .venv with test extras and run the fast test suite
 test: $(VENV)/.installed-dev
