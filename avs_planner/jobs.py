@@ -1,8 +1,9 @@
 """The planner package as the HTTP service sees it: three plain-data jobs, nothing else.
 
 The service runs these in worker processes, so inputs and outputs are JSON-able dicts and the
-heavy modules are imported on first use. A missing part (e.g. the episode runner before
-`avs_planner/episode.py` exists) raises `JobUnavailableError`, never a fake result.
+heavy modules are imported on first use. A part that cannot be imported (e.g. the episode
+runner, `avs_planner.episode`, in a trimmed install) raises `JobUnavailableError`, never a fake
+result.
 """
 
 from __future__ import annotations
