@@ -138,33 +138,24 @@ def _goal_value(rt: RelaxedTask, dist: list[float], use_max: bool) -> float:
     return max(values) if use_max else sum(values)
 
 
+def _cost_and_risk(rt: RelaxedTask, state: int, use_max: bool) -> Estimate:
+    """Relaxed goal cost and −log-probability estimates (max or additive aggregation)."""
+    dist, _ = relaxed_costs(rt, state, rt.cost, use_max)
+    hc = _goal_value(rt, dist, use_max)
+    if hc == INF:
+        return INF, INF
+    dist, _ = relaxed_costs(rt, state, rt.neglog, use_max)
+    return hc, _goal_value(rt, dist, use_max)
+
+
 def _hmax(task: GroundTask, reward: float) -> Estimator:
     rt = RelaxedTask(task, reward)
-
-    def estimate(state: int) -> Estimate:
-        dist, _ = relaxed_costs(rt, state, rt.cost, True)
-        hc = _goal_value(rt, dist, True)
-        if hc == INF:
-            return INF, INF
-        dist, _ = relaxed_costs(rt, state, rt.neglog, True)
-        return hc, _goal_value(rt, dist, True)
-
-    return estimate
+    return lambda state: _cost_and_risk(rt, state, True)
 
 
 def _hadd(task: GroundTask, reward: float) -> Estimator:
     base = RelaxedTask(task, reward, clauses=True)
-
-    def estimate(state: int) -> Estimate:
-        rt = base.for_state(state)
-        dist, _ = relaxed_costs(rt, state, rt.cost, False)
-        hc = _goal_value(rt, dist, False)
-        if hc == INF:
-            return INF, INF
-        dist, _ = relaxed_costs(rt, state, rt.neglog, False)
-        return hc, _goal_value(rt, dist, False)
-
-    return estimate
+    return lambda state: _cost_and_risk(base.for_state(state), state, False)
 
 
 class _FF:

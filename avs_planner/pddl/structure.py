@@ -213,13 +213,19 @@ def check_order(sections: list[Node], order: list[str], report: Report) -> None:
             latest = (rank, head)
 
 
+def _start_define(define: SList, order: list[str], report: Report) -> Atom | None:
+    """Check the section order of a `(define ...)` form and return its declared name."""
+    check_order(define.items[2:], order, report)
+    header = define.items[1]
+    if isinstance(header, SList) and isinstance(header.items[1], Atom):
+        return header.items[1]
+    return None
+
+
 def read_domain(define: SList, report: Report) -> Domain:
     """Collect a domain's declarations from its `(define ...)` form."""
     domain = Domain(report.file)
-    check_order(define.items[2:], DOMAIN_ORDER, report)
-    header = define.items[1]
-    if isinstance(header, SList) and isinstance(header.items[1], Atom):
-        domain.name = header.items[1]
+    domain.name = _start_define(define, DOMAIN_ORDER, report) or domain.name
     for section in define.items[2:]:
         if not isinstance(section, SList) or not section.head().startswith(":"):
             report.add(section, "syntax", "expected a section such as (:predicates ...)")
@@ -372,10 +378,7 @@ _DOMAIN_SECTIONS = {
 def read_problem(define: SList, report: Report) -> Problem:
     """Collect a problem's declarations from its `(define ...)` form."""
     problem = Problem(report.file)
-    check_order(define.items[2:], PROBLEM_ORDER, report)
-    header = define.items[1]
-    if isinstance(header, SList) and isinstance(header.items[1], Atom):
-        problem.name = header.items[1]
+    problem.name = _start_define(define, PROBLEM_ORDER, report) or problem.name
     for section in define.items[2:]:
         if not isinstance(section, SList) or not section.head().startswith(":"):
             report.add(section, "syntax", "expected a section such as (:init ...)")
