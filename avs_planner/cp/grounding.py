@@ -3,18 +3,24 @@
 Two stages. The *structure* (every ground action consistent with types and static atoms, and
 the fact table) depends only on the domain, the objects and the static atoms, so it is cached
 under that key. The *instance* (initial bitset, relaxed-reachable actions, costs and success
-probabilities evaluated from numeric values) is rebuilt for every call and is cheap.
+probabilities evaluated from numeric values) is rebuilt for every call.
+
+Both stages work on arrays: atoms are integer codes (`encoding.AtomSpace`), a schema's
+bindings are columns of object ids built by a join over its static preconditions, and the
+reachability and relevance fixpoints run over (ground action x condition) arrays of fact ids.
+Only the ground actions that survive become `GroundAction` objects.
 """
 
 from __future__ import annotations
 
-import itertools
-from collections import OrderedDict, defaultdict
-from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from collections import OrderedDict
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
+import numpy as np
 from unified_planning.model import FNode, Problem
 
+from avs_planner.cp.encoding import AtomSpace, Columns
 from avs_planner.cp.formulas import FormulaGrounder
 from avs_planner.cp.schema import AtomTemplate, LiftedSchema, compile_schemas
 from avs_planner.cp.task import Atom, GroundAction, GroundTask, WorldState
@@ -22,25 +28,9 @@ from avs_planner.errors import PlanningError
 from avs_planner.pddl.model import ProbabilisticProblem
 
 MAX_GROUND_ACTIONS = 2_000_000
-
-
-@dataclass(frozen=True)
-class _Proto:
-    """A ground action before costs and probabilities are filled in."""
-
-    schema: LiftedSchema
-    binding: Mapping[str, str]
-    action: GroundAction
-
-
-@dataclass(frozen=True)
-class GroundStructure:
-    """The cached part of grounding: fact table and every statically possible ground action."""
-
-    facts: tuple[Atom, ...]
-    fact_index: Mapping[Atom, int]
-    protos: tuple[_Proto, ...]
-    static_atoms: frozenset[Atom]
+MAX_BINDINGS = 20_000_000  # partial bindings of one schema while joining its static atoms
+_PAD_TRUE = -1  # padding code of precondition arrays (an always-true fact)
+_PAD_NONE = -2  # padding code of the other arrays (a fact nothing reads or makes true)
 
 
 def world_state(problem: Problem) -> WorldState:
@@ -57,101 +47,231 @@ def world_state(problem: Problem) -> WorldState:
     return WorldState(frozenset(atoms), values)
 
 
-def _substitute(template: AtomTemplate, binding: Mapping[str, str]) -> Atom:
-    # a binding maps every parameter; object names never start with "?", so get(t, t) is exact
-    get = binding.get
-    return (template[0], *map(get, template[1:], template[1:]))
+@dataclass(frozen=True)
+class _Block:
+    """The ground actions of one schema: rows start..stop of the structure's arrays."""
+
+    schema: LiftedSchema
+    start: int
+    stop: int
+    columns: Mapping[str, np.ndarray]  # parameter -> object id, one per row
+    assumptive: bool
+
+    def select(self, mask: np.ndarray) -> tuple[Columns, int]:
+        """Columns of the rows where `mask` (over this block's rows) is true."""
+        return {p: c[mask] for p, c in self.columns.items()}, int(mask.sum())
 
 
-class _StaticIndex:
-    """Static true atoms, indexed by predicate and by (predicate, position, object)."""
+@dataclass(frozen=True)
+class GroundStructure:
+    """The cached part of grounding: fact table and every statically possible ground action.
 
-    def __init__(self, atoms: frozenset[Atom]):
-        self.by_pred: dict[str, list[tuple[str, ...]]] = defaultdict(list)
-        self.by_pos: dict[tuple[str, int, str], list[tuple[str, ...]]] = defaultdict(list)
-        for atom in sorted(atoms):
-            args = atom[1:]
-            self.by_pred[atom[0]].append(args)
-            for i, obj in enumerate(args):
-                self.by_pos[(atom[0], i, obj)].append(args)
+    Rows of `pre`, `pre_neg`, `add`, `delete` are ground actions, entries fact ids; padding is
+    fact id `len(facts)` in `pre` (read as true) and `len(facts) + 1` elsewhere (never true)."""
 
-    def candidates(self, template: AtomTemplate, binding: Mapping[str, str]):
-        for i, term in enumerate(template[1:]):
-            value = binding.get(term) if term[0] == "?" else term
-            if value is not None:
-                return self.by_pos.get((template[0], i, value), ())
-        return self.by_pred.get(template[0], ())
+    facts: tuple[Atom, ...]
+    fact_index: Mapping[Atom, int]
+    static_atoms: frozenset[Atom]
+    space: AtomSpace
+    blocks: tuple[_Block, ...]
+    pre: np.ndarray
+    pre_neg: np.ndarray
+    add: np.ndarray
+    delete: np.ndarray
+    clauses: Mapping[int, tuple[tuple[tuple[int, ...], tuple[int, ...]], ...]]
+    _rows: dict[int, tuple] = field(default_factory=dict, compare=False, repr=False)
+    _lists: list = field(default_factory=list, compare=False, repr=False)
 
+    @property
+    def size(self) -> int:
+        return len(self.pre)
 
-def _match(template: AtomTemplate, args, binding: dict, domains) -> dict | None:
-    terms = template[1:]
-    if len(terms) != len(args):
-        return None
-    new = dict(binding)
-    for term, value in zip(terms, args, strict=True):
-        if term[0] != "?":
-            if term != value:
-                return None
-        elif term in new:
-            if new[term] != value:
-                return None
-        elif value in domains[term]:
-            new[term] = value
-        else:
-            return None
-    return new
+    def block_of(self, row: int) -> _Block:
+        for block in self.blocks:
+            if block.start <= row < block.stop:
+                return block
+        raise IndexError(row)
 
+    def label(self, row: int) -> str:
+        block = self.block_of(row)
+        names = self.space.names
+        args = (names[int(block.columns[p][row - block.start])] for p in block.schema.params)
+        return "(" + " ".join((block.schema.name, *args)) + ")"
 
-def _join(atoms: Sequence[AtomTemplate], binding: dict, index: _StaticIndex, domains) -> Iterator:
-    if not atoms:
-        yield binding
-        return
-    first, rest = atoms[0], atoms[1:]
-    for args in index.candidates(first, binding):
-        extended = _match(first, args, binding, domains)
-        if extended is not None:
-            yield from _join(rest, extended, index, domains)
-
-
-def _bindings(schema: LiftedSchema, index: _StaticIndex, order, member, static):
-    """Every parameter binding consistent with types, static atoms and (in)equalities."""
-    for partial in _join(schema.static_pos, {}, index, member):
-        free = [p for p in schema.params if p not in partial]
-        for values in itertools.product(*(order[p] for p in free)):
-            binding = {**partial, **dict(zip(free, values, strict=True))}
-            if _consistent(schema, binding, static):
-                yield binding
-
-
-def _consistent(schema: LiftedSchema, binding: Mapping[str, str], static) -> bool:
-    def value(term: str) -> str:
-        return binding[term] if term[0] == "?" else term
-
-    if any(value(a) != value(b) for a, b in schema.equal):
-        return False
-    if any(value(a) == value(b) for a, b in schema.not_equal):
-        return False
-    return not any(_substitute(t, binding) in static for t in schema.static_neg)
+    def row(self, row: int) -> tuple:
+        """(name, args, pre, pre_neg, add, delete, pre_facts, add_facts, clauses, assumptive,
+        signature) of one ground action, built once per structure."""
+        known = self._rows.get(row)
+        if known is not None:
+            return known
+        if not self._lists:
+            self._lists.extend((self.pre.tolist(), self.pre_neg.tolist(), self.add.tolist(),
+                                self.delete.tolist(), {}))
+        pre_rows, neg_rows, add_rows, delete_rows, columns = self._lists
+        n = len(self.facts)
+        block = self.block_of(row)
+        cols = columns.get(block.start)
+        if cols is None:
+            cols = columns[block.start] = [block.columns[p].tolist() for p in block.schema.params]
+        names = self.space.names
+        i = row - block.start
+        args = tuple([names[c[i]] for c in cols])
+        pre_facts = tuple(sorted({f for f in pre_rows[row] if f < n}))
+        add_facts = tuple(sorted({f for f in add_rows[row] if f < n}))
+        clauses = tuple((_mask(pos), _mask(negs)) for pos, negs in self.clauses.get(row, ()))
+        add = _mask(add_facts)
+        name = block.schema.name
+        known = self._rows[row] = (
+            name, args, _mask(pre_facts), _mask(f for f in neg_rows[row] if f < n), add,
+            _mask(f for f in delete_rows[row] if f < n) & ~add, pre_facts, add_facts, clauses,
+            block.assumptive, (name.lower(), *(x.lower() for x in args)),
+        )
+        return known
 
 
-class _FactTable:
-    def __init__(self) -> None:
-        self.facts: list[Atom] = []
-        self.index: dict[Atom, int] = {}
+def _mask(ids) -> int:
+    mask = 0
+    for i in ids:
+        mask |= 1 << i
+    return mask
 
-    def bits(self, atoms) -> tuple[int, tuple[int, ...]]:
-        index, facts = self.index, self.facts
-        ids = set()
-        for atom in atoms:
-            i = index.get(atom)
-            if i is None:
-                i = index[atom] = len(facts)
-                facts.append(atom)
-            ids.add(i)
-        mask = 0
-        for i in ids:
-            mask |= 1 << i
-        return mask, tuple(sorted(ids))
+
+def _member(codes: np.ndarray, sorted_codes: np.ndarray) -> np.ndarray:
+    if len(sorted_codes) == 0:
+        return np.zeros(len(codes), dtype=bool)
+    at = np.minimum(np.searchsorted(sorted_codes, codes), len(sorted_codes) - 1)
+    return sorted_codes[at] == codes
+
+
+def _term_params(terms: Sequence[str]) -> frozenset[str]:
+    return frozenset(t for t in terms if t[0] == "?")
+
+
+def _bindings(
+    schema: LiftedSchema, space: AtomSpace, static_codes: np.ndarray
+) -> tuple[dict[str, np.ndarray], int]:
+    """Every parameter binding consistent with types, static atoms and (in)equalities, as
+    columns of object ids in lexicographic order of the schema's parameters. A join: one
+    parameter at a time (the one closing most constraints first), filtering as soon as a
+    constraint's parameters are all bound."""
+    params = schema.params
+    domain = {p: space.objects_of(t) for p, t in zip(params, schema.param_types, strict=True)}
+    pending = (
+        [("in", t, _term_params(t[1:])) for t in schema.static_pos]
+        + [("out", t, _term_params(t[1:])) for t in schema.static_neg]
+        + [("eq", pair, _term_params(pair)) for pair in schema.equal]
+        + [("ne", pair, _term_params(pair)) for pair in schema.not_equal]
+    )
+    columns: dict[str, np.ndarray] = {}
+    rows = 1
+
+    def value(term: str, rows: int) -> np.ndarray:
+        if term[0] == "?":
+            return columns[term]
+        return np.full(rows, space.object_id[term], dtype=np.int64)
+
+    def apply(ready: list) -> None:
+        nonlocal columns, rows
+        mask = np.ones(rows, dtype=bool)
+        for kind, item, _ in ready:
+            if kind in ("in", "out"):
+                hit = _member(space.encode_rows(item, columns, rows), static_codes)
+                mask &= hit if kind == "in" else ~hit
+            else:
+                same = value(item[0], rows) == value(item[1], rows)
+                mask &= same if kind == "eq" else ~same
+        if not mask.all():
+            columns = {p: c[mask] for p, c in columns.items()}
+            rows = int(mask.sum())
+
+    bound: set[str] = set()
+    apply([c for c in pending if not c[2]])
+    pending = [c for c in pending if c[2]]
+    remaining = list(params)
+    while remaining and rows:
+        param = min(remaining, key=lambda p, pending=pending: (
+            -sum(1 for c in pending if c[2] <= bound | {p}), len(domain[p]), params.index(p)
+        ))
+        remaining.remove(param)
+        objects = domain[param]
+        if rows * len(objects) > MAX_BINDINGS:
+            raise PlanningError(
+                f"action {schema.name}: more than {MAX_BINDINGS} partial bindings to ground"
+            )
+        columns = {p: np.repeat(c, len(objects)) for p, c in columns.items()}
+        columns[param] = np.tile(objects, rows)
+        rows *= len(objects)
+        bound.add(param)
+        apply([c for c in pending if c[2] <= bound])
+        pending = [c for c in pending if not c[2] <= bound]
+    if not rows or remaining:
+        return {p: np.zeros(0, dtype=np.int64) for p in params}, 0
+    if params:
+        order = np.lexsort([columns[p] for p in reversed(params)])
+        columns = {p: columns[p][order] for p in params}
+    return columns, rows
+
+
+def _codes(templates: Sequence[AtomTemplate], space: AtomSpace, columns: Columns,
+           rows: int) -> np.ndarray:
+    if not templates:
+        return np.empty((rows, 0), dtype=np.int64)
+    return np.stack([space.encode_rows(t, columns, rows) for t in templates], axis=1)
+
+
+def _pad(lists: list[list[int]], pad: int) -> np.ndarray:
+    width = max((len(x) for x in lists), default=0)
+    out = np.full((len(lists), width), pad, dtype=np.int64)
+    for i, x in enumerate(lists):
+        out[i, : len(x)] = x
+    return out
+
+
+def _complex_rows(schema, space, columns, rows, formulas):
+    """Per binding: CNF of the quantified/disjunctive conditions. Unit clauses become extra
+    pre/pre_neg codes; longer ones are kept per row. Rows with an empty clause are dropped."""
+    keep = np.ones(rows, dtype=bool)
+    extra_pos: list[list[int]] = []
+    extra_neg: list[list[int]] = []
+    clauses: list[tuple] = []
+    names = space.names
+
+    def code(atom: Atom) -> int:
+        c = space.encode(atom)
+        if c is None:
+            raise PlanningError(f"action {schema.name}: cannot ground condition atom {atom}")
+        return c
+
+    for i in range(rows):
+        binding = {p: names[int(columns[p][i])] for p in schema.params}
+        cnf = [c for node in schema.complex for c in formulas.cnf(node, binding)]
+        pos: list[int] = []
+        neg: list[int] = []
+        longer = []
+        for clause in sorted(cnf, key=lambda c: sorted(c)):
+            if not clause:
+                keep[i] = False
+                break
+            if len(clause) == 1:
+                ((atom, positive),) = clause
+                (pos if positive else neg).append(code(atom))
+            else:
+                longer.append((
+                    tuple(code(a) for a, positive in sorted(clause) if positive),
+                    tuple(code(a) for a, positive in sorted(clause) if not positive),
+                ))
+        extra_pos.append(pos)
+        extra_neg.append(neg)
+        clauses.append(tuple(longer))
+    return keep, _pad(extra_pos, _PAD_TRUE), _pad(extra_neg, _PAD_NONE), clauses
+
+
+def _widen(array: np.ndarray, width: int, pad: int) -> np.ndarray:
+    if array.shape[1] == width:
+        return array
+    out = np.full((array.shape[0], width), pad, dtype=np.int64)
+    out[:, : array.shape[1]] = array
+    return out
 
 
 def build_structure(
@@ -159,60 +279,97 @@ def build_structure(
     assumptive: Mapping[str, bool],
 ) -> GroundStructure:
     """Ground every action over the objects, filtered by types and static atoms."""
-    index = _StaticIndex(static)
-    table = _FactTable()
+    space = AtomSpace(problem)
+    static_codes = np.unique(np.array(
+        [c for c in (space.encode(a) for a in static) if c is not None], dtype=np.int64
+    ))
     static_names = {f.name for f in problem.get_static_fluents()}
     formulas = FormulaGrounder(
         static, static_names, lambda t: list(dict.fromkeys(o.name for o in problem.objects(t)))
     )
-    protos: list[_Proto] = []
+    parts = []  # (schema, columns, rows, pre, neg, add, delete, clauses per row)
+    total = 0
     for schema in schemas:
         if schema.never:
             continue
-        order = {
-            p: list(dict.fromkeys(o.name for o in problem.objects(t)))
-            for p, t in zip(schema.params, schema.param_types, strict=True)
-        }
-        member = {p: set(names) for p, names in order.items()}
-        for binding in _bindings(schema, index, order, member, static):
-            proto = _proto(schema, binding, table, len(protos), assumptive, formulas)
-            if proto is not None:
-                protos.append(proto)
-            if len(protos) > MAX_GROUND_ACTIONS:
-                raise PlanningError(f"grounding exceeds {MAX_GROUND_ACTIONS} actions")
-    return GroundStructure(tuple(table.facts), dict(table.index), tuple(protos), static)
+        columns, rows = _bindings(schema, space, static_codes)
+        if not rows:
+            continue
+        pre = _codes(schema.pre_pos, space, columns, rows)
+        neg = _codes(schema.pre_neg, space, columns, rows)
+        clauses: list[tuple] = [()] * rows
+        if schema.complex:
+            keep, more_pos, more_neg, clauses = _complex_rows(
+                schema, space, columns, rows, formulas
+            )
+            pre = np.concatenate([pre, more_pos], axis=1)
+            neg = np.concatenate([neg, more_neg], axis=1)
+        else:
+            keep = np.ones(rows, dtype=bool)
+        for i in range(pre.shape[1]):  # a condition and its negation: never applicable
+            for j in range(neg.shape[1]):
+                keep &= pre[:, i] != neg[:, j]
+        add = _codes(schema.add, space, columns, rows)
+        delete = _codes(schema.delete, space, columns, rows)
+        for j in range(delete.shape[1]):  # add wins over delete (PDDL: deletes first)
+            for i in range(add.shape[1]):
+                delete[:, j] = np.where(delete[:, j] == add[:, i], _PAD_NONE, delete[:, j])
+        if not keep.all():
+            columns = {p: c[keep] for p, c in columns.items()}
+            pre, neg, add, delete = pre[keep], neg[keep], add[keep], delete[keep]
+            clauses = [c for c, k in zip(clauses, keep.tolist(), strict=True) if k]
+            rows = int(keep.sum())
+        total += rows
+        if total > MAX_GROUND_ACTIONS:
+            raise PlanningError(f"grounding exceeds {MAX_GROUND_ACTIONS} actions")
+        if rows:
+            parts.append((schema, columns, rows, pre, neg, add, delete, clauses))
+    return _assemble(problem, space, static, parts, assumptive)
 
 
-def _proto(schema, binding, table: _FactTable, i: int, assumptive, formulas) -> _Proto | None:
-    pos_atoms = [_substitute(t, binding) for t in schema.pre_pos]
-    neg_atoms = [_substitute(t, binding) for t in schema.pre_neg]
-    clauses: list[tuple[int, int]] = []
-    if schema.complex:
-        cnf = [c for node in schema.complex for c in formulas.cnf(node, binding)]
-        for clause in sorted(cnf, key=lambda c: sorted(c)):
-            if not clause:
-                return None
-            if len(clause) == 1:
-                ((atom, positive),) = clause
-                (pos_atoms if positive else neg_atoms).append(atom)
-            else:
-                pos, _ = table.bits(a for a, positive in sorted(clause) if positive)
-                neg, _ = table.bits(a for a, positive in sorted(clause) if not positive)
-                clauses.append((pos, neg))
-    pre, pre_ids = table.bits(pos_atoms)
-    neg, _ = table.bits(neg_atoms)
-    if pre & neg:
-        return None
-    add, add_ids = table.bits(_substitute(t, binding) for t in schema.add)
-    delete, _ = table.bits(_substitute(t, binding) for t in schema.delete)
-    args = tuple(binding[p] for p in schema.params)
-    action = GroundAction(
-        index=i, name=schema.name, args=args, pre=pre, pre_neg=neg, add=add,
-        delete=delete & ~add, cost=0.0, probability=1.0,
-        assumptive=assumptive[schema.name], pre_facts=pre_ids, add_facts=add_ids,
-        clauses=tuple(clauses),
+def _assemble(problem, space, static, parts, assumptive) -> GroundStructure:
+    """Concatenate the schemas' rows and renumber the atom codes they use as fact ids."""
+    arrays = {k: [] for k in ("pre", "neg", "add", "delete")}
+    clause_codes: list = []
+    for _, _, _, pre, neg, add, delete, clauses in parts:
+        for key, array in zip(arrays, (pre, neg, add, delete), strict=True):
+            arrays[key].append(array)
+        clause_codes.extend(c for row in clauses for clause in row for side in clause
+                            for c in side)
+    used = [a[a >= 0] for key in arrays for a in arrays[key]]
+    codes = np.unique(np.concatenate(used + [np.array(clause_codes, dtype=np.int64)]))
+    n = len(codes)
+    facts = tuple(space.decode(c) for c in codes.tolist())
+
+    def renumber(array: np.ndarray, pad: int) -> np.ndarray:
+        out = np.searchsorted(codes, array)
+        out[array == _PAD_TRUE] = n
+        out[array == _PAD_NONE] = n + 1
+        return out
+
+    stacked = {}
+    for key, pad in (("pre", _PAD_TRUE), ("neg", _PAD_NONE), ("add", _PAD_NONE),
+                     ("delete", _PAD_NONE)):
+        width = max((a.shape[1] for a in arrays[key]), default=0)
+        joined = (np.concatenate([_widen(a, width, pad) for a in arrays[key]])
+                  if arrays[key] else np.empty((0, 0), dtype=np.int64))
+        stacked[key] = renumber(joined, pad)
+    blocks, clauses, start = [], {}, 0
+    index_of = {c: i for i, c in enumerate(codes.tolist())}
+    for schema, columns, rows, *_, row_clauses in parts:
+        blocks.append(_Block(schema, start, start + rows, columns, assumptive[schema.name]))
+        for i, row in enumerate(row_clauses):
+            if row:
+                clauses[start + i] = tuple(
+                    (tuple(index_of[c] for c in pos), tuple(index_of[c] for c in neg))
+                    for pos, neg in row
+                )
+        start += rows
+    return GroundStructure(
+        facts=facts, fact_index={a: i for i, a in enumerate(facts)},
+        static_atoms=static, space=space, blocks=tuple(blocks), pre=stacked["pre"],
+        pre_neg=stacked["neg"], add=stacked["add"], delete=stacked["delete"], clauses=clauses,
     )
-    return _Proto(schema, binding, action)
 
 
 def _goal(problem: Problem, structure: GroundStructure) -> tuple[int, int, bool]:
@@ -245,83 +402,97 @@ def _flatten(node: FNode) -> list[FNode]:
     return [node]
 
 
-def _reachable(protos: Sequence[_Proto], init: int) -> list[_Proto]:
-    """Relaxed reachability (negative preconditions ignored): actions that may ever apply."""
-    reached = init
-    pending = list(protos)
-    kept: list[_Proto] = []
-    changed = True
-    while changed:
-        changed = False
-        waiting = []
-        for proto in pending:
-            pre = proto.action.pre
-            if pre & reached == pre:
-                kept.append(proto)
-                if proto.action.add & ~reached:
-                    reached |= proto.action.add
-                    changed = True
-            else:
-                waiting.append(proto)
-        pending = waiting
-    kept.sort(key=lambda p: p.action.index)
-    return kept
+def _ids(mask: int) -> list[int]:
+    out, i = [], 0
+    while mask:
+        if mask & 1:
+            out.append(i)
+        mask >>= 1
+        i += 1
+    return out
 
 
-def _relevant(protos: Sequence[_Proto], goal: int, goal_neg: int) -> list[_Proto]:
+def _reachable(st: GroundStructure, init: np.ndarray, allowed: np.ndarray) -> np.ndarray:
+    """Relaxed reachability (negative preconditions and clauses ignored) over the rows in
+    `allowed`: the rows that may ever apply. `init` is a boolean array over fact ids + pads."""
+    reached = init.copy()
+    active = np.zeros(st.size, dtype=bool)
+    waiting = np.flatnonzero(allowed)
+    none = len(st.facts) + 1
+    while len(waiting):
+        ok = reached[st.pre[waiting]].all(axis=1)
+        if not ok.any():
+            break
+        new = waiting[ok]
+        waiting = waiting[~ok]
+        active[new] = True
+        before = int(reached.sum())
+        reached[st.add[new]] = True
+        reached[none] = False
+        if int(reached.sum()) == before:
+            break
+    return active
+
+
+def _relevant(st: GroundStructure, allowed: np.ndarray, goal: int, goal_neg: int) -> np.ndarray:
     """Backward relevance: keep actions that add a fact needed true or delete one needed
     false, where needs grow by the kept actions' conditions. Dropping the rest loses no plan
     (they can be cut from any plan, which only lowers its cost and raises its probability)."""
-    need_true, need_false = goal, goal_neg
-    kept = [False] * len(protos)
-    changed = True
-    while changed:
-        changed = False
-        for i, proto in enumerate(protos):
-            a = proto.action
-            if kept[i] or not (a.add & need_true or a.delete & need_false):
-                continue
-            kept[i] = changed = True
-            need_true |= a.pre
-            need_false |= a.pre_neg
-            for pos, neg in a.clauses:
-                need_true |= pos
-                need_false |= neg
-    return [p for p, keep in zip(protos, kept, strict=True) if keep]
+    n = len(st.facts)
+    need_true = np.zeros(n + 2, dtype=bool)
+    need_false = np.zeros(n + 2, dtype=bool)
+    need_true[_ids(goal)] = True
+    need_false[_ids(goal_neg)] = True
+    kept = np.zeros(st.size, dtype=bool)
+    waiting = np.flatnonzero(allowed)
+    while len(waiting):
+        hit = need_true[st.add[waiting]].any(axis=1) | need_false[st.delete[waiting]].any(axis=1)
+        if not hit.any():
+            break
+        new = waiting[hit]
+        waiting = waiting[~hit]
+        kept[new] = True
+        need_true[st.pre[new]] = True
+        need_false[st.pre_neg[new]] = True
+        for row in new.tolist():
+            for pos, neg in st.clauses.get(row, ()):
+                need_true[list(pos)] = True
+                need_false[list(neg)] = True
+        need_true[n:] = False
+        need_false[n:] = False
+    return kept
 
 
-def _probability(proto: _Proto, values: Mapping[Atom, float]) -> float:
-    probability = proto.schema.probability(proto.binding, values)
-    if not 0.0 <= probability <= 1.0:
-        raise PlanningError(
-            f"success probability of {proto.action.label} is {probability}, not in [0, 1]"
-        )
-    return probability
+def _evaluate(st: GroundStructure, rows: np.ndarray, values: Mapping[Atom, float],
+              what: str) -> np.ndarray:
+    """Success probability (`what` = "prob") or cost of the rows in the boolean mask."""
+    out = np.zeros(st.size)
+    for block in st.blocks:
+        sel = rows[block.start:block.stop]
+        if not sel.any():
+            continue
+        columns, count = block.select(sel)
+        expr = block.schema.prob_vec if what == "prob" else block.schema.cost_vec
+        out[block.start:block.stop][sel] = expr(st.space, columns, count, values)
+    return out
 
 
-def _read_mask(protos: Sequence[_Proto], goal: int) -> int:
-    """Every fact some action's precondition or the goal reads."""
-    read = goal
-    for proto in protos:
-        read |= proto.action.reads
-    return read
+def _check(st: GroundStructure, rows: np.ndarray, values: np.ndarray, what: str) -> None:
+    if what == "prob":
+        bad = rows & ~((values >= 0.0) & (values <= 1.0))
+    else:
+        bad = rows & ~((values >= 0.0) & np.isfinite(values))
+    if bad.any():
+        row = int(np.flatnonzero(bad)[0])
+        if what == "prob":
+            raise PlanningError(
+                f"success probability of {st.label(row)} is {values[row]}, not in [0, 1]"
+            )
+        raise PlanningError(f"cost of {st.label(row)} is {values[row]} (must be >= 0)")
 
 
-def _instantiate(
-    proto: _Proto, index: int, probability: float, values: Mapping[Atom, float], read: int
-) -> GroundAction:
-    """The ground action with cost and probability; effects on facts nothing reads are
-    dropped (e.g. `visited` of ordinary places), so states differing only there merge."""
-    cost = proto.schema.cost(proto.binding, values)
-    if cost < 0:
-        raise PlanningError(f"cost of {proto.action.label} is negative ({cost})")
-    a = proto.action
-    add = a.add & read
-    add_facts = a.add_facts if add == a.add else tuple(f for f in a.add_facts if read >> f & 1)
-    return GroundAction(
-        index, a.name, a.args, a.pre, a.pre_neg, add, a.delete & read, cost, probability,
-        a.assumptive, a.pre_facts, add_facts, a.clauses,
-    )
+def _bits(flags: np.ndarray) -> int:
+    return int.from_bytes(np.packbits(flags, bitorder="little").tobytes(), "little")
 
 
 class GroundingCache:
@@ -385,28 +556,52 @@ def ground(
     cache = DEFAULT_CACHE if cache is None else cache
     state = world_state(pproblem.problem) if state is None else state
     structure = cache.structure(pproblem, state)
-    init = 0
-    for atom in state.true_atoms:
-        i = structure.fact_index.get(atom)
-        if i is not None:
-            init |= 1 << i
-    goal, goal_neg, impossible = _goal(pproblem.problem, structure)
+    st = structure
+    n = len(st.facts)
+    init_ids = [i for i in map(st.fact_index.get, state.true_atoms) if i is not None]
+    init = _mask(init_ids)
+    goal, goal_neg, impossible = _goal(pproblem.problem, st)
+    reached = np.zeros(n + 2, dtype=bool)
+    reached[init_ids] = True
+    reached[n] = True  # the padding of preconditions
     # drop actions that can never succeed (p = 0), then what only they made reachable;
     # only reachable actions are evaluated (others may read values :init does not give)
-    possible, probability = [], {}
-    for proto in _reachable(structure.protos, init):
-        p = _probability(proto, state.values)
-        if p > 0.0:
-            possible.append(proto)
-            probability[proto.action.index] = p
-    reachable = _relevant(_reachable(possible, init), goal, goal_neg)
-    read = _read_mask(reachable, goal | goal_neg)
-    actions = [
-        _instantiate(proto, i, probability[proto.action.index], state.values, read)
-        for i, proto in enumerate(reachable)
-    ]
+    reachable = _reachable(st, reached, np.ones(st.size, dtype=bool))
+    probability = _evaluate(st, reachable, state.values, "prob")
+    _check(st, reachable, probability, "prob")
+    possible = reachable & (probability > 0.0)
+    kept = _relevant(st, _reachable(st, reached, possible), goal, goal_neg)
+    cost = _evaluate(st, kept, state.values, "cost")
+    _check(st, kept, cost, "cost")
+    # effects on facts nothing reads are dropped (e.g. `visited` of ordinary places), so
+    # states differing only there merge
+    read = np.zeros(n + 2, dtype=bool)
+    read[_ids(goal | goal_neg)] = True
+    read[st.pre[kept]] = True
+    read[st.pre_neg[kept]] = True
+    rows = np.flatnonzero(kept).tolist()
+    for row in rows:
+        for pos, neg in st.clauses.get(row, ()):
+            read[list(pos)] = True
+            read[list(neg)] = True
+    read_mask = _bits(read[:n])
+    actions = []
+    by_signature = {}
+    costs, probabilities = cost.tolist(), probability.tolist()
+    for index, row in enumerate(rows):
+        (name, args, pre, neg, add, delete, pre_facts, add_facts, clauses, assume,
+         signature) = st.row(row)
+        if add & ~read_mask:
+            add &= read_mask
+            add_facts = tuple(f for f in add_facts if read_mask >> f & 1)
+        action = GroundAction(
+            index, name, args, pre, neg, add, delete & read_mask, costs[row],
+            probabilities[row], assume, pre_facts, add_facts, clauses,
+        )
+        actions.append(action)
+        by_signature[signature] = action
     return GroundTask(
         facts=structure.facts, fact_index=structure.fact_index, actions=tuple(actions),
         init=init, goal=goal, goal_neg=goal_neg, goal_impossible=impossible,
-        by_signature={(a.name.lower(), *(x.lower() for x in a.args)): a for a in actions},
+        by_signature=by_signature,
     )

@@ -20,6 +20,7 @@ from unified_planning.model import (
     Type,
 )
 
+from avs_planner.cp.encoding import VectorExpr, compile_vector
 from avs_planner.errors import PlanningError
 from avs_planner.pddl.model import ProbabilisticProblem
 
@@ -48,6 +49,8 @@ class LiftedSchema:
     probability: NumExpr
     complex: tuple[FNode, ...] = ()
     never: bool = False
+    cost_vec: VectorExpr | None = None  # the same expressions over arrays of bindings
+    prob_vec: VectorExpr | None = None
 
 
 def _term(node: FNode) -> Term:
@@ -184,6 +187,9 @@ def compile_schemas(pproblem: ProbabilisticProblem) -> tuple[LiftedSchema, ...]:
                 add=tuple(add), delete=tuple(delete),
                 cost=cost, probability=prob, never=bool(parts["never"]),
                 complex=tuple(parts["complex"]),
+                cost_vec=compile_vector(cost_node, f"cost of {action.name}",
+                                        0.0 if has_metric else 1.0),
+                prob_vec=compile_vector(prob_node, f"success probability of {action.name}", 1.0),
             )
         )
     return tuple(schemas)

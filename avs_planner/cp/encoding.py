@@ -1,0 +1,180 @@
+"""Ground atoms as integers, so the grounder can work on whole arrays of bindings at once.
+
+Every fluent (boolean or numeric) gets a block of codes: the code of `(f o1 .. ok)` is
+`base[f] + sum(stride_i * local_i(o_i))`, where `local_i` is the object's position among the
+objects of the fluent's i-th parameter type. A lifted atom under an array of bindings is then
+a few integer array operations, and numeric expressions (costs, success probabilities) are
+evaluated for many ground actions in one go.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+from collections.abc import Callable, Mapping
+from fractions import Fraction
+
+import numpy as np
+from unified_planning.model import FNode, Problem, Type
+
+from avs_planner.cp.task import Atom
+from avs_planner.errors import PlanningError
+
+Columns = Mapping[str, np.ndarray]  # parameter ("?x") -> object ids, one per binding
+MAX_CODE = 2**62
+
+
+class AtomSpace:
+    """Object ids, per-type object lists and the integer code of every possible atom."""
+
+    def __init__(self, problem: Problem):
+        self.problem = problem
+        self.names: list[str] = [o.name for o in problem.all_objects]
+        self.object_id: dict[str, int] = {n: i for i, n in enumerate(self.names)}
+        self._of_type: dict[str, np.ndarray] = {}
+        self._local: dict[str, np.ndarray] = {}
+        self.base: dict[str, int] = {}
+        self.strides: dict[str, tuple[int, ...]] = {}
+        self.arg_types: dict[str, tuple[Type, ...]] = {}
+        self._starts: list[int] = []
+        self._fluents: list[str] = []
+        total = 0
+        for fluent in problem.fluents:
+            types = tuple(p.type for p in fluent.signature)
+            sizes = [len(self.objects_of(t)) for t in types]
+            strides = [1] * len(sizes)
+            for i in range(len(sizes) - 2, -1, -1):
+                strides[i] = strides[i + 1] * max(sizes[i + 1], 1)
+            self.base[fluent.name] = total
+            self.strides[fluent.name] = tuple(strides)
+            self.arg_types[fluent.name] = types
+            self._starts.append(total)
+            self._fluents.append(fluent.name)
+            total += max(math.prod(sizes), 1)
+            if total >= MAX_CODE:
+                raise PlanningError(
+                    f"too many possible atoms to ground (fluent {fluent.name} over "
+                    f"{' x '.join(map(str, sizes))} objects)"
+                )
+        self.size = total
+        self._decoded: dict[int, Atom] = {}
+
+    def objects_of(self, type_: Type) -> np.ndarray:
+        """Object ids of `type_` (subtypes included), in the problem's order."""
+        key = str(type_)
+        ids = self._of_type.get(key)
+        if ids is None:
+            names = dict.fromkeys(o.name for o in self.problem.objects(type_))
+            ids = self._of_type[key] = np.fromiter(
+                (self.object_id[n] for n in names), dtype=np.int64, count=len(names)
+            )
+            local = np.full(len(self.names), -1, dtype=np.int64)
+            local[ids] = np.arange(len(ids))
+            self._local[key] = local
+        return ids
+
+    def _local_of(self, type_: Type) -> np.ndarray:
+        self.objects_of(type_)
+        return self._local[str(type_)]
+
+    def encode_rows(self, template: tuple[str, ...], columns: Columns, rows: int) -> np.ndarray:
+        """Codes of a lifted atom `(f ?x obj ...)` under `rows` bindings."""
+        name = template[0]
+        code = np.full(rows, self.base[name], dtype=np.int64)
+        types = self.arg_types[name]
+        for term, stride, type_ in zip(template[1:], self.strides[name], types, strict=True):
+            local = self._local_of(type_)
+            if term[0] == "?":
+                code += stride * local[columns[term]]
+            else:
+                code += stride * int(local[self.object_id[term]])
+        return code
+
+    def encode(self, atom: Atom) -> int | None:
+        """Code of a ground atom; None if its fluent or an object is unknown or mistyped."""
+        base = self.base.get(atom[0])
+        if base is None or len(atom) - 1 != len(self.strides[atom[0]]):
+            return None
+        code = base
+        for obj, stride, type_ in zip(atom[1:], self.strides[atom[0]], self.arg_types[atom[0]],
+                                      strict=True):
+            gid = self.object_id.get(obj)
+            if gid is None:
+                return None
+            local = int(self._local_of(type_)[gid])
+            if local < 0:
+                return None
+            code += stride * local
+        return code
+
+    def decode(self, code: int) -> Atom:
+        atom = self._decoded.get(code)
+        if atom is not None:
+            return atom
+        i = int(np.searchsorted(self._starts, code, side="right")) - 1
+        name = self._fluents[i]
+        rest = code - self._starts[i]
+        names = []
+        for stride, type_ in zip(self.strides[name], self.arg_types[name], strict=True):
+            local, rest = divmod(rest, stride)
+            names.append(self.names[int(self.objects_of(type_)[local])])
+        atom = self._decoded[code] = (name, *names)
+        return atom
+
+
+VectorExpr = Callable[[AtomSpace, Columns, int, Mapping[Atom, float]], np.ndarray]
+"""(space, columns, rows, numeric values) -> one value per row."""
+
+_ARITH = {"PLUS": operator.add, "MINUS": operator.sub, "TIMES": operator.mul,
+          "DIV": operator.truediv}
+
+
+def compile_vector(node: FNode | None, where: str, default: float) -> VectorExpr:
+    """A numeric UP expression (constants, fluent terms, + - * /) over arrays of bindings."""
+    if node is None:
+        return lambda space, cols, rows, values: np.full(rows, default)
+    if node.is_constant():
+        value = float(Fraction(str(node.constant_value())))
+        return lambda space, cols, rows, values: np.full(rows, value)
+    if node.is_fluent_exp():
+        template = (node.fluent().name, *(_term(a) for a in node.args))
+        return lambda space, cols, rows, values: _lookup(
+            space, template, cols, rows, values, where
+        )
+    kind = node.node_type.name
+    if kind in _ARITH and node.args:
+        parts = [compile_vector(a, where, default) for a in node.args]
+        op = _ARITH[kind]
+
+        def arith(space, cols, rows, values):
+            acc = parts[0](space, cols, rows, values)
+            for part in parts[1:]:
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    acc = op(acc, part(space, cols, rows, values))
+            return acc
+
+        return arith
+    raise PlanningError(f"{where}: unsupported numeric expression {node}")
+
+
+def _term(node: FNode) -> str:
+    if node.is_parameter_exp():
+        return "?" + node.parameter().name
+    if node.is_object_exp():
+        return node.object().name
+    raise PlanningError(f"unsupported argument {node} (only parameters and objects)")
+
+
+def _lookup(space: AtomSpace, template, cols, rows, values, where) -> np.ndarray:
+    if rows == 0:
+        return np.zeros(0)
+    codes = space.encode_rows(template, cols, rows)
+    unique, inverse = np.unique(codes, return_inverse=True)
+    found = np.empty(len(unique))
+    for i, code in enumerate(unique.tolist()):
+        atom = space.decode(code)
+        value = values.get(atom)
+        if value is None:
+            raise PlanningError(f"{where}: no value for ({' '.join(atom)}) in :init")
+        found[i] = value
+    return found[inverse]
