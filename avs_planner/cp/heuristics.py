@@ -180,15 +180,17 @@ class _FF:
         return sum(rt.cost[a] + 1.0 for a in chosen), sum(rt.neglog[a] for a in chosen)
 
     @staticmethod
-    def _relaxed_plan(rt: RelaxedTask, state: int, support: list[int]) -> set[int]:
-        chosen: set[int] = set()
+    def _relaxed_plan(rt: RelaxedTask, state: int, support: list[int]) -> dict[int, None]:
+        """The relaxed plan's actions in the order chosen (a dict, not a set: the sums above
+        then run in a defined order, which the compiled core reproduces bit for bit)."""
+        chosen: dict[int, None] = {}
         stack = [g for g in rt.goal if not state >> g & 1]
         seen: set[int] = set(stack)
         while stack:
             a = support[stack.pop()]
             if a < 0 or a in chosen:
                 continue
-            chosen.add(a)
+            chosen[a] = None
             for f in rt.pre[a]:
                 if f not in seen and not state >> f & 1:
                     seen.add(f)

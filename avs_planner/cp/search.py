@@ -14,12 +14,14 @@ import time
 from dataclasses import dataclass, field
 from enum import Enum
 
+from avs_planner.cp import native
 from avs_planner.cp.heuristics import get_heuristic
 from avs_planner.cp.symmetry import NO_SYMMETRIES, Symmetries
 from avs_planner.cp.task import GroundAction, GroundTask, atom_str
 from avs_planner.errors import PlanningError
 
 DEFAULT_REWARD = 500.0  # as domains/README.md assumes for the AVS domain
+ENGINES = ("auto", "native", "python")  # auto: the compiled core when it was built
 
 
 class PlanStatus(Enum):
@@ -43,6 +45,7 @@ class SearchOptions:
     symmetry: bool = True
     lazy: bool | None = None  # deferred evaluation; None: only on deterministic tasks
     preferred: bool = True  # helpful actions first (dual queue) when h is inadmissible and has them
+    engine: str = "auto"  # "native" (C core, same results), "python", or auto: native if built
 
     def check(self) -> SearchOptions:
         if self.reward < 0 or not math.isfinite(self.reward):
@@ -56,7 +59,23 @@ class SearchOptions:
         if not 0.0 <= self.min_success <= 1.0:
             raise PlanningError(f"success threshold must be in [0, 1], got {self.min_success}")
         get_heuristic(self.heuristic)
+        if self.engine not in ENGINES:
+            raise PlanningError(
+                f"unknown engine {self.engine!r} (choose one of: {', '.join(ENGINES)})")
+        if self.engine == "native" and not native.AVAILABLE:
+            raise PlanningError("engine 'native' asked for but the compiled search core is "
+                                "not built (reinstall with `pip install -e .` and a C compiler)")
+        if self.engine == "native" and self.heuristic not in native.HEURISTIC_CODES:
+            raise PlanningError(f"engine 'native' has no heuristic {self.heuristic!r}")
         return self
+
+    @property
+    def engine_used(self) -> str:
+        """The engine that will run: auto resolves to native when the core is built."""
+        if self.engine == "auto":
+            supported = native.AVAILABLE and self.heuristic in native.HEURISTIC_CODES
+            return "native" if supported else "python"
+        return self.engine
 
 
 @dataclass(frozen=True)
@@ -158,7 +177,37 @@ def search(
     start = time.perf_counter()
     if task.goal_impossible:
         return _finish(task, options, PlanStatus.UNSOLVABLE, None, start, 0, 0)
+    if options.engine_used == "native":
+        return _native_search(task, options, start, symmetries)
     return _Search(task, options, start, symmetries).run()
+
+
+def _lazy(task: GroundTask, options: SearchOptions) -> bool:
+    """Deferred evaluation: as asked, or by default only on deterministic tasks (it helps on
+    classical tasks, hurts where R(1 - p) jumps dominate g); never with admissible h."""
+    lazy = options.lazy
+    if lazy is None:
+        lazy = all(a.probability == 1.0 for a in task.actions)
+    return lazy and not get_heuristic(options.heuristic).admissible
+
+
+def _preferred(options: SearchOptions) -> bool:
+    """LAMA's dual queue: only where optimality does not count (and h records helpful
+    actions: FF; the native core checks that itself)."""
+    return options.preferred and not get_heuristic(options.heuristic).admissible
+
+
+def _native_search(
+    task: GroundTask, options: SearchOptions, start: float, symmetries: Symmetries
+) -> PlanResult:
+    status, path, expanded, generated = native.run(
+        task, options.heuristic, options.reward, options.weight, options.min_success,
+        options.timeout_s, options.node_limit, _lazy(task, options), _preferred(options),
+        symmetries, start,
+    )
+    steps = [task.actions[i] for i in path]
+    return _finish(task, options, PlanStatus(status), steps, start, expanded, generated,
+                   engine="native")
 
 
 class _Search:
@@ -181,17 +230,14 @@ class _Search:
         # LAMA's dual queue: successors by helpful actions also go to a preferred queue,
         # which is popped more often (boosted whenever h improves); off when optimality counts
         self.helpful: dict[int, frozenset[int]] | None = getattr(self.estimator, "helpful", None)
-        if not options.preferred or get_heuristic(options.heuristic).admissible:
+        if not _preferred(options):
             self.helpful = None
         self.pref_heap: list[tuple[float, float, int]] = []
         self.priority = [0, 0]
         self.best_h = math.inf
         self.from_pref = False
         self.pruned_threshold = False
-        lazy = options.lazy
-        if lazy is None:  # helps on classical tasks, hurts where R(1 - p) jumps dominate g
-            lazy = all(a.probability == 1.0 for a in task.actions)
-        self.lazy = lazy and not get_heuristic(options.heuristic).admissible
+        self.lazy = _lazy(task, options)
         self.h_of_node: list[float] = []
         self.evaluated: list[bool] = []
         self.commutes: dict[tuple[int, int], bool] = {}
@@ -328,7 +374,8 @@ class _Search:
         path.reverse()
         steps = [self.task.actions[i] for i in path]
         return _finish(
-            self.task, self.options, status, steps, self.start, expanded, len(self.states)
+            self.task, self.options, status, steps, self.start, expanded, len(self.states),
+            engine="python",
         )
 
 
@@ -340,12 +387,15 @@ def _finish(
     start: float,
     expanded: int,
     generated: int,
+    engine: str | None = None,
 ) -> PlanResult:
     elapsed = time.perf_counter() - start
+    extra = {"engine": engine or options.engine_used}
     if status is not PlanStatus.SOLVED or steps is None:
         return PlanResult(
             status, planning_time_s=elapsed, expanded=expanded, generated=generated,
             reward=options.reward, heuristic=options.heuristic, weight=options.weight,
+            extra=extra,
         )
     plan = tuple(PlanStep.of(a) for a in steps)
     cost = math.fsum(s.cost for s in plan)
@@ -354,4 +404,5 @@ def _finish(
         status, plan, cost, probability, objective(cost, probability, options.reward),
         planning_time_s=elapsed, expanded=expanded, generated=generated,
         reward=options.reward, heuristic=options.heuristic, weight=options.weight,
+        extra=extra,
     )

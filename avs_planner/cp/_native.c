@@ -1,0 +1,1499 @@
+/* Compiled search core of the continual planner: the search of avs_planner/cp/search.py with
+ * the relaxed heuristics of avs_planner/cp/heuristics.py, on a task packed by
+ * avs_planner/cp/native.py.
+ *
+ * Exactness: it is a port, not a re-design. Every floating-point expression is evaluated in
+ * the same order as the Python code (built with -ffp-contract=off so no fused multiply-add),
+ * Python's sum() is reproduced (plain left-to-right before 3.12, Neumaier-compensated from
+ * 3.12 on), heaps are ordered on the same keys ((f, h, node) for the open lists, (d, fact)
+ * for the relaxed Dijkstra; keys are unique, so any binary heap pops in the same order), and
+ * action loops run in index order. The search therefore returns the same plan and the same
+ * expanded/generated counts as the Python engine; only TIMEOUT depends on the clock.
+ *
+ * States are fixed-width uint64 bitsets; an open-addressing hash table maps a state to its
+ * record (Pareto labels, cached estimate, helpful actions). The GIL is released while the
+ * search runs; the packed task object is immutable and kept alive by the caller's reference.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+typedef uint64_t word;
+
+enum { H_BLIND = 0, H_MAX = 1, H_ADD = 2, H_FF = 3 };
+enum { ST_SOLVED = 0, ST_UNSOLVABLE = 1, ST_THRESHOLD = 2, ST_TIMEOUT = 3, ST_NODE_LIMIT = 4 };
+
+#define BIT(s, f) (((s)[(f) >> 6] >> ((f) & 63)) & 1u)
+
+/* ------------------------------------------------------------------------------------------ */
+/* Python's sum() over floats, started from the int 0                                          */
+
+typedef struct {
+    double hi, lo;
+} PySum;
+
+static inline void pysum_add(PySum *s, double x)
+{
+#if PY_VERSION_HEX >= 0x030C0000
+    /* CPython >= 3.12 builtin sum: Neumaier compensated summation */
+    double t = s->hi + x;
+    if (fabs(s->hi) >= fabs(x))
+        s->lo += (s->hi - t) + x;
+    else
+        s->lo += (x - t) + s->hi;
+    s->hi = t;
+#else
+    s->hi += x;
+#endif
+}
+
+static inline double pysum_value(const PySum *s)
+{
+#if PY_VERSION_HEX >= 0x030C0000
+    if (s->lo != 0.0 && isfinite(s->lo))
+        return s->hi + s->lo;
+#endif
+    return s->hi;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* The packed task (immutable; built once per GroundTask action table)                         */
+
+typedef struct {
+    PyObject_HEAD
+    Py_ssize_t n_facts, n_actions, W;
+    word *pre, *pre_neg, *add, *del, *reads; /* n_actions * W each */
+    double *cost, *prob, *neglog;
+    int32_t *pre_off, *pre_facts; /* relaxed preconditions (pre_facts), CSR per action */
+    int32_t *add_off, *add_facts;
+    int32_t *cl_off;              /* clauses (pos, neg) per action, CSR */
+    word *cl_pos, *cl_neg;        /* n_clauses * W */
+    /* unit clauses (one positive fact, some negative facts) in RelaxedTask._unit_clauses
+     * order, grouped by action; each maps to a distinct (action, fact) "pair" unless the fact
+     * is already a base precondition of the action (pair -1) */
+    Py_ssize_t n_unit, n_pairs;
+    int32_t *unit_off;            /* per action, CSR into unit_* */
+    int32_t *unit_fact, *unit_clause, *unit_pair;
+    int32_t *pair_action;
+    /* h^max: pre_of[f] = actions with f in pre_facts, in action order (CSR) */
+    int32_t *pof_off, *pof;
+    /* h_add/FF: pre_of[f] with clause pairs merged in action order; entry pair -1 = base */
+    int32_t *xof_off, *xof_action, *xof_pair;
+    int32_t *no_pre;              /* actions with no pre_facts, ascending */
+    Py_ssize_t n_no_pre;
+    int32_t *n_pairs_of;          /* number of pairs of each action */
+    Py_ssize_t total_add;
+} TaskObject;
+
+static void task_free_arrays(TaskObject *t)
+{
+    void *ptrs[] = {t->pre, t->pre_neg, t->add, t->del, t->reads, t->cost, t->prob, t->neglog,
+                    t->pre_off, t->pre_facts, t->add_off, t->add_facts, t->cl_off, t->cl_pos,
+                    t->cl_neg, t->unit_off, t->unit_fact, t->unit_clause, t->unit_pair,
+                    t->pair_action, t->pof_off, t->pof, t->xof_off, t->xof_action,
+                    t->xof_pair, t->no_pre, t->n_pairs_of};
+    for (size_t i = 0; i < sizeof(ptrs) / sizeof(ptrs[0]); i++)
+        free(ptrs[i]);
+}
+
+static void task_dealloc(TaskObject *t)
+{
+    task_free_arrays(t);
+    Py_TYPE(t)->tp_free((PyObject *)t);
+}
+
+static void *xcalloc(size_t n, size_t size)
+{
+    return calloc(n ? n : 1, size ? size : 1);
+}
+
+/* Copy a buffer of `count` items of `size` bytes; ValueError naming `what` if the length is
+ * off. */
+static void *copy_buffer(Py_buffer *b, Py_ssize_t count, size_t size, const char *what)
+{
+    if (count < 0 || (size_t)b->len != (size_t)count * size) {
+        PyErr_Format(PyExc_ValueError, "native task: %s has %zd bytes, expected %zd", what,
+                     b->len, count < 0 ? (Py_ssize_t)-1 : (Py_ssize_t)(count * (Py_ssize_t)size));
+        return NULL;
+    }
+    void *out = xcalloc((size_t)count, size);
+    if (!out) {
+        PyErr_NoMemory();
+        return NULL;
+    }
+    if (count)
+        memcpy(out, b->buf, (size_t)count * size);
+    return out;
+}
+
+/* int64 CSR (offsets n+1, values) -> int32, checking monotone offsets and value range */
+static int copy_csr(Py_buffer *off_b, Py_buffer *val_b, Py_ssize_t n, Py_ssize_t limit,
+                    int32_t **off_out, int32_t **val_out, const char *what)
+{
+    if ((size_t)off_b->len != (size_t)(n + 1) * 8 || val_b->len % 8) {
+        PyErr_Format(PyExc_ValueError, "native task: %s offsets/values have wrong sizes", what);
+        return -1;
+    }
+    const int64_t *off = off_b->buf, *val = val_b->buf;
+    Py_ssize_t m = val_b->len / 8;
+    if (off[0] != 0 || off[n] != m) {
+        PyErr_Format(PyExc_ValueError, "native task: %s offsets do not cover the values", what);
+        return -1;
+    }
+    for (Py_ssize_t i = 0; i < n; i++)
+        if (off[i + 1] < off[i]) {
+            PyErr_Format(PyExc_ValueError, "native task: %s offsets decrease", what);
+            return -1;
+        }
+    if (m > INT32_MAX || n > INT32_MAX) {
+        PyErr_Format(PyExc_ValueError, "native task: %s too large", what);
+        return -1;
+    }
+    for (Py_ssize_t i = 0; i < m; i++)
+        if (val[i] < 0 || (limit >= 0 && val[i] >= limit)) {
+            PyErr_Format(PyExc_ValueError, "native task: %s value %lld out of range", what,
+                         (long long)val[i]);
+            return -1;
+        }
+    *off_out = xcalloc((size_t)n + 1, sizeof(int32_t));
+    *val_out = xcalloc((size_t)m, sizeof(int32_t));
+    if (!*off_out || !*val_out) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    for (Py_ssize_t i = 0; i <= n; i++)
+        (*off_out)[i] = (int32_t)off[i];
+    for (Py_ssize_t i = 0; i < m; i++)
+        (*val_out)[i] = (int32_t)val[i];
+    return 0;
+}
+
+static int popcount_words(const word *x, Py_ssize_t W, int32_t *single)
+{
+    int n = 0;
+    for (Py_ssize_t i = 0; i < W; i++)
+        if (x[i]) {
+            int c = __builtin_popcountll(x[i]);
+            if (c == 1)
+                *single = (int32_t)(i * 64 + __builtin_ctzll(x[i]));
+            n += c;
+        }
+    return n;
+}
+
+static int any_word(const word *x, Py_ssize_t W)
+{
+    for (Py_ssize_t i = 0; i < W; i++)
+        if (x[i])
+            return 1;
+    return 0;
+}
+
+/* Derived tables: reads masks, unit clauses and pairs, pre_of lists, no_pre. */
+static int task_derive(TaskObject *t)
+{
+    Py_ssize_t A = t->n_actions, F = t->n_facts, W = t->W;
+    t->reads = xcalloc((size_t)(A * W), sizeof(word));
+    t->unit_off = xcalloc((size_t)A + 1, sizeof(int32_t));
+    t->n_pairs_of = xcalloc((size_t)A, sizeof(int32_t));
+    Py_ssize_t n_cl = t->cl_off[A];
+    t->unit_fact = xcalloc((size_t)n_cl, sizeof(int32_t));
+    t->unit_clause = xcalloc((size_t)n_cl, sizeof(int32_t));
+    t->unit_pair = xcalloc((size_t)n_cl, sizeof(int32_t));
+    t->pair_action = xcalloc((size_t)n_cl, sizeof(int32_t));
+    int32_t *pair_fact = xcalloc((size_t)n_cl, sizeof(int32_t));
+    if (!t->reads || !t->unit_off || !t->n_pairs_of || !t->unit_fact || !t->unit_clause ||
+        !t->unit_pair || !t->pair_action || !pair_fact)
+        goto nomem;
+    Py_ssize_t nu = 0, np = 0;
+    for (Py_ssize_t a = 0; a < A; a++) {
+        word *r = t->reads + a * W;
+        for (Py_ssize_t i = 0; i < W; i++)
+            r[i] = t->pre[a * W + i] | t->pre_neg[a * W + i];
+        t->unit_off[a] = (int32_t)nu;
+        Py_ssize_t first_pair = np;
+        for (int32_t k = t->cl_off[a]; k < t->cl_off[a + 1]; k++) {
+            const word *pos = t->cl_pos + (Py_ssize_t)k * W, *neg = t->cl_neg + (Py_ssize_t)k * W;
+            for (Py_ssize_t i = 0; i < W; i++)
+                r[i] |= pos[i] | neg[i];
+            int32_t f = -1;
+            if (popcount_words(pos, W, &f) != 1 || !any_word(neg, W))
+                continue;
+            int32_t pair = -1, in_base = 0;
+            for (int32_t j = t->pre_off[a]; j < t->pre_off[a + 1]; j++)
+                if (t->pre_facts[j] == f)
+                    in_base = 1;
+            if (!in_base) {
+                for (Py_ssize_t q = first_pair; q < np; q++)
+                    if (pair_fact[q] == f)
+                        pair = (int32_t)q;
+                if (pair < 0) {
+                    pair = (int32_t)np;
+                    pair_fact[np] = f;
+                    t->pair_action[np++] = (int32_t)a;
+                    t->n_pairs_of[a]++;
+                }
+            }
+            t->unit_fact[nu] = f;
+            t->unit_clause[nu] = k;
+            t->unit_pair[nu++] = pair;
+        }
+    }
+    t->unit_off[A] = (int32_t)nu;
+    t->n_unit = nu;
+    t->n_pairs = np;
+
+    /* pre_of (base) and merged pre_of (base + pairs), both in action order */
+    t->pof_off = xcalloc((size_t)F + 1, sizeof(int32_t));
+    t->xof_off = xcalloc((size_t)F + 1, sizeof(int32_t));
+    Py_ssize_t n_pre = t->pre_off[A];
+    t->pof = xcalloc((size_t)n_pre, sizeof(int32_t));
+    t->xof_action = xcalloc((size_t)(n_pre + np), sizeof(int32_t));
+    t->xof_pair = xcalloc((size_t)(n_pre + np), sizeof(int32_t));
+    t->no_pre = xcalloc((size_t)A, sizeof(int32_t));
+    int32_t *fill = xcalloc((size_t)F + 1, sizeof(int32_t));
+    if (!t->pof_off || !t->xof_off || !t->pof || !t->xof_action || !t->xof_pair || !t->no_pre ||
+        !fill)
+        goto nomem2;
+    for (Py_ssize_t j = 0; j < n_pre; j++)
+        t->pof_off[t->pre_facts[j] + 1]++;
+    for (Py_ssize_t q = 0; q < np; q++)
+        t->xof_off[pair_fact[q] + 1]++;
+    for (Py_ssize_t f = 0; f < F; f++) {
+        t->xof_off[f + 1] += t->pof_off[f + 1];
+        t->pof_off[f + 1] += t->pof_off[f];
+        t->xof_off[f + 1] += t->xof_off[f];
+    }
+    /* base pre_of: actions ascending, each occurrence of f once (duplicates kept) */
+    for (Py_ssize_t a = 0; a < A; a++)
+        for (int32_t j = t->pre_off[a]; j < t->pre_off[a + 1]; j++) {
+            int32_t f = t->pre_facts[j];
+            t->pof[t->pof_off[f] + fill[f]++] = (int32_t)a;
+        }
+    memset(fill, 0, sizeof(int32_t) * ((size_t)F + 1));
+    /* merged: walk actions ascending; an action's base entries then its pairs for f. A pair's
+     * fact is never a base fact of the same action, so per (f, a) there is only one kind. */
+    for (Py_ssize_t a = 0; a < A; a++) {
+        for (int32_t j = t->pre_off[a]; j < t->pre_off[a + 1]; j++) {
+            int32_t f = t->pre_facts[j];
+            int32_t at = t->xof_off[f] + fill[f]++;
+            t->xof_action[at] = (int32_t)a;
+            t->xof_pair[at] = -1;
+        }
+    }
+    /* insert pairs: rebuild each fact's list by merging (both parts ascending in action) */
+    {
+        int32_t *tmp_a = xcalloc((size_t)(n_pre + np), sizeof(int32_t));
+        int32_t *tmp_p = xcalloc((size_t)(n_pre + np), sizeof(int32_t));
+        int32_t *pf_off = xcalloc((size_t)F + 1, sizeof(int32_t));
+        if (!tmp_a || !tmp_p || !pf_off) {
+            free(tmp_a);
+            free(tmp_p);
+            free(pf_off);
+            goto nomem2;
+        }
+        /* pairs by fact, ascending pair id = ascending action */
+        int32_t *pf = xcalloc((size_t)np, sizeof(int32_t));
+        int32_t *pfill = xcalloc((size_t)F + 1, sizeof(int32_t));
+        if (!pf || !pfill) {
+            free(tmp_a);
+            free(tmp_p);
+            free(pf_off);
+            free(pf);
+            free(pfill);
+            goto nomem2;
+        }
+        for (Py_ssize_t q = 0; q < np; q++)
+            pf_off[pair_fact[q] + 1]++;
+        for (Py_ssize_t f = 0; f < F; f++)
+            pf_off[f + 1] += pf_off[f];
+        for (Py_ssize_t q = 0; q < np; q++)
+            pf[pf_off[pair_fact[q]] + pfill[pair_fact[q]]++] = (int32_t)q;
+        for (Py_ssize_t f = 0; f < F; f++) {
+            int32_t bi = t->xof_off[f], be = t->xof_off[f] + fill[f];
+            int32_t pi = pf_off[f], pe = pf_off[f + 1];
+            int32_t out = t->xof_off[f];
+            while (bi < be || pi < pe) {
+                if (pi >= pe || (bi < be && t->xof_action[bi] < t->pair_action[pf[pi]])) {
+                    tmp_a[out] = t->xof_action[bi];
+                    tmp_p[out++] = -1;
+                    bi++;
+                } else {
+                    tmp_a[out] = t->pair_action[pf[pi]];
+                    tmp_p[out++] = pf[pi];
+                    pi++;
+                }
+            }
+        }
+        memcpy(t->xof_action, tmp_a, sizeof(int32_t) * (size_t)(n_pre + np));
+        memcpy(t->xof_pair, tmp_p, sizeof(int32_t) * (size_t)(n_pre + np));
+        free(tmp_a);
+        free(tmp_p);
+        free(pf_off);
+        free(pf);
+        free(pfill);
+    }
+    t->n_no_pre = 0;
+    for (Py_ssize_t a = 0; a < A; a++)
+        if (t->pre_off[a] == t->pre_off[a + 1])
+            t->no_pre[t->n_no_pre++] = (int32_t)a;
+    t->total_add = t->add_off[A];
+    free(fill);
+    free(pair_fact);
+    return 0;
+nomem2:
+    free(fill);
+nomem:
+    free(pair_fact);
+    PyErr_NoMemory();
+    return -1;
+}
+
+#define NBUF 14
+
+static PyObject *task_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
+{
+    Py_ssize_t n_facts, n_actions;
+    Py_buffer b[NBUF];
+    memset(b, 0, sizeof(b));
+    if (!PyArg_ParseTuple(args, "nny*y*y*y*y*y*y*y*y*y*y*y*y*y*:Task", &n_facts, &n_actions,
+                          &b[0], &b[1], &b[2], &b[3], &b[4], &b[5], &b[6], &b[7], &b[8], &b[9],
+                          &b[10], &b[11], &b[12], &b[13]))
+        return NULL;
+    TaskObject *t = NULL;
+    if (n_facts < 0 || n_actions < 0 || n_facts > INT32_MAX / 2 || n_actions > INT32_MAX / 2) {
+        PyErr_SetString(PyExc_ValueError, "native task: bad fact or action count");
+        goto fail;
+    }
+    t = (TaskObject *)type->tp_alloc(type, 0);
+    if (!t)
+        goto fail;
+    t->n_facts = n_facts;
+    t->n_actions = n_actions;
+    t->W = n_facts / 64 + 1;
+    Py_ssize_t AW = n_actions * t->W;
+    if (!(t->pre = copy_buffer(&b[0], AW, 8, "pre")) ||
+        !(t->pre_neg = copy_buffer(&b[1], AW, 8, "pre_neg")) ||
+        !(t->add = copy_buffer(&b[2], AW, 8, "add")) ||
+        !(t->del = copy_buffer(&b[3], AW, 8, "delete")) ||
+        !(t->cost = copy_buffer(&b[4], n_actions, 8, "cost")) ||
+        !(t->prob = copy_buffer(&b[5], n_actions, 8, "probability")) ||
+        !(t->neglog = copy_buffer(&b[6], n_actions, 8, "neglog")))
+        goto fail;
+    if (copy_csr(&b[7], &b[8], n_actions, n_facts, &t->pre_off, &t->pre_facts, "pre_facts") ||
+        copy_csr(&b[9], &b[10], n_actions, n_facts, &t->add_off, &t->add_facts, "add_facts"))
+        goto fail;
+    if ((size_t)b[11].len != (size_t)(n_actions + 1) * 8) {
+        PyErr_SetString(PyExc_ValueError, "native task: clause offsets have the wrong size");
+        goto fail;
+    }
+    const int64_t *cl = b[11].buf;
+    for (Py_ssize_t a = 0; a < n_actions; a++)
+        if (cl[a + 1] < cl[a]) {
+            PyErr_SetString(PyExc_ValueError, "native task: clause offsets decrease");
+            goto fail;
+        }
+    if (cl[0] != 0 || cl[n_actions] > INT32_MAX / 2) {
+        PyErr_SetString(PyExc_ValueError, "native task: bad clause offsets");
+        goto fail;
+    }
+    Py_ssize_t n_cl = (Py_ssize_t)cl[n_actions];
+    t->cl_off = xcalloc((size_t)n_actions + 1, sizeof(int32_t));
+    if (!t->cl_off) {
+        PyErr_NoMemory();
+        goto fail;
+    }
+    for (Py_ssize_t a = 0; a <= n_actions; a++)
+        t->cl_off[a] = (int32_t)cl[a];
+    if (!(t->cl_pos = copy_buffer(&b[12], n_cl * t->W, 8, "clause pos")) ||
+        !(t->cl_neg = copy_buffer(&b[13], n_cl * t->W, 8, "clause neg")))
+        goto fail;
+    /* no bit at or above n_facts anywhere */
+    word top = (word)1 << (n_facts & 63);
+    word hi_mask = ~(top - 1);
+    word *all[] = {t->pre, t->pre_neg, t->add, t->del};
+    for (int k = 0; k < 4; k++)
+        for (Py_ssize_t a = 0; a < n_actions; a++)
+            if (all[k][a * t->W + t->W - 1] & hi_mask) {
+                PyErr_Format(PyExc_ValueError, "native task: action %zd has a fact >= %zd", a,
+                             n_facts);
+                goto fail;
+            }
+    if (task_derive(t))
+        goto fail;
+    for (int i = 0; i < NBUF; i++)
+        PyBuffer_Release(&b[i]);
+    return (PyObject *)t;
+fail:
+    for (int i = 0; i < NBUF; i++)
+        if (b[i].obj)
+            PyBuffer_Release(&b[i]);
+    Py_XDECREF(t);
+    return NULL;
+}
+
+static PyObject *task_get_n_actions(TaskObject *t, void *closure)
+{
+    return PyLong_FromSsize_t(t->n_actions);
+}
+
+static PyObject *task_get_n_facts(TaskObject *t, void *closure)
+{
+    return PyLong_FromSsize_t(t->n_facts);
+}
+
+static PyGetSetDef task_getset[] = {
+    {"n_actions", (getter)task_get_n_actions, NULL, "number of actions", NULL},
+    {"n_facts", (getter)task_get_n_facts, NULL, "number of facts", NULL},
+    {NULL},
+};
+
+static PyTypeObject TaskType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "avs_planner.cp._native.Task",
+    .tp_basicsize = sizeof(TaskObject),
+    .tp_dealloc = (destructor)task_dealloc,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "Packed ground actions (see avs_planner.cp.native.pack_task).",
+    .tp_new = task_new,
+    .tp_getset = task_getset,
+};
+
+/* ------------------------------------------------------------------------------------------ */
+/* Search data                                                                                  */
+
+typedef struct {
+    double c, p;
+    int32_t node;
+} Label;
+
+typedef struct {
+    Label *labels;
+    int32_t n_labels, cap_labels;
+    int8_t h_known;
+    double hc, hl;
+    int64_t help_off;
+    int32_t help_n;
+    uint64_t hash;
+} StateRec;
+
+typedef struct {
+    double f, h;
+    int32_t node;
+} QEntry;
+
+typedef struct {
+    QEntry *v;
+    size_t n, cap;
+} Queue;
+
+typedef struct {
+    double d;
+    int32_t f;
+} DEntry;
+
+typedef struct {
+    const TaskObject *t;
+    Py_ssize_t W;
+    /* options */
+    int heuristic, lazy, preferred;
+    double reward, weight, min_success, timeout;
+    int64_t node_limit;
+    /* goal */
+    word *goal, *goal_neg;
+    int32_t *goal_facts;
+    int8_t *is_goal;
+    Py_ssize_t n_goal;
+    /* symmetry (may be empty) */
+    int has_sym;
+    const int64_t *sym_act_off, *sym_pair_ids, *sym_pair_off, *sym_fg;
+    /* state table */
+    word *sdata;
+    StateRec *recs;
+    int32_t n_states, cap_states;
+    int32_t *slots;
+    size_t n_slots;
+    /* nodes */
+    int32_t *n_state, *n_parent, *n_via;
+    double *n_c, *n_p, *n_h;
+    int8_t *n_alive, *n_eval;
+    int32_t n_nodes, cap_nodes;
+    /* queues */
+    Queue heap, pref;
+    int64_t priority[2];
+    double best_h;
+    int from_pref, pruned_threshold;
+    /* helpful pool */
+    int32_t *help;
+    int64_t n_help, cap_help;
+    /* heuristic scratch */
+    double *dist, *value, *combined;
+    int32_t *support, *remaining, *rem_ext, *stack, *chosen;
+    uint32_t *seen_stamp, *chosen_stamp, *emit_stamp, *help_stamp;
+    uint32_t stamp, help_mark;
+    int8_t *active, *pair_eff;
+    DEntry *dheap;
+    size_t dn, dcap;
+    word *succ;
+    int oom;
+} Search;
+
+static inline int qless(const QEntry *a, const QEntry *b)
+{
+    if (a->f != b->f)
+        return a->f < b->f;
+    if (a->h != b->h)
+        return a->h < b->h;
+    return a->node < b->node;
+}
+
+static int qpush(Search *s, Queue *q, double f, double h, int32_t node)
+{
+    if (q->n == q->cap) {
+        size_t cap = q->cap ? q->cap * 2 : 1024;
+        QEntry *v = realloc(q->v, cap * sizeof(QEntry));
+        if (!v) {
+            s->oom = 1;
+            return -1;
+        }
+        q->v = v;
+        q->cap = cap;
+    }
+    QEntry e = {f, h, node};
+    size_t i = q->n++;
+    while (i > 0) {
+        size_t parent = (i - 1) / 2;
+        if (!qless(&e, &q->v[parent]))
+            break;
+        q->v[i] = q->v[parent];
+        i = parent;
+    }
+    q->v[i] = e;
+    return 0;
+}
+
+static QEntry qpop(Queue *q)
+{
+    QEntry top = q->v[0];
+    QEntry last = q->v[--q->n];
+    size_t i = 0, n = q->n;
+    while (1) {
+        size_t l = 2 * i + 1;
+        if (l >= n)
+            break;
+        size_t m = (l + 1 < n && qless(&q->v[l + 1], &q->v[l])) ? l + 1 : l;
+        if (!qless(&q->v[m], &last))
+            break;
+        q->v[i] = q->v[m];
+        i = m;
+    }
+    if (n)
+        q->v[i] = last;
+    return top;
+}
+
+static inline int dless(const DEntry *a, const DEntry *b)
+{
+    return a->d < b->d || (a->d == b->d && a->f < b->f);
+}
+
+static inline void dpush(Search *s, double d, int32_t f)
+{
+    /* capacity n_facts + total add effects + 1 bounds the pushes of one Dijkstra */
+    DEntry e = {d, f};
+    size_t i = s->dn++;
+    DEntry *v = s->dheap;
+    while (i > 0) {
+        size_t parent = (i - 1) / 2;
+        if (!dless(&e, &v[parent]))
+            break;
+        v[i] = v[parent];
+        i = parent;
+    }
+    v[i] = e;
+}
+
+static inline DEntry dpop(Search *s)
+{
+    DEntry *v = s->dheap;
+    DEntry top = v[0];
+    DEntry last = v[--s->dn];
+    size_t i = 0, n = s->dn;
+    while (1) {
+        size_t l = 2 * i + 1;
+        if (l >= n)
+            break;
+        size_t m = (l + 1 < n && dless(&v[l + 1], &v[l])) ? l + 1 : l;
+        if (!dless(&v[m], &last))
+            break;
+        v[i] = v[m];
+        i = m;
+    }
+    if (n)
+        v[i] = last;
+    return top;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Relaxed heuristics (heuristics.py)                                                           */
+
+/* Which unit clauses hold their negative part in `state` (RelaxedTask.for_state), which
+ * (action, fact) pairs that makes effective, and the variant's remaining counts. */
+static void clause_variant(Search *s, const word *state)
+{
+    const TaskObject *t = s->t;
+    Py_ssize_t W = s->W;
+    memset(s->pair_eff, 0, (size_t)t->n_pairs);
+    for (Py_ssize_t k = 0; k < t->n_unit; k++) {
+        const word *neg = t->cl_neg + (Py_ssize_t)t->unit_clause[k] * W;
+        int on = 1;
+        for (Py_ssize_t i = 0; i < W; i++)
+            if ((neg[i] & state[i]) != neg[i]) {
+                on = 0;
+                break;
+            }
+        s->active[k] = (int8_t)on;
+        if (on && t->unit_pair[k] >= 0)
+            s->pair_eff[t->unit_pair[k]] = 1;
+    }
+    for (Py_ssize_t a = 0; a < t->n_actions; a++)
+        s->rem_ext[a] = t->pre_off[a + 1] - t->pre_off[a];
+    for (Py_ssize_t q = 0; q < t->n_pairs; q++)
+        if (s->pair_eff[q])
+            s->rem_ext[t->pair_action[q]]++;
+}
+
+static inline void relax_fire(Search *s, int32_t a, double nd)
+{
+    const TaskObject *t = s->t;
+    for (int32_t j = t->add_off[a]; j < t->add_off[a + 1]; j++) {
+        int32_t g = t->add_facts[j];
+        if (nd < s->dist[g]) {
+            s->dist[g] = nd;
+            s->support[g] = a;
+            dpush(s, nd, g);
+        }
+    }
+}
+
+/* relaxed_costs(): generalised Dijkstra, h^max (use_max) or h^add; ext = clause variant */
+static void relaxed_costs(Search *s, const word *state, const double *w, int use_max, int ext)
+{
+    const TaskObject *t = s->t;
+    Py_ssize_t F = t->n_facts, A = t->n_actions;
+    double *dist = s->dist;
+    for (Py_ssize_t f = 0; f < F; f++) {
+        dist[f] = INFINITY;
+        s->support[f] = -1;
+    }
+    s->dn = 0;
+    for (Py_ssize_t f = 0; f < F; f++)
+        if (BIT(state, f)) {
+            dist[f] = 0.0;
+            dpush(s, 0.0, (int32_t)f);
+        }
+    int32_t *remaining = s->remaining;
+    if (ext)
+        memcpy(remaining, s->rem_ext, sizeof(int32_t) * (size_t)A);
+    else
+        for (Py_ssize_t a = 0; a < A; a++)
+            remaining[a] = t->pre_off[a + 1] - t->pre_off[a];
+    double *value = s->value;
+    for (Py_ssize_t a = 0; a < A; a++)
+        value[a] = 0.0;
+    for (Py_ssize_t i = 0; i < t->n_no_pre; i++) {
+        int32_t a = t->no_pre[i];
+        if (ext && remaining[a] != 0)
+            continue; /* an active clause gave it a precondition */
+        relax_fire(s, a, w[a]);
+    }
+    Py_ssize_t goals_left = s->n_goal;
+    const int32_t *off = ext ? t->xof_off : t->pof_off;
+    const int32_t *acts = ext ? t->xof_action : t->pof;
+    while (s->dn && goals_left) {
+        DEntry e = dpop(s);
+        double d = e.d;
+        int32_t f = e.f;
+        if (d > dist[f])
+            continue;
+        if (s->is_goal[f])
+            goals_left--;
+        for (int32_t j = off[f]; j < off[f + 1]; j++) {
+            if (ext && t->xof_pair[j] >= 0 && !s->pair_eff[t->xof_pair[j]])
+                continue;
+            int32_t a = acts[j];
+            if (use_max)
+                value[a] = value[a] > d ? value[a] : d;
+            else
+                value[a] = value[a] + d;
+            remaining[a] -= 1;
+            if (remaining[a] == 0)
+                relax_fire(s, a, value[a] + w[a]);
+        }
+    }
+}
+
+static double goal_value(Search *s, int use_max)
+{
+    if (!s->n_goal)
+        return 0.0;
+    if (use_max) {
+        double best = s->dist[s->goal_facts[0]];
+        for (Py_ssize_t i = 1; i < s->n_goal; i++) {
+            double v = s->dist[s->goal_facts[i]];
+            if (v > best)
+                best = v;
+        }
+        return best;
+    }
+    PySum sum = {0.0, 0.0};
+    for (Py_ssize_t i = 0; i < s->n_goal; i++)
+        pysum_add(&sum, s->dist[s->goal_facts[i]]);
+    return pysum_value(&sum);
+}
+
+static void cost_and_risk(Search *s, const word *state, int use_max, int ext, double *hc,
+                          double *hl)
+{
+    relaxed_costs(s, state, s->t->cost, use_max, ext);
+    *hc = goal_value(s, use_max);
+    if (*hc == INFINITY) {
+        *hl = INFINITY;
+        return;
+    }
+    relaxed_costs(s, state, s->t->neglog, use_max, ext);
+    *hl = goal_value(s, use_max);
+}
+
+static int applicable(const TaskObject *t, Py_ssize_t W, int32_t a, const word *state)
+{
+    const word *pre = t->pre + a * W, *neg = t->pre_neg + a * W;
+    for (Py_ssize_t i = 0; i < W; i++)
+        if ((state[i] & pre[i]) != pre[i] || (state[i] & neg[i]))
+            return 0;
+    for (int32_t k = t->cl_off[a]; k < t->cl_off[a + 1]; k++) {
+        const word *cp = t->cl_pos + (Py_ssize_t)k * W, *cn = t->cl_neg + (Py_ssize_t)k * W;
+        int ok = 0;
+        for (Py_ssize_t i = 0; i < W && !ok; i++)
+            if ((state[i] & cp[i]) || (cn[i] & ~state[i]))
+                ok = 1;
+        if (!ok)
+            return 0;
+    }
+    return 1;
+}
+
+static int push_help(Search *s, int32_t a)
+{
+    if (s->n_help == s->cap_help) {
+        int64_t cap = s->cap_help ? s->cap_help * 2 : 4096;
+        int32_t *v = realloc(s->help, (size_t)cap * sizeof(int32_t));
+        if (!v) {
+            s->oom = 1;
+            return -1;
+        }
+        s->help = v;
+        s->cap_help = cap;
+    }
+    s->help[s->n_help++] = a;
+    return 0;
+}
+
+static uint32_t next_stamp(Search *s)
+{
+    if (++s->stamp == 0) { /* wrapped: clear every stamp array */
+        memset(s->seen_stamp, 0, sizeof(uint32_t) * (size_t)s->t->n_facts);
+        memset(s->chosen_stamp, 0, sizeof(uint32_t) * (size_t)s->t->n_actions);
+        memset(s->emit_stamp, 0, sizeof(uint32_t) * ((size_t)s->t->n_pairs + 1));
+        s->stamp = 1;
+    }
+    return s->stamp;
+}
+
+/* _FF.__call__: h_add on the combined weights, relaxed plan by supporters, helpful actions */
+static void ff(Search *s, const word *state, StateRec *rec, double *hc, double *hl)
+{
+    const TaskObject *t = s->t;
+    relaxed_costs(s, state, s->combined, 0, 1);
+    for (Py_ssize_t i = 0; i < s->n_goal; i++)
+        if (s->dist[s->goal_facts[i]] == INFINITY) {
+            *hc = *hl = INFINITY;
+            return;
+        }
+    uint32_t st = next_stamp(s);
+    Py_ssize_t top = 0, n_chosen = 0;
+    for (Py_ssize_t i = 0; i < s->n_goal; i++) {
+        int32_t g = s->goal_facts[i];
+        if (!BIT(state, g)) {
+            s->stack[top++] = g;
+            s->seen_stamp[g] = st;
+        }
+    }
+    while (top) {
+        int32_t a = s->support[s->stack[--top]];
+        if (a < 0 || s->chosen_stamp[a] == st)
+            continue;
+        s->chosen_stamp[a] = st;
+        s->chosen[n_chosen++] = a;
+        /* the variant's pre[a]: base pre_facts, then active clause facts not yet there */
+        for (int32_t j = t->pre_off[a]; j < t->pre_off[a + 1]; j++) {
+            int32_t f = t->pre_facts[j];
+            if (s->seen_stamp[f] != st && !BIT(state, f)) {
+                s->seen_stamp[f] = st;
+                s->stack[top++] = f;
+            }
+        }
+        for (int32_t k = t->unit_off[a]; k < t->unit_off[a + 1]; k++) {
+            int32_t q = t->unit_pair[k];
+            if (!s->active[k] || q < 0 || s->emit_stamp[q] == st)
+                continue;
+            s->emit_stamp[q] = st;
+            int32_t f = t->unit_fact[k];
+            if (s->seen_stamp[f] != st && !BIT(state, f)) {
+                s->seen_stamp[f] = st;
+                s->stack[top++] = f;
+            }
+        }
+    }
+    PySum sc = {0.0, 0.0}, sl = {0.0, 0.0};
+    for (Py_ssize_t i = 0; i < n_chosen; i++)
+        pysum_add(&sc, t->cost[s->chosen[i]] + 1.0);
+    for (Py_ssize_t i = 0; i < n_chosen; i++)
+        pysum_add(&sl, t->neglog[s->chosen[i]]);
+    *hc = pysum_value(&sc);
+    *hl = pysum_value(&sl);
+    rec->help_off = s->n_help;
+    rec->help_n = 0;
+    for (Py_ssize_t i = 0; i < n_chosen; i++)
+        if (applicable(t, s->W, s->chosen[i], state)) {
+            if (push_help(s, s->chosen[i]))
+                return;
+            rec->help_n++;
+        }
+}
+
+static void estimate(Search *s, int32_t sid)
+{
+    StateRec *rec = &s->recs[sid];
+    if (rec->h_known)
+        return;
+    const word *state = s->sdata + (Py_ssize_t)sid * s->W;
+    double hc = 0.0, hl = 0.0;
+    switch (s->heuristic) {
+    case H_MAX:
+        cost_and_risk(s, state, 1, 0, &hc, &hl);
+        break;
+    case H_ADD:
+        clause_variant(s, state);
+        cost_and_risk(s, state, 0, 1, &hc, &hl);
+        break;
+    case H_FF:
+        clause_variant(s, state);
+        ff(s, state, rec, &hc, &hl);
+        break;
+    default:
+        break;
+    }
+    rec = &s->recs[sid];
+    rec->hc = hc;
+    rec->hl = hl;
+    rec->h_known = 1;
+}
+
+/* _Search.f: c + w*hc + R(1 - p exp(-hl)) */
+static double f_value(Search *s, int32_t sid, double c, double p)
+{
+    estimate(s, sid);
+    StateRec *rec = &s->recs[sid];
+    if (rec->hc == INFINITY)
+        return INFINITY;
+    double w = s->weight;
+    return c + w * rec->hc + s->reward * (1.0 - p * exp(-rec->hl));
+}
+
+static inline double objective(double c, double p, double reward)
+{
+    return c + reward * (1.0 - p);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* State table                                                                                  */
+
+static inline uint64_t hash_state(const word *x, Py_ssize_t W)
+{
+    uint64_t h = 0x9E3779B97F4A7C15ull;
+    for (Py_ssize_t i = 0; i < W; i++) {
+        h ^= x[i] + 0x9E3779B97F4A7C15ull + (h << 6) + (h >> 2);
+        h *= 0xFF51AFD7ED558CCDull;
+        h ^= h >> 32;
+    }
+    return h;
+}
+
+static int grow_slots(Search *s)
+{
+    size_t n = s->n_slots ? s->n_slots * 2 : 1024;
+    int32_t *slots = malloc(n * sizeof(int32_t));
+    if (!slots) {
+        s->oom = 1;
+        return -1;
+    }
+    memset(slots, 0xff, n * sizeof(int32_t));
+    for (int32_t id = 0; id < s->n_states; id++) {
+        size_t i = (size_t)s->recs[id].hash & (n - 1);
+        while (slots[i] >= 0)
+            i = (i + 1) & (n - 1);
+        slots[i] = id;
+    }
+    free(s->slots);
+    s->slots = slots;
+    s->n_slots = n;
+    return 0;
+}
+
+/* id of `state`, or -1 if absent; *slot_out: where to insert it */
+static int32_t find_state(Search *s, const word *state, uint64_t h, size_t *slot_out)
+{
+    size_t mask = s->n_slots - 1, i = (size_t)h & mask;
+    Py_ssize_t W = s->W;
+    while (s->slots[i] >= 0) {
+        int32_t id = s->slots[i];
+        if (s->recs[id].hash == h && !memcmp(s->sdata + (Py_ssize_t)id * W, state, 8 * (size_t)W))
+            return id;
+        i = (i + 1) & mask;
+    }
+    *slot_out = i;
+    return -1;
+}
+
+static int32_t insert_state(Search *s, const word *state, uint64_t h, size_t slot)
+{
+    if (s->n_states == s->cap_states) {
+        if (s->cap_states > INT32_MAX / 2) {
+            s->oom = 1;
+            return -1;
+        }
+        int32_t cap = s->cap_states ? s->cap_states * 2 : 1024;
+        word *sd = realloc(s->sdata, (size_t)cap * (size_t)s->W * 8);
+        if (!sd) {
+            s->oom = 1;
+            return -1;
+        }
+        s->sdata = sd;
+        StateRec *r = realloc(s->recs, (size_t)cap * sizeof(StateRec));
+        if (!r) {
+            s->oom = 1;
+            return -1;
+        }
+        s->recs = r;
+        s->cap_states = cap;
+    }
+    int32_t id = s->n_states++;
+    memcpy(s->sdata + (Py_ssize_t)id * s->W, state, 8 * (size_t)s->W);
+    StateRec *rec = &s->recs[id];
+    memset(rec, 0, sizeof(*rec));
+    rec->hash = h;
+    s->slots[slot] = id;
+    if ((size_t)s->n_states * 2 > s->n_slots && grow_slots(s))
+        return -1;
+    return id;
+}
+
+/* _Labels.add: keep (c, p, node) unless dominated; drop (and kill) labels it dominates */
+static int labels_add(Search *s, StateRec *rec, double c, double p, int32_t node)
+{
+    for (int32_t i = 0; i < rec->n_labels; i++)
+        if (rec->labels[i].c <= c && rec->labels[i].p >= p)
+            return 0;
+    int32_t kept = 0;
+    for (int32_t i = 0; i < rec->n_labels; i++) {
+        Label l = rec->labels[i];
+        if (c <= l.c && p >= l.p)
+            s->n_alive[l.node] = 0;
+        else
+            rec->labels[kept++] = l;
+    }
+    rec->n_labels = kept;
+    if (rec->n_labels == rec->cap_labels) {
+        int32_t cap = rec->cap_labels ? rec->cap_labels * 2 : 1;
+        Label *v = realloc(rec->labels, (size_t)cap * sizeof(Label));
+        if (!v) {
+            s->oom = 1;
+            return -1;
+        }
+        rec->labels = v;
+        rec->cap_labels = cap;
+    }
+    rec->labels[rec->n_labels++] = (Label){c, p, node};
+    return 1;
+}
+
+static int grow_nodes(Search *s)
+{
+    if (s->cap_nodes > INT32_MAX / 2) {
+        s->oom = 1;
+        return -1;
+    }
+    int32_t cap = s->cap_nodes ? s->cap_nodes * 2 : 4096;
+#define GROW(field, type)                                                                       \
+    do {                                                                                        \
+        type *v = realloc(s->field, (size_t)cap * sizeof(type));                                \
+        if (!v) {                                                                               \
+            s->oom = 1;                                                                         \
+            return -1;                                                                          \
+        }                                                                                       \
+        s->field = v;                                                                           \
+    } while (0)
+    GROW(n_state, int32_t);
+    GROW(n_parent, int32_t);
+    GROW(n_via, int32_t);
+    GROW(n_c, double);
+    GROW(n_p, double);
+    GROW(n_h, double);
+    GROW(n_alive, int8_t);
+    GROW(n_eval, int8_t);
+#undef GROW
+    s->cap_nodes = cap;
+    return 0;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* The search (_Search)                                                                         */
+
+static int queue_node(Search *s, double f, double h, int32_t node, int preferred)
+{
+    if (qpush(s, &s->heap, f, h, node))
+        return -1;
+    if (preferred && qpush(s, &s->pref, f, h, node))
+        return -1;
+    if (h < s->best_h && s->n_eval[node]) {
+        s->best_h = h;
+        s->priority[1] -= 1000;
+    }
+    return 0;
+}
+
+static int push_node(Search *s, const word *state, double c, double p, int32_t parent,
+                     int32_t action, int preferred)
+{
+    if (p <= 0.0 || p < s->min_success) {
+        s->pruned_threshold |= p > 0.0;
+        return 0;
+    }
+    int32_t node = s->n_nodes;
+    uint64_t h = hash_state(state, s->W);
+    size_t slot = 0;
+    int32_t sid = find_state(s, state, h, &slot);
+    if (sid < 0) {
+        sid = insert_state(s, state, h, slot);
+        if (sid < 0)
+            return -1;
+    }
+    int added = labels_add(s, &s->recs[sid], c, p, node);
+    if (added <= 0)
+        return added;
+    double g = objective(c, p, s->reward);
+    double hv;
+    int deferred = s->lazy && parent >= 0;
+    if (deferred)
+        hv = s->n_h[parent];
+    else
+        hv = f_value(s, sid, c, p) - g;
+    if (s->oom)
+        return -1;
+    if (s->n_nodes == s->cap_nodes && grow_nodes(s))
+        return -1;
+    s->n_nodes++;
+    s->n_state[node] = sid;
+    s->n_c[node] = c;
+    s->n_p[node] = p;
+    s->n_parent[node] = parent;
+    s->n_via[node] = action;
+    s->n_alive[node] = hv != INFINITY;
+    s->n_h[node] = hv;
+    s->n_eval[node] = !deferred;
+    if (hv != INFINITY)
+        return queue_node(s, g + hv, hv, node, preferred);
+    return 0;
+}
+
+static int32_t pop_node(Search *s)
+{
+    int use_pref = s->pref.n && (s->priority[1] <= s->priority[0] || !s->heap.n);
+    s->from_pref = use_pref;
+    s->priority[use_pref ? 1 : 0] += 1;
+    return qpop(use_pref ? &s->pref : &s->heap).node;
+}
+
+/* _Search.evaluate: 1 if the node may be expanded now, 0 if dropped or re-queued, -1 error */
+static int evaluate_node(Search *s, int32_t node)
+{
+    if (s->n_eval[node])
+        return 1;
+    s->n_eval[node] = 1;
+    double c = s->n_c[node], p = s->n_p[node];
+    double f = f_value(s, s->n_state[node], c, p);
+    if (s->oom)
+        return -1;
+    if (f == INFINITY) {
+        s->n_alive[node] = 0;
+        return 0;
+    }
+    double h = f - objective(c, p, s->reward);
+    s->n_h[node] = h;
+    Queue *q = s->from_pref ? &s->pref : &s->heap;
+    if (q->n && f > q->v[0].f) {
+        if (queue_node(s, f, h, node, s->from_pref))
+            return -1;
+        return 0;
+    }
+    if (h < s->best_h) {
+        s->best_h = h;
+        s->priority[1] -= 1000;
+    }
+    return 1;
+}
+
+static inline int is_goal_state(const Search *s, const word *state)
+{
+    for (Py_ssize_t i = 0; i < s->W; i++)
+        if ((state[i] & s->goal[i]) != s->goal[i] || (state[i] & s->goal_neg[i]))
+            return 0;
+    return 1;
+}
+
+static inline int commutes(const TaskObject *t, Py_ssize_t W, int32_t a, int32_t b)
+{
+    const word *ra = t->reads + a * W, *rb = t->reads + b * W;
+    const word *aa = t->add + a * W, *da = t->del + a * W;
+    const word *ab = t->add + b * W, *db = t->del + b * W;
+    for (Py_ssize_t i = 0; i < W; i++) {
+        word w1 = aa[i] | da[i], w2 = ab[i] | db[i];
+        if ((ra[i] & w2) || (rb[i] & w1) || (aa[i] & db[i]) || (da[i] & ab[i]))
+            return 0;
+    }
+    return 1;
+}
+
+/* Symmetries.prunes */
+static int sym_prunes(const Search *s, int32_t a, const word *state)
+{
+    for (int64_t k = s->sym_act_off[a]; k < s->sym_act_off[a + 1]; k++) {
+        int64_t pair = s->sym_pair_ids[k];
+        int all = 1;
+        for (int64_t j = s->sym_pair_off[pair]; j < s->sym_pair_off[pair + 1]; j++) {
+            int64_t f = s->sym_fg[2 * j], g = s->sym_fg[2 * j + 1];
+            unsigned bf = (unsigned)BIT(state, f);
+            unsigned bg = g >= 0 ? (unsigned)BIT(state, g) : 0u;
+            if (bf != bg) {
+                all = 0;
+                break;
+            }
+        }
+        if (all)
+            return 1;
+    }
+    return 0;
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* returns status; *goal_node set when solved; -1 on allocation failure */
+static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *expanded_out)
+{
+    const TaskObject *t = s->t;
+    Py_ssize_t W = s->W, A = t->n_actions;
+    double t0 = now_s();
+    int64_t expanded = 0;
+    *expanded_out = 0;
+    if (push_node(s, init, 0.0, 1.0, -1, -1, 0) < 0)
+        return -1;
+    while (s->heap.n || s->pref.n) {
+        int32_t node = pop_node(s);
+        if (!s->n_alive[node])
+            continue;
+        int ev = evaluate_node(s, node);
+        if (ev < 0)
+            return -1;
+        if (!ev)
+            continue;
+        s->n_alive[node] = 0;
+        int32_t sid = s->n_state[node];
+        double c = s->n_c[node], p = s->n_p[node];
+        /* copy: the state table may move while successors are inserted */
+        memcpy(s->succ + W, s->sdata + (Py_ssize_t)sid * W, 8 * (size_t)W);
+        const word *state = s->succ + W;
+        if (is_goal_state(s, state)) {
+            double obj = objective(c, p, s->reward);
+            if (s->from_pref && s->heap.n && s->heap.v[0].f < obj) {
+                s->n_alive[node] = 1;
+                if (qpush(s, &s->heap, obj, 0.0, node))
+                    return -1;
+                continue;
+            }
+            *goal_node = node;
+            *expanded_out = expanded;
+            return ST_SOLVED;
+        }
+        expanded += 1;
+        *expanded_out = expanded;
+        if (s->node_limit >= 0 && expanded > s->node_limit)
+            return ST_NODE_LIMIT;
+        if (s->timeout >= 0 && now_s() - t0 > s->timeout)
+            return ST_TIMEOUT;
+        int32_t last = s->n_via[node];
+        uint32_t mark = 0;
+        if (s->preferred) {
+            StateRec *rec = &s->recs[sid];
+            if (++s->help_mark == 0) {
+                memset(s->help_stamp, 0, sizeof(uint32_t) * (size_t)A);
+                s->help_mark = 1;
+            }
+            mark = s->help_mark;
+            for (int32_t i = 0; i < rec->help_n; i++)
+                s->help_stamp[s->help[rec->help_off + i]] = mark;
+        }
+        word *succ = s->succ;
+        for (Py_ssize_t a = 0; a < A; a++) {
+            const word *pre = t->pre + a * W, *neg = t->pre_neg + a * W;
+            int ok = 1;
+            for (Py_ssize_t i = 0; i < W; i++)
+                if ((state[i] & pre[i]) != pre[i] || (state[i] & neg[i])) {
+                    ok = 0;
+                    break;
+                }
+            if (!ok)
+                continue;
+            if (t->cl_off[a] != t->cl_off[a + 1] && !applicable(t, W, (int32_t)a, state))
+                continue;
+            if (last > a && commutes(t, W, (int32_t)a, last))
+                continue; /* the order (a, last) is explored instead */
+            if (s->has_sym && sym_prunes(s, (int32_t)a, state))
+                continue; /* a mirror image with a lower object is explored */
+            const word *ad = t->add + a * W, *de = t->del + a * W;
+            for (Py_ssize_t i = 0; i < W; i++)
+                succ[i] = (state[i] & ~de[i]) | ad[i];
+            int pref = s->preferred && s->help_stamp[a] == mark;
+            if (push_node(s, succ, c + t->cost[a], p * t->prob[a], node, (int32_t)a, pref) < 0)
+                return -1;
+        }
+    }
+    *expanded_out = expanded;
+    return s->pruned_threshold ? ST_THRESHOLD : ST_UNSOLVABLE;
+}
+
+static void search_free(Search *s)
+{
+    for (int32_t i = 0; i < s->n_states; i++)
+        free(s->recs[i].labels);
+    void *ptrs[] = {s->goal, s->goal_neg, s->goal_facts, s->is_goal, s->sdata, s->recs,
+                    s->slots, s->n_state, s->n_parent, s->n_via, s->n_c, s->n_p, s->n_h,
+                    s->n_alive, s->n_eval, s->heap.v, s->pref.v, s->help, s->dist, s->value,
+                    s->combined, s->support, s->remaining, s->rem_ext, s->stack, s->chosen,
+                    s->seen_stamp, s->chosen_stamp, s->emit_stamp, s->help_stamp, s->active,
+                    s->pair_eff, s->dheap, s->succ};
+    for (size_t i = 0; i < sizeof(ptrs) / sizeof(ptrs[0]); i++)
+        free(ptrs[i]);
+}
+
+static int search_alloc(Search *s)
+{
+    const TaskObject *t = s->t;
+    size_t F = (size_t)t->n_facts, A = (size_t)t->n_actions, W = (size_t)s->W;
+    s->goal = xcalloc(W, 8);
+    s->goal_neg = xcalloc(W, 8);
+    s->goal_facts = xcalloc(F, sizeof(int32_t));
+    s->is_goal = xcalloc(F, 1);
+    s->dist = xcalloc(F, sizeof(double));
+    s->value = xcalloc(A, sizeof(double));
+    s->combined = xcalloc(A, sizeof(double));
+    s->support = xcalloc(F, sizeof(int32_t));
+    s->remaining = xcalloc(A, sizeof(int32_t));
+    s->rem_ext = xcalloc(A, sizeof(int32_t));
+    s->stack = xcalloc(F, sizeof(int32_t));
+    s->chosen = xcalloc(A, sizeof(int32_t));
+    s->seen_stamp = xcalloc(F, sizeof(uint32_t));
+    s->chosen_stamp = xcalloc(A, sizeof(uint32_t));
+    s->emit_stamp = xcalloc((size_t)t->n_pairs + 1, sizeof(uint32_t));
+    s->help_stamp = xcalloc(A, sizeof(uint32_t));
+    s->active = xcalloc((size_t)t->n_unit, 1);
+    s->pair_eff = xcalloc((size_t)t->n_pairs, 1);
+    s->dcap = F + (size_t)t->total_add + 1;
+    s->dheap = xcalloc(s->dcap, sizeof(DEntry));
+    s->succ = xcalloc(2 * W, 8);
+    if (!s->goal || !s->goal_neg || !s->goal_facts || !s->is_goal || !s->dist || !s->value ||
+        !s->combined || !s->support || !s->remaining || !s->rem_ext || !s->stack ||
+        !s->chosen || !s->seen_stamp || !s->chosen_stamp || !s->emit_stamp || !s->help_stamp ||
+        !s->active || !s->pair_eff || !s->dheap || !s->succ)
+        return -1;
+    return grow_slots(s);
+}
+
+static int check_words(Py_buffer *b, Py_ssize_t W, Py_ssize_t n_facts, const char *what)
+{
+    if ((size_t)b->len != (size_t)W * 8) {
+        PyErr_Format(PyExc_ValueError, "native search: %s has %zd bytes, expected %zd", what,
+                     b->len, W * 8);
+        return -1;
+    }
+    const word *x = b->buf;
+    if (x[W - 1] & ~(((word)1 << (n_facts & 63)) - 1)) {
+        PyErr_Format(PyExc_ValueError, "native search: %s has a fact >= %zd", what, n_facts);
+        return -1;
+    }
+    return 0;
+}
+
+static int check_symmetry(Search *s, Py_buffer *b, Py_ssize_t A, Py_ssize_t F)
+{
+    /* b: act_off (A+1 or empty), pair_ids, pair_off, fg */
+    if (b[0].len == 0) {
+        s->has_sym = 0;
+        return 0;
+    }
+    for (int i = 0; i < 4; i++)
+        if (b[i].len % 8) {
+            PyErr_SetString(PyExc_ValueError, "native search: symmetry arrays must be int64");
+            return -1;
+        }
+    Py_ssize_t n_ids = b[1].len / 8, n_off = b[2].len / 8, n_fg = b[3].len / 16;
+    const int64_t *act_off = b[0].buf, *ids = b[1].buf, *poff = b[2].buf, *fg = b[3].buf;
+    if (b[0].len / 8 != A + 1 || act_off[0] != 0 || act_off[A] != n_ids || n_off < 1 ||
+        poff[0] != 0 || poff[n_off - 1] != n_fg || b[3].len % 16) {
+        PyErr_SetString(PyExc_ValueError, "native search: inconsistent symmetry arrays");
+        return -1;
+    }
+    for (Py_ssize_t a = 0; a < A; a++)
+        if (act_off[a + 1] < act_off[a])
+            goto bad;
+    for (Py_ssize_t i = 0; i < n_ids; i++)
+        if (ids[i] < 0 || ids[i] >= n_off - 1)
+            goto bad;
+    for (Py_ssize_t i = 0; i + 1 < n_off; i++)
+        if (poff[i + 1] < poff[i])
+            goto bad;
+    for (Py_ssize_t i = 0; i < n_fg; i++)
+        if (fg[2 * i] < 0 || fg[2 * i] >= F || fg[2 * i + 1] < -1 || fg[2 * i + 1] >= F)
+            goto bad;
+    s->has_sym = 1;
+    s->sym_act_off = act_off;
+    s->sym_pair_ids = ids;
+    s->sym_pair_off = poff;
+    s->sym_fg = fg;
+    return 0;
+bad:
+    PyErr_SetString(PyExc_ValueError, "native search: symmetry arrays out of range");
+    return -1;
+}
+
+static PyObject *native_search(PyObject *self, PyObject *args)
+{
+    TaskObject *t;
+    Py_buffer b[7];
+    memset(b, 0, sizeof(b));
+    Search s;
+    memset(&s, 0, sizeof(s));
+    long long node_limit;
+    if (!PyArg_ParseTuple(args, "O!y*y*y*iddddLppy*y*y*y*:search", &TaskType, &t, &b[0], &b[1],
+                          &b[2], &s.heuristic, &s.reward, &s.weight, &s.min_success, &s.timeout,
+                          &node_limit, &s.lazy, &s.preferred, &b[3], &b[4], &b[5], &b[6]))
+        return NULL;
+    PyObject *result = NULL;
+    s.t = t;
+    s.W = t->W;
+    s.node_limit = node_limit;
+    s.best_h = INFINITY;
+    Py_ssize_t W = t->W, F = t->n_facts, A = t->n_actions;
+    if (s.heuristic < H_BLIND || s.heuristic > H_FF) {
+        PyErr_SetString(PyExc_ValueError, "native search: unknown heuristic code");
+        goto done;
+    }
+    if (check_words(&b[0], W, F, "init") || check_words(&b[1], W, F, "goal") ||
+        check_words(&b[2], W, F, "goal_neg") || check_symmetry(&s, &b[3], A, F))
+        goto done;
+    if (search_alloc(&s)) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    s.preferred = s.preferred && s.heuristic == H_FF;
+    memcpy(s.goal, b[1].buf, 8 * (size_t)W);
+    memcpy(s.goal_neg, b[2].buf, 8 * (size_t)W);
+    for (Py_ssize_t f = 0; f < F; f++)
+        if (BIT(s.goal, f)) {
+            s.goal_facts[s.n_goal++] = (int32_t)f;
+            s.is_goal[f] = 1;
+        }
+    for (Py_ssize_t a = 0; a < A; a++) /* RelaxedTask.combined, same expression */
+        s.combined[a] = 1.0 + t->cost[a] + s.reward * (1.0 - t->prob[a]);
+    int32_t goal_node = -1;
+    int64_t expanded = 0;
+    int status;
+    Py_BEGIN_ALLOW_THREADS
+    status = run_search(&s, b[0].buf, &goal_node, &expanded);
+    Py_END_ALLOW_THREADS
+    if (status < 0 || s.oom) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    Py_ssize_t length = 0;
+    for (int32_t n = goal_node; n >= 0 && s.n_via[n] >= 0; n = s.n_parent[n])
+        length++;
+    PyObject *path = PyTuple_New(length);
+    if (!path)
+        goto done;
+    Py_ssize_t i = length;
+    for (int32_t n = goal_node; n >= 0 && s.n_via[n] >= 0; n = s.n_parent[n]) {
+        PyObject *v = PyLong_FromLong(s.n_via[n]);
+        if (!v) {
+            Py_DECREF(path);
+            goto done;
+        }
+        PyTuple_SET_ITEM(path, --i, v);
+    }
+    result = Py_BuildValue("(iNLi)", status, path, (long long)expanded, (int)s.n_nodes);
+done:
+    search_free(&s);
+    for (int i = 0; i < 7; i++)
+        if (b[i].obj)
+            PyBuffer_Release(&b[i]);
+    return result;
+}
+
+static PyMethodDef native_methods[] = {
+    {"search", native_search, METH_VARARGS,
+     "search(task, init, goal, goal_neg, heuristic, reward, weight, min_success, timeout_s, "
+     "node_limit, lazy, preferred, sym_act_off, sym_pair_ids, sym_pair_off, sym_fg) -> "
+     "(status, path, expanded, generated). Use avs_planner.cp.native, not this directly."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef native_module = {
+    PyModuleDef_HEAD_INIT, "_native",
+    "Compiled search core of the continual planner (see avs_planner/cp/native.py).", -1,
+    native_methods, NULL, NULL, NULL, NULL,
+};
+
+PyMODINIT_FUNC PyInit__native(void)
+{
+    if (PyType_Ready(&TaskType) < 0)
+        return NULL;
+    PyObject *m = PyModule_Create(&native_module);
+    if (!m)
+        return NULL;
+    Py_INCREF(&TaskType);
+    if (PyModule_AddObject(m, "Task", (PyObject *)&TaskType) < 0) {
+        Py_DECREF(&TaskType);
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
+}
