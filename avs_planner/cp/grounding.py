@@ -495,6 +495,24 @@ def _bits(flags: np.ndarray) -> int:
     return int.from_bytes(np.packbits(flags, bitorder="little").tobytes(), "little")
 
 
+class _HashOnce:
+    """A cache key whose (costly: UP actions hash structurally) hash is computed once."""
+
+    __slots__ = ("value", "_hash")
+
+    def __init__(self, value: tuple):
+        self.value = value
+        self._hash = hash(value)
+
+    def __hash__(self) -> int:
+        return self._hash
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, _HashOnce) and (
+            other is self or (other._hash == self._hash and other.value == self.value)
+        )
+
+
 class GroundingCache:
     """Keeps compiled schemas and ground structures for the last few (domain, objects, statics)."""
 
@@ -502,6 +520,7 @@ class GroundingCache:
         self.size = size
         self._schemas: OrderedDict[tuple, tuple[LiftedSchema, ...]] = OrderedDict()
         self._structures: OrderedDict[tuple, GroundStructure] = OrderedDict()
+        self._problem_keys: OrderedDict[int, tuple] = OrderedDict()
         self.hits = 0
         self.misses = 0
 
@@ -517,26 +536,37 @@ class GroundingCache:
         return value
 
     def schemas(self, pproblem: ProbabilisticProblem) -> tuple[LiftedSchema, ...]:
-        key = self._schema_key(pproblem)
+        key, _ = self._keys(pproblem)
         return self._remember(self._schemas, key, lambda: compile_schemas(pproblem))
 
-    @staticmethod
-    def _schema_key(pproblem: ProbabilisticProblem) -> tuple:
+    def _keys(self, pproblem: ProbabilisticProblem) -> tuple[tuple, frozenset[str]]:
+        """The schema key and static fluent names of a problem, computed once per problem
+        object (hashing UP actions and finding static fluents walks the whole domain). A
+        problem must not be changed after it was grounded; build a new one instead."""
+        known = self._problem_keys.get(id(pproblem))
+        if known is not None and known[0] is pproblem:
+            return known[1], known[2]
         problem = pproblem.problem
-        return (
+        static_names = frozenset(f.name for f in problem.get_static_fluents())
+        key = _HashOnce((
             tuple(problem.actions),
             tuple(sorted((k, str(v)) for k, v in pproblem.success.items())),
             tuple(str(m) for m in problem.quality_metrics),
-            frozenset(f.name for f in problem.get_static_fluents()),
-        )
+            static_names,
+        ))
+        objects = _HashOnce(tuple((o.name, str(o.type)) for o in problem.all_objects))
+        self._problem_keys[id(pproblem)] = (pproblem, key, static_names, objects)
+        if len(self._problem_keys) > self.size:
+            self._problem_keys.popitem(last=False)
+        return key, static_names
 
     def structure(self, pproblem: ProbabilisticProblem, state: WorldState) -> GroundStructure:
         problem = pproblem.problem
+        schema_key, static_names = self._keys(pproblem)
         schemas = self.schemas(pproblem)
-        static_names = {f.name for f in problem.get_static_fluents()}
+        objects = self._problem_keys[id(pproblem)][3]
         static = frozenset(a for a in state.true_atoms if a[0] in static_names)
-        objects = tuple((o.name, str(o.type)) for o in problem.all_objects)
-        key = (self._schema_key(pproblem), objects, static)
+        key = (schema_key, objects, static)
         assumptive = {s.name: pproblem.is_assumptive(s.name) for s in schemas}
         return self._remember(
             self._structures, key,
