@@ -13,8 +13,10 @@ Only the ground actions that survive become `GroundAction` objects.
 
 from __future__ import annotations
 
+import gc
 from collections import OrderedDict
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -79,8 +81,8 @@ class GroundStructure:
     add: np.ndarray
     delete: np.ndarray
     clauses: Mapping[int, tuple[tuple[tuple[int, ...], tuple[int, ...]], ...]]
+    arg_ids: np.ndarray  # (rows, max arity) object ids of the arguments, padded with -1
     _rows: dict[int, tuple] = field(default_factory=dict, compare=False, repr=False)
-    _lists: list = field(default_factory=list, compare=False, repr=False)
 
     @property
     def size(self) -> int:
@@ -98,35 +100,35 @@ class GroundStructure:
         args = (names[int(block.columns[p][row - block.start])] for p in block.schema.params)
         return "(" + " ".join((block.schema.name, *args)) + ")"
 
-    def row(self, row: int) -> tuple:
-        """(name, args, pre, pre_neg, add, delete, pre_facts, add_facts, clauses, assumptive,
-        signature) of one ground action, built once per structure."""
-        known = self._rows.get(row)
-        if known is not None:
-            return known
-        if not self._lists:
-            self._lists.extend((self.pre.tolist(), self.pre_neg.tolist(), self.add.tolist(),
-                                self.delete.tolist(), {}))
-        pre_rows, neg_rows, add_rows, delete_rows, columns = self._lists
+    def rows(self, rows: list[int]) -> list[tuple]:
+        """Per row: (name, args, pre, pre_neg, add, delete, pre_facts, add_facts, clauses,
+        assumptive, signature) of the ground action, built once per structure."""
+        known = self._rows
+        missing = [r for r in rows if r not in known]
+        if missing:
+            self._build_rows(missing)
+        return [known[r] for r in rows]
+
+    def _build_rows(self, missing: list[int]) -> None:
         n = len(self.facts)
-        block = self.block_of(row)
-        cols = columns.get(block.start)
-        if cols is None:
-            cols = columns[block.start] = [block.columns[p].tolist() for p in block.schema.params]
         names = self.space.names
-        i = row - block.start
-        args = tuple([names[c[i]] for c in cols])
-        pre_facts = tuple(sorted({f for f in pre_rows[row] if f < n}))
-        add_facts = tuple(sorted({f for f in add_rows[row] if f < n}))
-        clauses = tuple((_mask(pos), _mask(negs)) for pos, negs in self.clauses.get(row, ()))
-        add = _mask(add_facts)
-        name = block.schema.name
-        known = self._rows[row] = (
-            name, args, _mask(pre_facts), _mask(f for f in neg_rows[row] if f < n), add,
-            _mask(f for f in delete_rows[row] if f < n) & ~add, pre_facts, add_facts, clauses,
-            block.assumptive, (name.lower(), *(x.lower() for x in args)),
-        )
-        return known
+        at = np.array(missing, dtype=np.int64)
+        pre_rows, neg_rows = self.pre[at].tolist(), self.pre_neg[at].tolist()
+        add_rows, delete_rows = self.add[at].tolist(), self.delete[at].tolist()
+        arg_rows = self.arg_ids[at].tolist()
+        for k, row in enumerate(missing):
+            block = self.block_of(row)
+            args = tuple([names[v] for v in arg_rows[k][: len(block.schema.params)]])
+            pre_facts = tuple(sorted({f for f in pre_rows[k] if f < n}))
+            add_facts = tuple(sorted({f for f in add_rows[k] if f < n}))
+            clauses = tuple((_mask(pos), _mask(neg)) for pos, neg in self.clauses.get(row, ()))
+            add = _mask(add_facts)
+            name = block.schema.name
+            self._rows[row] = (
+                name, args, _mask(pre_facts), _mask(f for f in neg_rows[k] if f < n), add,
+                _mask(f for f in delete_rows[k] if f < n) & ~add, pre_facts, add_facts,
+                clauses, block.assumptive, (name.lower(), *(x.lower() for x in args)),
+            )
 
 
 def _mask(ids) -> int:
@@ -356,8 +358,12 @@ def _assemble(problem, space, static, parts, assumptive) -> GroundStructure:
         stacked[key] = renumber(joined, pad)
     blocks, clauses, start = [], {}, 0
     index_of = {c: i for i, c in enumerate(codes.tolist())}
+    arity = max((len(part[0].params) for part in parts), default=0)
+    arg_ids = np.full((sum(part[2] for part in parts), arity), -1, dtype=np.int64)
     for schema, columns, rows, *_, row_clauses in parts:
         blocks.append(_Block(schema, start, start + rows, columns, assumptive[schema.name]))
+        for j, param in enumerate(schema.params):
+            arg_ids[start:start + rows, j] = columns[param]
         for i, row in enumerate(row_clauses):
             if row:
                 clauses[start + i] = tuple(
@@ -369,6 +375,7 @@ def _assemble(problem, space, static, parts, assumptive) -> GroundStructure:
         facts=facts, fact_index={a: i for i, a in enumerate(facts)},
         static_atoms=static, space=space, blocks=tuple(blocks), pre=stacked["pre"],
         pre_neg=stacked["neg"], add=stacked["add"], delete=stacked["delete"], clauses=clauses,
+        arg_ids=arg_ids,
     )
 
 
@@ -577,12 +584,34 @@ class GroundingCache:
 DEFAULT_CACHE = GroundingCache()
 
 
+@contextmanager
+def _gc_paused() -> Iterator[None]:
+    """Grounding allocates many small, acyclic objects; the cyclic collector's passes over a
+    large heap then cost more than the grounding (measured 0.31 s vs 0.11 s for a 12-place
+    AVS problem). It is paused for the call and restored after."""
+    if not gc.isenabled():
+        yield
+        return
+    gc.disable()
+    try:
+        yield
+    finally:
+        gc.enable()
+
+
 def ground(
     pproblem: ProbabilisticProblem,
     state: WorldState | None = None,
     cache: GroundingCache | None = None,
 ) -> GroundTask:
     """Ground the task from `state` (default: the problem's :init) into a `GroundTask`."""
+    with _gc_paused():
+        return _ground(pproblem, state, cache)
+
+
+def _ground(
+    pproblem: ProbabilisticProblem, state: WorldState | None, cache: GroundingCache | None
+) -> GroundTask:
     cache = DEFAULT_CACHE if cache is None else cache
     state = world_state(pproblem.problem) if state is None else state
     structure = cache.structure(pproblem, state)
@@ -618,9 +647,9 @@ def ground(
     actions = []
     by_signature = {}
     costs, probabilities = cost.tolist(), probability.tolist()
-    for index, row in enumerate(rows):
+    for index, (row, info) in enumerate(zip(rows, st.rows(rows), strict=True)):
         (name, args, pre, neg, add, delete, pre_facts, add_facts, clauses, assume,
-         signature) = st.row(row)
+         signature) = info
         if add & ~read_mask:
             add &= read_mask
             add_facts = tuple(f for f in add_facts if read_mask >> f & 1)
