@@ -25,7 +25,7 @@ from unified_planning.model import FNode, Problem
 from avs_planner.cp.encoding import AtomSpace, Columns
 from avs_planner.cp.formulas import FormulaGrounder
 from avs_planner.cp.schema import AtomTemplate, LiftedSchema, compile_schemas
-from avs_planner.cp.task import Atom, GroundAction, GroundTask, WorldState
+from avs_planner.cp.task import Atom, GroundAction, GroundTask, TaskArrays, WorldState
 from avs_planner.errors import PlanningError
 from avs_planner.pddl.model import ProbabilisticProblem
 
@@ -498,6 +498,24 @@ def _check(st: GroundStructure, rows: np.ndarray, values: np.ndarray, what: str)
         raise PlanningError(f"cost of {st.label(row)} is {values[row]} (must be >= 0)")
 
 
+def _fact_matrix(ids: np.ndarray, n: int, read: np.ndarray | None) -> np.ndarray:
+    """Rows of fact ids sorted and unique, padding (ids >= n) and, if `read` is given,
+    facts nothing reads replaced by -1 at the end of the row."""
+    big = np.iinfo(np.int64).max
+    valid = ids < n
+    if read is not None:
+        valid[valid] = read[ids[valid]]
+    out = np.where(valid, ids, big)
+    out.sort(axis=1)
+    if out.shape[1] > 1:
+        dup = np.zeros(out.shape, dtype=bool)
+        dup[:, 1:] = out[:, 1:] == out[:, :-1]
+        out[dup] = big
+        out.sort(axis=1)
+    out[out == big] = -1
+    return out
+
+
 def _bits(flags: np.ndarray) -> int:
     return int.from_bytes(np.packbits(flags, bitorder="little").tobytes(), "little")
 
@@ -659,8 +677,16 @@ def _ground(
         )
         actions.append(action)
         by_signature[signature] = action
+    kept_rows = np.array(rows, dtype=np.int64)
+    arrays = TaskArrays(
+        pre=_fact_matrix(st.pre[kept_rows], n, None),
+        pre_neg=_fact_matrix(st.pre_neg[kept_rows], n, None),
+        add=_fact_matrix(st.add[kept_rows], n, read),
+        delete=_fact_matrix(st.delete[kept_rows], n, read),
+        cost=cost[kept_rows], probability=probability[kept_rows],
+    )
     return GroundTask(
         facts=structure.facts, fact_index=structure.fact_index, actions=tuple(actions),
         init=init, goal=goal, goal_neg=goal_neg, goal_impossible=impossible,
-        by_signature=by_signature,
+        by_signature=by_signature, arrays=arrays,
     )

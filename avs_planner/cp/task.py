@@ -10,6 +10,8 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
+import numpy as np
+
 Atom = tuple[str, ...]
 """A ground atom: (predicate, arg1, ..., argN), names as in the problem."""
 
@@ -96,6 +98,21 @@ class WorldState:
 
 
 @dataclass(frozen=True)
+class TaskArrays:
+    """The actions of a task as arrays, row i = action i, for consumers that work on arrays
+    (the native search core's packer). Fact-id matrices hold each row's facts sorted and
+    unique, padded with -1 at the end; `add` and `delete` are after read-masking, as in the
+    `GroundAction`s."""
+
+    pre: np.ndarray
+    pre_neg: np.ndarray
+    add: np.ndarray
+    delete: np.ndarray
+    cost: np.ndarray
+    probability: np.ndarray
+
+
+@dataclass(frozen=True)
 class GroundTask:
     """Facts, reachable ground actions, initial state and goal of one planning call."""
 
@@ -107,6 +124,7 @@ class GroundTask:
     goal_neg: int = 0
     goal_impossible: bool = False
     by_signature: Mapping[tuple[str, ...], GroundAction] = field(default_factory=dict)
+    arrays: TaskArrays | None = field(default=None, compare=False, repr=False)
 
     def is_goal(self, state: int) -> bool:
         return (state & self.goal) == self.goal and not (state & self.goal_neg)
