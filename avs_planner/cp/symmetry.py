@@ -9,7 +9,7 @@ search only tries the lower one.
 
 from __future__ import annotations
 
-from collections import defaultdict
+from collections import OrderedDict, defaultdict
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
@@ -117,24 +117,51 @@ def _partition(names: list[str], state: WorldState, mentions) -> list[tuple[str,
     return [tuple(c) for c in classes]
 
 
-def _build(task: GroundTask, groups: Iterable[tuple[str, ...]]) -> Symmetries:
+_FACT_PAIRS: OrderedDict[tuple, tuple[tuple, dict]] = OrderedDict()
+_FACT_PAIRS_SIZE = 8
+
+
+def _fact_pairs(task: GroundTask, groups: tuple[tuple[str, ...], ...]) -> dict:
+    """Per pair (a, b) of a group, the facts mentioning a or b and their swapped images;
+    depends only on the fact table, so it is kept for the last few (fact table, groups)."""
+    key = (id(task.facts), groups)
+    hit = _FACT_PAIRS.get(key)
+    if hit is not None and hit[0] is task.facts:
+        _FACT_PAIRS.move_to_end(key)
+        return hit[1]
     fact_pairs: dict[Pair, tuple[tuple[int, int], ...]] = {}
-    lower: dict[str, list[Pair]] = {}
     facts_of: dict[str, list[int]] = defaultdict(list)
     for i, atom in enumerate(task.facts):
         for x in set(atom[1:]):
             facts_of[x].append(i)
     for group in groups:
         for j, b in enumerate(group):
-            lower[b] = [(a, b) for a in group[:j]]
             for a in group[:j]:
                 touched = sorted(set(facts_of[a]) | set(facts_of[b]))
                 fact_pairs[(a, b)] = tuple(
                     (f, task.fact_index.get(_swap(task.facts[f], a, b), -1)) for f in touched
                 )
+    _FACT_PAIRS[key] = (task.facts, fact_pairs)  # a strong ref keeps the id unique
+    while len(_FACT_PAIRS) > _FACT_PAIRS_SIZE:
+        _FACT_PAIRS.popitem(last=False)
+    return fact_pairs
+
+
+def _build(task: GroundTask, groups: Iterable[tuple[str, ...]]) -> Symmetries:
+    groups = tuple(groups)
+    fact_pairs = _fact_pairs(task, groups)
+    lower = {b: [(a, b) for a in group[:j]] for group in groups for j, b in enumerate(group)}
+    higher = frozenset(b for b, pairs in lower.items() if pairs)
     checks = {}
+    by_args: dict[tuple[str, ...], tuple[Pair, ...]] = {}
     for action in task.actions:
-        pairs = tuple(p for x in dict.fromkeys(action.args) for p in lower.get(x, ()))
-        if pairs:
-            checks[action.index] = pairs
-    return Symmetries(tuple(groups), fact_pairs, checks)
+        args = action.args
+        if higher.isdisjoint(args):
+            continue
+        pairs = by_args.get(args)
+        if pairs is None:
+            pairs = by_args[args] = tuple(
+                p for x in dict.fromkeys(args) for p in lower.get(x, ())
+            )
+        checks[action.index] = pairs
+    return Symmetries(groups, fact_pairs, checks)
