@@ -41,6 +41,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="hmax (admissible), hadd, ff (default) or blind")
     parser.add_argument("--min-success", type=float, default=0.0,
                         help="give up if the best plan's success probability is below this")
+    parser.add_argument("--engine", choices=("auto", "native", "python"), default="auto",
+                        help="search core: native (compiled, same results), python, or auto "
+                        "(native when built; default)")
     parser.set_defaults(func=run)
 
 
@@ -52,7 +55,8 @@ def run(args: argparse.Namespace) -> int:
     given = {"reward": args.reward, "weight": args.weight}
     options = SearchOptions(
         heuristic=args.heuristic, timeout_s=args.timeout, node_limit=args.node_limit,
-        min_success=args.min_success, **{k: v for k, v in given.items() if v is not None},
+        min_success=args.min_success, engine=args.engine,
+        **{k: v for k, v in given.items() if v is not None},
     ).check()
     pproblem = read_files(args.domain, args.problem)
     result = plan(pproblem, options)

@@ -1468,11 +1468,94 @@ done:
     return result;
 }
 
+/* estimates(task, goal, heuristic, reward, states) -> [(hc, hl, helpful actions)]: the
+ * heuristic alone on each state (W words each), for tests against heuristics.py */
+static PyObject *native_estimates(PyObject *self, PyObject *args)
+{
+    TaskObject *t;
+    Py_buffer goal = {0}, states = {0};
+    Search s;
+    memset(&s, 0, sizeof(s));
+    if (!PyArg_ParseTuple(args, "O!y*idy*:estimates", &TaskType, &t, &goal, &s.heuristic,
+                          &s.reward, &states))
+        return NULL;
+    PyObject *out = NULL;
+    s.t = t;
+    s.W = t->W;
+    Py_ssize_t W = t->W, F = t->n_facts, A = t->n_actions;
+    if (s.heuristic < H_BLIND || s.heuristic > H_FF) {
+        PyErr_SetString(PyExc_ValueError, "native estimates: unknown heuristic code");
+        goto done;
+    }
+    if (check_words(&goal, W, F, "goal"))
+        goto done;
+    if (states.len % (8 * W)) {
+        PyErr_SetString(PyExc_ValueError, "native estimates: states are not whole bitsets");
+        goto done;
+    }
+    if (search_alloc(&s)) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    memcpy(s.goal, goal.buf, 8 * (size_t)W);
+    for (Py_ssize_t f = 0; f < F; f++)
+        if (BIT(s.goal, f)) {
+            s.goal_facts[s.n_goal++] = (int32_t)f;
+            s.is_goal[f] = 1;
+        }
+    for (Py_ssize_t a = 0; a < A; a++)
+        s.combined[a] = 1.0 + t->cost[a] + s.reward * (1.0 - t->prob[a]);
+    Py_ssize_t n = states.len / (8 * W);
+    out = PyList_New(0);
+    for (Py_ssize_t i = 0; out && i < n; i++) {
+        const word *state = (const word *)states.buf + i * W;
+        if (state[W - 1] & ~(((word)1 << (F & 63)) - 1)) {
+            PyErr_SetString(PyExc_ValueError, "native estimates: a state has a fact too many");
+            Py_CLEAR(out);
+            break;
+        }
+        uint64_t h = hash_state(state, W);
+        size_t slot = 0;
+        int32_t sid = find_state(&s, state, h, &slot);
+        if (sid < 0 && (sid = insert_state(&s, state, h, slot)) < 0)
+            break;
+        estimate(&s, sid);
+        if (s.oom)
+            break;
+        StateRec *rec = &s.recs[sid];
+        PyObject *helpful = PyTuple_New(rec->help_n);
+        if (!helpful) {
+            Py_CLEAR(out);
+            break;
+        }
+        for (int32_t j = 0; j < rec->help_n; j++)
+            PyTuple_SET_ITEM(helpful, j, PyLong_FromLong(s.help[rec->help_off + j]));
+        PyObject *item = Py_BuildValue("(ddN)", rec->hc, rec->hl, helpful);
+        if (!item || PyList_Append(out, item)) {
+            Py_XDECREF(item);
+            Py_CLEAR(out);
+            break;
+        }
+        Py_DECREF(item);
+    }
+    if (s.oom) {
+        Py_CLEAR(out);
+        PyErr_NoMemory();
+    }
+done:
+    search_free(&s);
+    PyBuffer_Release(&goal);
+    PyBuffer_Release(&states);
+    return out;
+}
+
 static PyMethodDef native_methods[] = {
     {"search", native_search, METH_VARARGS,
      "search(task, init, goal, goal_neg, heuristic, reward, weight, min_success, timeout_s, "
      "node_limit, lazy, preferred, sym_act_off, sym_pair_ids, sym_pair_off, sym_fg) -> "
      "(status, path, expanded, generated). Use avs_planner.cp.native, not this directly."},
+    {"estimates", native_estimates, METH_VARARGS,
+     "estimates(task, goal, heuristic, reward, states) -> [(hc, hl, helpful)] (for tests)."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -149,3 +149,15 @@ def run(
         remaining, -1 if node_limit is None else int(node_limit), lazy, preferred, *sym,
     )
     return STATUS_NAMES[status], path, expanded, generated
+
+
+def estimates(
+    task: GroundTask, heuristic: str, reward: float, states: list[int]
+) -> list[tuple[float, float, tuple[int, ...]]]:
+    """The C heuristic alone: (hc, hl, helpful actions) per state, as heuristics.py gives."""
+    packed = pack_task(task)
+    n_facts = len(task.facts)
+    n_bytes = 8 * words(n_facts)
+    blob = b"".join(_bits(s, n_bytes, n_facts, "a state") for s in states)
+    return _native.estimates(packed, _bits(task.goal, n_bytes, n_facts, "the goal"),
+                             HEURISTIC_CODES[heuristic], float(reward), blob)

@@ -6,12 +6,16 @@ import math
 
 import pytest
 
+from avs_planner.cp import native
 from avs_planner.cp.grounding import ground
 from avs_planner.cp.planner import plan
 from avs_planner.cp.search import PlanStatus, SearchOptions, objective
 from avs_planner.errors import PlanningError
 
 R = 100.0
+# the brute-force checks run on both search engines (native: the compiled core)
+ENGINES = ["python", pytest.param("native", marks=pytest.mark.skipif(
+    not native.AVAILABLE, reason="native core not built (test_cp_native fails for that)"))]
 
 
 def brute_force(task, reward: float) -> float:
@@ -34,14 +38,17 @@ def brute_force(task, reward: float) -> float:
     return best
 
 
+@pytest.mark.parametrize("engine", ENGINES)
 @pytest.mark.parametrize("heuristic", ["hmax", "blind"])
-def test_w1_admissible_is_optimal_against_brute_force(heuristic, make_random):
+def test_w1_admissible_is_optimal_against_brute_force(heuristic, engine, make_random):
     checked = 0
     for seed in range(60):
         pproblem = make_random(seed)
         task = ground(pproblem)
         expected = brute_force(task, R)
-        result = plan(pproblem, SearchOptions(reward=R, heuristic=heuristic, weight=1.0))
+        result = plan(pproblem, SearchOptions(reward=R, heuristic=heuristic, weight=1.0,
+                                              engine=engine))
+        assert result.extra["engine"] == engine
         if expected == math.inf:
             assert result.status is PlanStatus.UNSOLVABLE, seed
             continue
@@ -51,12 +58,14 @@ def test_w1_admissible_is_optimal_against_brute_force(heuristic, make_random):
     assert checked >= 20  # enough solvable instances were actually compared
 
 
-def test_satisficing_plans_are_valid_and_no_better_than_optimal(make_random):
+@pytest.mark.parametrize("engine", ENGINES)
+def test_satisficing_plans_are_valid_and_no_better_than_optimal(engine, make_random):
     for seed in range(30):
         pproblem = make_random(seed)
         task = ground(pproblem)
         expected = brute_force(task, R)
-        result = plan(pproblem, SearchOptions(reward=R, heuristic="ff", weight=3.0))
+        result = plan(pproblem, SearchOptions(reward=R, heuristic="ff", weight=3.0,
+                                              engine=engine))
         if expected == math.inf:
             continue
         state = task.init
