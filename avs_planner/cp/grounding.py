@@ -113,22 +113,36 @@ class GroundStructure:
         n = len(self.facts)
         names = self.space.names
         at = np.array(missing, dtype=np.int64)
-        pre_rows, neg_rows = self.pre[at].tolist(), self.pre_neg[at].tolist()
-        add_rows, delete_rows = self.add[at].tolist(), self.delete[at].tolist()
+        pre, neg, add, delete = (_fact_matrix(a[at], n, None)
+                                 for a in (self.pre, self.pre_neg, self.add, self.delete))
+        pre_masks, neg_masks, add_masks, delete_masks = (
+            _row_masks(m, n) for m in (pre, neg, add, delete)
+        )
+        pre_count, add_count = (pre >= 0).sum(axis=1).tolist(), (add >= 0).sum(axis=1).tolist()
+        pre_rows, add_rows = pre.tolist(), add.tolist()
         arg_rows = self.arg_ids[at].tolist()
         for k, row in enumerate(missing):
             block = self.block_of(row)
             args = tuple([names[v] for v in arg_rows[k][: len(block.schema.params)]])
-            pre_facts = tuple(sorted({f for f in pre_rows[k] if f < n}))
-            add_facts = tuple(sorted({f for f in add_rows[k] if f < n}))
             clauses = tuple((_mask(pos), _mask(neg)) for pos, neg in self.clauses.get(row, ()))
-            add = _mask(add_facts)
             name = block.schema.name
             self._rows[row] = (
-                name, args, _mask(pre_facts), _mask(f for f in neg_rows[k] if f < n), add,
-                _mask(f for f in delete_rows[k] if f < n) & ~add, pre_facts, add_facts,
+                name, args, pre_masks[k], neg_masks[k], add_masks[k], delete_masks[k],
+                tuple(pre_rows[k][: pre_count[k]]), tuple(add_rows[k][: add_count[k]]),
                 clauses, block.assumptive, (name.lower(), *(x.lower() for x in args)),
             )
+
+
+def _row_masks(matrix: np.ndarray, n: int) -> list[int]:
+    """Each row's fact ids (>= 0; -1 is padding) as a Python int bitset."""
+    words = n // 64 + 1
+    out = np.zeros((matrix.shape[0], words), dtype=np.uint64)
+    rows, cols = np.nonzero(matrix >= 0)
+    facts = matrix[rows, cols]
+    np.bitwise_or.at(out, (rows, facts // 64),
+                     np.left_shift(np.uint64(1), (facts % 64).astype(np.uint64)))
+    data, size = out.tobytes(), 8 * words
+    return [int.from_bytes(data[i:i + size], "little") for i in range(0, len(data), size)]
 
 
 def _mask(ids) -> int:
