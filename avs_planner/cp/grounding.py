@@ -292,14 +292,15 @@ def _widen(array: np.ndarray, width: int, pad: int) -> np.ndarray:
 
 def build_structure(
     problem: Problem, schemas: Sequence[LiftedSchema], static: frozenset[Atom],
-    assumptive: Mapping[str, bool],
+    assumptive: Mapping[str, bool], static_names: frozenset[str] | None = None,
 ) -> GroundStructure:
     """Ground every action over the objects, filtered by types and static atoms."""
     space = AtomSpace(problem)
     static_codes = np.unique(np.array(
         [c for c in (space.encode(a) for a in static) if c is not None], dtype=np.int64
     ))
-    static_names = {f.name for f in problem.get_static_fluents()}
+    if static_names is None:
+        static_names = frozenset(f.name for f in problem.get_static_fluents())
     formulas = FormulaGrounder(
         static, static_names, lambda t: list(dict.fromkeys(o.name for o in problem.objects(t)))
     )
@@ -575,8 +576,8 @@ class GroundingCache:
         return value
 
     def schemas(self, pproblem: ProbabilisticProblem) -> tuple[LiftedSchema, ...]:
-        key, _ = self._keys(pproblem)
-        return self._remember(self._schemas, key, lambda: compile_schemas(pproblem))
+        key, names = self._keys(pproblem)
+        return self._remember(self._schemas, key, lambda: compile_schemas(pproblem, names))
 
     def _keys(self, pproblem: ProbabilisticProblem) -> tuple[tuple, frozenset[str]]:
         """The schema key and static fluent names of a problem, computed once per problem
@@ -609,7 +610,7 @@ class GroundingCache:
         assumptive = {s.name: pproblem.is_assumptive(s.name) for s in schemas}
         return self._remember(
             self._structures, key,
-            lambda: build_structure(problem, schemas, static, assumptive),
+            lambda: build_structure(problem, schemas, static, assumptive, static_names),
         )
 
 

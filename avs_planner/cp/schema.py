@@ -153,10 +153,14 @@ def _cost_exprs(problem: Problem) -> tuple[dict[str, FNode], FNode | None]:
     return {}, None
 
 
-def compile_schemas(pproblem: ProbabilisticProblem) -> tuple[LiftedSchema, ...]:
-    """Compile every action of the problem; raises PlanningError naming what is unsupported."""
+def compile_schemas(
+    pproblem: ProbabilisticProblem, static_names: frozenset[str] | None = None
+) -> tuple[LiftedSchema, ...]:
+    """Compile every action of the problem; raises PlanningError naming what is unsupported.
+    `static_names`: the problem's static fluents, if the caller already knows them."""
     problem = pproblem.problem
-    static = {f.name for f in problem.get_static_fluents()}
+    static = (static_names if static_names is not None
+              else {f.name for f in problem.get_static_fluents()})
     costs, _default = _cost_exprs(problem)  # default is 0 when a metric is given
     has_metric = bool(costs)
     schemas = []
