@@ -284,3 +284,14 @@ def test_avs_plan_engine_flag(capsys):
         out = json.loads(capsys.readouterr().out)
         outputs.append((out["plan"], out["expanded"], out["cost"], out["probability"]))
     assert outputs[0] == outputs[1]
+
+
+@needs_native
+@pytest.mark.parametrize("name", ["corridor", "room3-kitchen"])
+def test_packing_from_the_grounder_arrays_equals_packing_from_actions(name):
+    task, _ = _avs(name)
+    assert task.arrays is not None
+    fast, slow = native.task_arrays(task), native.task_args(task)
+    assert len(fast) == len(slow)
+    for a, b in zip(fast, slow, strict=True):
+        assert (a == b) if isinstance(a, int) else bytes(memoryview(a)) == bytes(memoryview(b))
