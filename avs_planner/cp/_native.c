@@ -85,6 +85,7 @@ typedef struct {
     /* h_add/FF: pre_of[f] with clause pairs merged in action order; entry pair -1 = base */
     int32_t *xof_off, *xof_action, *xof_pair;
     int32_t *no_pre;              /* actions with no pre_facts, ascending */
+    int32_t *pre_len;             /* number of pre_facts of each action */
     Py_ssize_t n_no_pre;
     int32_t *n_pairs_of;          /* number of pairs of each action */
     Py_ssize_t total_add;
@@ -96,7 +97,7 @@ static void task_free_arrays(TaskObject *t)
                     t->pre_off, t->pre_facts, t->add_off, t->add_facts, t->cl_off, t->cl_pos,
                     t->cl_neg, t->unit_off, t->unit_fact, t->unit_clause, t->unit_pair,
                     t->pair_action, t->pof_off, t->pof, t->xof_off, t->xof_action,
-                    t->xof_pair, t->no_pre, t->n_pairs_of};
+                    t->xof_pair, t->no_pre, t->n_pairs_of, t->pre_len};
     for (size_t i = 0; i < sizeof(ptrs) / sizeof(ptrs[0]); i++)
         free(ptrs[i]);
 }
@@ -338,6 +339,11 @@ static int task_derive(TaskObject *t)
         free(pf);
         free(pfill);
     }
+    t->pre_len = xcalloc((size_t)A, sizeof(int32_t));
+    if (!t->pre_len)
+        goto nomem2;
+    for (Py_ssize_t a = 0; a < A; a++)
+        t->pre_len[a] = t->pre_off[a + 1] - t->pre_off[a];
     t->n_no_pre = 0;
     for (Py_ssize_t a = 0; a < A; a++)
         if (t->pre_off[a] == t->pre_off[a + 1])
@@ -497,6 +503,11 @@ typedef struct {
 } DEntry;
 
 typedef struct {
+    double value;      /* h^max / h^add of the action's preconditions so far */
+    int32_t remaining; /* preconditions not yet reached */
+} Counter;
+
+typedef struct {
     const TaskObject *t;
     Py_ssize_t W;
     /* options */
@@ -531,12 +542,14 @@ typedef struct {
     int32_t *help;
     int64_t n_help, cap_help;
     /* heuristic scratch */
-    double *dist, *value, *combined;
-    int32_t *support, *remaining, *rem_ext, *stack, *chosen;
+    double *dist, *combined;
+    Counter *counter;
+    int32_t *support, *rem_ext, *stack, *chosen;
     uint32_t *seen_stamp, *chosen_stamp, *emit_stamp, *help_stamp;
     uint32_t stamp, help_mark;
     int8_t *active, *pair_eff;
     DEntry *dheap;
+    int32_t *hpos; /* fact -> index in dheap, -1 if absent */
     size_t dn, dcap;
     word *succ;
     int oom;
@@ -601,28 +614,44 @@ static inline int dless(const DEntry *a, const DEntry *b)
     return a->d < b->d || (a->d == b->d && a->f < b->f);
 }
 
-static inline void dpush(Search *s, double d, int32_t f)
+/* The relaxed Dijkstra's queue: an indexed heap, one entry per fact keyed (dist, fact). Python
+ * pushes a new (d, f) on every improvement and skips stale entries when popped; keeping one
+ * entry per fact and lowering its key pops the non-stale entries in the same order (keys are
+ * unique), with a heap of at most n_facts entries. */
+static inline void dsift_up(Search *s, size_t i, DEntry e)
 {
-    /* capacity n_facts + total add effects + 1 bounds the pushes of one Dijkstra */
-    DEntry e = {d, f};
-    size_t i = s->dn++;
     DEntry *v = s->dheap;
     while (i > 0) {
         size_t parent = (i - 1) / 2;
         if (!dless(&e, &v[parent]))
             break;
         v[i] = v[parent];
+        s->hpos[v[i].f] = (int32_t)i;
         i = parent;
     }
     v[i] = e;
+    s->hpos[e.f] = (int32_t)i;
+}
+
+static inline void dpush(Search *s, double d, int32_t f)
+{
+    DEntry e = {d, f};
+    int32_t at = s->hpos[f];
+    if (at >= 0) /* keys only decrease (an improvement), so sift up */
+        dsift_up(s, (size_t)at, e);
+    else
+        dsift_up(s, s->dn++, e);
 }
 
 static inline DEntry dpop(Search *s)
 {
     DEntry *v = s->dheap;
     DEntry top = v[0];
+    s->hpos[top.f] = -1;
     DEntry last = v[--s->dn];
     size_t i = 0, n = s->dn;
+    if (!n)
+        return top;
     while (1) {
         size_t l = 2 * i + 1;
         if (l >= n)
@@ -631,11 +660,19 @@ static inline DEntry dpop(Search *s)
         if (!dless(&v[m], &last))
             break;
         v[i] = v[m];
+        s->hpos[v[i].f] = (int32_t)i;
         i = m;
     }
-    if (n)
-        v[i] = last;
+    v[i] = last;
+    s->hpos[last.f] = (int32_t)i;
     return top;
+}
+
+static inline void dclear(Search *s)
+{
+    for (size_t i = 0; i < s->dn; i++)
+        s->hpos[s->dheap[i].f] = -1;
+    s->dn = 0;
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -690,24 +727,22 @@ static void relaxed_costs(Search *s, const word *state, const double *w, int use
         dist[f] = INFINITY;
         s->support[f] = -1;
     }
-    s->dn = 0;
+    dclear(s);
     for (Py_ssize_t f = 0; f < F; f++)
         if (BIT(state, f)) {
             dist[f] = 0.0;
             dpush(s, 0.0, (int32_t)f);
         }
-    int32_t *remaining = s->remaining;
-    if (ext)
-        memcpy(remaining, s->rem_ext, sizeof(int32_t) * (size_t)A);
-    else
-        for (Py_ssize_t a = 0; a < A; a++)
-            remaining[a] = t->pre_off[a + 1] - t->pre_off[a];
-    double *value = s->value;
-    for (Py_ssize_t a = 0; a < A; a++)
-        value[a] = 0.0;
+    /* value and remaining count side by side: one cache line per action touched */
+    Counter *cnt = s->counter;
+    const int32_t *rem = ext ? s->rem_ext : t->pre_len;
+    for (Py_ssize_t a = 0; a < A; a++) {
+        cnt[a].value = 0.0;
+        cnt[a].remaining = rem[a];
+    }
     for (Py_ssize_t i = 0; i < t->n_no_pre; i++) {
         int32_t a = t->no_pre[i];
-        if (ext && remaining[a] != 0)
+        if (ext && cnt[a].remaining != 0)
             continue; /* an active clause gave it a precondition */
         relax_fire(s, a, w[a]);
     }
@@ -726,13 +761,13 @@ static void relaxed_costs(Search *s, const word *state, const double *w, int use
             if (ext && t->xof_pair[j] >= 0 && !s->pair_eff[t->xof_pair[j]])
                 continue;
             int32_t a = acts[j];
+            Counter *ca = &cnt[a];
             if (use_max)
-                value[a] = value[a] > d ? value[a] : d;
+                ca->value = ca->value > d ? ca->value : d;
             else
-                value[a] = value[a] + d;
-            remaining[a] -= 1;
-            if (remaining[a] == 0)
-                relax_fire(s, a, value[a] + w[a]);
+                ca->value = ca->value + d;
+            if (--ca->remaining == 0)
+                relax_fire(s, a, ca->value + w[a]);
         }
     }
 }
@@ -1297,10 +1332,10 @@ static void search_free(Search *s)
         free(s->recs[i].labels);
     void *ptrs[] = {s->goal, s->goal_neg, s->goal_facts, s->is_goal, s->sdata, s->recs,
                     s->slots, s->n_state, s->n_parent, s->n_via, s->n_c, s->n_p, s->n_h,
-                    s->n_alive, s->n_eval, s->heap.v, s->pref.v, s->help, s->dist, s->value,
-                    s->combined, s->support, s->remaining, s->rem_ext, s->stack, s->chosen,
+                    s->n_alive, s->n_eval, s->heap.v, s->pref.v, s->help, s->dist, s->counter,
+                    s->combined, s->support, s->rem_ext, s->stack, s->chosen,
                     s->seen_stamp, s->chosen_stamp, s->emit_stamp, s->help_stamp, s->active,
-                    s->pair_eff, s->dheap, s->succ};
+                    s->pair_eff, s->dheap, s->hpos, s->succ};
     for (size_t i = 0; i < sizeof(ptrs) / sizeof(ptrs[0]); i++)
         free(ptrs[i]);
 }
@@ -1314,10 +1349,9 @@ static int search_alloc(Search *s)
     s->goal_facts = xcalloc(F, sizeof(int32_t));
     s->is_goal = xcalloc(F, 1);
     s->dist = xcalloc(F, sizeof(double));
-    s->value = xcalloc(A, sizeof(double));
+    s->counter = xcalloc(A, sizeof(Counter));
     s->combined = xcalloc(A, sizeof(double));
     s->support = xcalloc(F, sizeof(int32_t));
-    s->remaining = xcalloc(A, sizeof(int32_t));
     s->rem_ext = xcalloc(A, sizeof(int32_t));
     s->stack = xcalloc(F, sizeof(int32_t));
     s->chosen = xcalloc(A, sizeof(int32_t));
@@ -1327,13 +1361,16 @@ static int search_alloc(Search *s)
     s->help_stamp = xcalloc(A, sizeof(uint32_t));
     s->active = xcalloc((size_t)t->n_unit, 1);
     s->pair_eff = xcalloc((size_t)t->n_pairs, 1);
-    s->dcap = F + (size_t)t->total_add + 1;
+    s->dcap = F + 1;
     s->dheap = xcalloc(s->dcap, sizeof(DEntry));
+    s->hpos = xcalloc(F, sizeof(int32_t));
+    if (s->hpos)
+        memset(s->hpos, 0xff, F * sizeof(int32_t));
     s->succ = xcalloc(2 * W, 8);
-    if (!s->goal || !s->goal_neg || !s->goal_facts || !s->is_goal || !s->dist || !s->value ||
-        !s->combined || !s->support || !s->remaining || !s->rem_ext || !s->stack ||
+    if (!s->goal || !s->goal_neg || !s->goal_facts || !s->is_goal || !s->dist || !s->counter ||
+        !s->combined || !s->support || !s->rem_ext || !s->stack ||
         !s->chosen || !s->seen_stamp || !s->chosen_stamp || !s->emit_stamp || !s->help_stamp ||
-        !s->active || !s->pair_eff || !s->dheap || !s->succ)
+        !s->active || !s->pair_eff || !s->dheap || !s->hpos || !s->succ)
         return -1;
     return grow_slots(s);
 }
