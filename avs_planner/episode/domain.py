@@ -71,6 +71,23 @@ def build_problem(
     return ProbabilisticProblem(problem, base.success, str(DOMAIN_FILE), f"<{name}>")
 
 
+_SKELETONS: dict[tuple, ProbabilisticProblem] = {}
+_SKELETON_CACHE = 32
+
+
+def planning_problem(objects: dict[str, list[str]], goal: Atom) -> ProbabilisticProblem:
+    """Objects and goal only, for a planner that takes the state as a `WorldState` (the CP's
+    `replan`/`update`); the same object set gives the same problem object, so the CP's
+    grounding cache recognises it without rehashing the domain."""
+    key = (tuple((t, tuple(names)) for t, names in sorted(objects.items())), goal)
+    problem = _SKELETONS.get(key)
+    if problem is None:
+        if len(_SKELETONS) >= _SKELETON_CACHE:
+            _SKELETONS.pop(next(iter(_SKELETONS)))
+        problem = _SKELETONS[key] = build_problem("episode", objects, frozenset(), {}, goal)
+    return problem
+
+
 def _fraction(value: float):  # noqa: ANN202 - Fraction, exact for UP
     from fractions import Fraction
 

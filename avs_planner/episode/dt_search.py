@@ -87,7 +87,16 @@ class ViewConeSearch:
             reach = self.ex.config.support_radius
             near = math.dist(seen.position[:2], support.position[:2]) <= reach
             return near and top + low <= seen.position[2] <= top + high
-        return self.ex.mind.room_at(seen.position[:2]) == location
+        if self.ex.mind.room_at(seen.position[:2]) != location:
+            return False
+        return not self._known(seen)
+
+    def _known(self, seen: SeenLike) -> bool:
+        """A detection of an object the mind already knows (a room search for another desk
+        must not confirm the desk it found before)."""
+        reach = self.ex.config.same_object
+        return any(obj.label == seen.label and math.dist(obj.position[:2], seen.position[:2])
+                   <= reach for obj in self.ex.mind.objects.values())
 
     def _conclude(self, result, label: str, relation: str, location: str,  # noqa: ANN001
                   made: ConeSet) -> StepOutcome:

@@ -14,7 +14,7 @@ import networkx as nx
 import numpy as np
 
 from avs_planner.cp.task import Atom, WorldState
-from avs_planner.episode.domain import build_problem
+from avs_planner.episode.domain import build_problem, planning_problem
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.mind import Mind
 from avs_planner.pddl import ProbabilisticProblem
@@ -69,7 +69,12 @@ class AvsState:
         return WorldState(self.atoms, dict(self.values))
 
     def problem(self) -> ProbabilisticProblem:
+        """The full problem (objects, :init, goal)."""
         return build_problem(self.name, self.objects, self.atoms, self.values, self.goal)
+
+    def skeleton(self) -> ProbabilisticProblem:
+        """Objects and goal only; plan it with `world_state()` as the initial state."""
+        return planning_problem(self.objects, self.goal)
 
     def to_pddl(self) -> str:
         """The same problem as PDDL text (for `avs domain check`, `avs plan` and traces)."""
@@ -316,8 +321,11 @@ class StateBuilder:
             obj = self.mind.objects[oid]
             atoms |= {("label-of", oid, obj.label), ("detected", oid)}
             if obj.support is None:
-                atoms |= {("related", oid, "in", obj.room),
-                          ("defined-exists", obj.label, "in", obj.room)}
+                # a found support does not settle "another one in this room": its
+                # p-obj-in (the Poisson count still unseen) keeps a second desk possible
+                atoms.add(("related", oid, "in", obj.room))
+                if obj.label == self.task.target:
+                    atoms.add(("defined-exists", obj.label, "in", obj.room))
             else:
                 atoms |= {("related", oid, "on", obj.support),
                           ("defined-exists", obj.label, "on", obj.support)}

@@ -1,0 +1,82 @@
+"""Support objects in a room (a second desk may exist after the first was found), the DT's
+room search skipping known objects, the CP problem skeleton, and path reuse while driving."""
+
+from __future__ import annotations
+
+import pytest
+
+from avs_planner.cp.continual import ContinualPlanner
+from avs_planner.cp.search import SearchOptions
+from avs_planner.episode.dt_search import ViewConeSearch
+from avs_planner.episode.executor import Executor, _split_leg
+from avs_planner.episode.mind import Mind
+from avs_planner.episode.robot import Seen, load_spec, open_world
+from avs_planner.episode.state_builder import SearchTask, StateBuilder
+from avs_planner.episode.viewcones import CameraModel
+
+OPTIONS = SearchOptions(weight=3.0, heuristic="hadd", node_limit=4000)
+
+
+@pytest.fixture()
+def corridor():
+    """A fresh mind (tests here add objects to it) after one look around the corridor."""
+    robot = open_world(load_spec("office", start=(6.0, 3.2, 0.0)), seed=1)
+    mind = Mind()
+    builder = StateBuilder(mind, SearchTask("cerealbox"))
+    cam = robot.robot.model.camera
+    executor = Executor(robot, mind, builder, CameraModel(robot.camera_height, cam.hfov,
+                                                          cam.detect_range), lambda *a, **k: None)
+    executor.look_around()
+    yield mind, builder, executor
+    robot.world.close()
+
+
+def _here(mind: Mind) -> tuple[str, tuple[float, float]]:
+    place = mind.place_map.current_place
+    return mind.place_map.room_of(place), mind.place_map.places[place].position
+
+
+def test_a_found_support_leaves_room_for_another_of_its_label(corridor) -> None:
+    mind, builder, _ = corridor
+    room, (x, y) = _here(mind)
+    table = mind.add_object("table", (x + 0.5, y, 0.4))
+    state = builder.build()
+    assert ("related", table.id, "in", room) in state.atoms
+    # not settled: the CP may still assume (and the DT look for) a second table here
+    assert ("defined-exists", "table", "in", room) not in state.atoms
+    mind.add_object("cerealbox", (x - 0.5, y, 0.4))
+    assert ("defined-exists", "cerealbox", "in", room) in builder.build().atoms
+
+
+def test_a_room_search_skips_objects_the_mind_knows(corridor) -> None:
+    mind, _, executor = corridor
+    room, (x, y) = _here(mind)
+    mind.add_object("table", (x + 0.5, y, 0.4))
+    search = ViewConeSearch(executor, "table", "in", room)
+    assert not search._inside(Seen(1, "table", (x + 0.8, y, 0.4), 0.9), "in", room)
+    assert search._inside(Seen(2, "table", (x - 1.5, y, 0.4), 0.9), "in", room)
+
+
+def test_the_skeleton_plans_like_the_full_problem_and_is_shared(corridor) -> None:
+    _, builder, _ = corridor
+    state = builder.build()
+    assert state.skeleton() is builder.build().skeleton()  # same objects, same problem
+    full = ContinualPlanner(state.problem(), OPTIONS).replan(state.world_state())
+    bare = ContinualPlanner(state.skeleton(), OPTIONS).replan(state.world_state())
+    assert full.solved and [s.label for s in full.plan] == [s.label for s in bare.plan]
+    assert full.probability == pytest.approx(bare.probability)
+
+
+def test_split_leg_returns_the_leg_and_the_rest() -> None:
+    path = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0)]
+    assert _split_leg(path, 0.5) == ([(0.5, 0.0)], [(0.5, 0.0), (1.0, 0.0), (1.0, 1.0)])
+    assert _split_leg(path, 1.5) == ([(1.0, 0.0), (1.0, 0.5)], [(1.0, 0.5), (1.0, 1.0)])
+    assert _split_leg(path, 5.0) == ([(1.0, 0.0), (1.0, 1.0)], [(1.0, 1.0)])
+
+
+def test_a_route_through_a_wall_is_not_clear(corridor) -> None:
+    _, _, executor = corridor
+    x, y, _ = executor.robot.pose
+    assert executor._clear([(x, y), (x + 1.0, y)])
+    assert not executor._clear([(x, y), (x, y + 1.5)])  # the office1 wall at y = 4
+    assert not executor._clear([(x, y)])
