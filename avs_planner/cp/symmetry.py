@@ -25,8 +25,23 @@ def _swap(atom: Atom, a: str, b: str) -> Atom:
     return (atom[0], *(b if x == a else a if x == b else x for x in atom[1:]))
 
 
-def _named_objects(pproblem: ProbabilisticProblem) -> set[str]:
-    """Objects the domain or the goal names explicitly (PDDL constants, goal arguments)."""
+_NAMED: OrderedDict[int, tuple[ProbabilisticProblem, frozenset[str]]] = OrderedDict()
+
+
+def _named_objects(pproblem: ProbabilisticProblem) -> frozenset[str]:
+    """Objects the domain or the goal names explicitly (PDDL constants, goal arguments);
+    kept for the last few problem objects (a problem is not changed once planned)."""
+    hit = _NAMED.get(id(pproblem))
+    if hit is not None and hit[0] is pproblem:
+        return hit[1]
+    names = frozenset(_walk_named(pproblem))
+    _NAMED[id(pproblem)] = (pproblem, names)
+    while len(_NAMED) > 16:
+        _NAMED.popitem(last=False)
+    return names
+
+
+def _walk_named(pproblem: ProbabilisticProblem) -> set[str]:
     problem = pproblem.problem
     roots: list[FNode] = list(problem.goals) + list(pproblem.success.values())
     for action in problem.actions:
@@ -117,18 +132,19 @@ def _partition(names: list[str], state: WorldState, mentions) -> list[tuple[str,
     return [tuple(c) for c in classes]
 
 
-_FACT_PAIRS: OrderedDict[tuple, tuple[tuple, dict]] = OrderedDict()
+_FACT_PAIRS: OrderedDict[tuple, tuple[tuple, dict, dict]] = OrderedDict()
 _FACT_PAIRS_SIZE = 8
 
 
-def _fact_pairs(task: GroundTask, groups: tuple[tuple[str, ...], ...]) -> dict:
+def _fact_pairs(task: GroundTask, groups: tuple[tuple[str, ...], ...]) -> tuple[dict, dict]:
     """Per pair (a, b) of a group, the facts mentioning a or b and their swapped images;
-    depends only on the fact table, so it is kept for the last few (fact table, groups)."""
+    depends only on the fact table, so it is kept for the last few (fact table, groups),
+    with a memo of the pairs that may prune an action, by its arguments."""
     key = (id(task.facts), groups)
     hit = _FACT_PAIRS.get(key)
     if hit is not None and hit[0] is task.facts:
         _FACT_PAIRS.move_to_end(key)
-        return hit[1]
+        return hit[1], hit[2]
     fact_pairs: dict[Pair, tuple[tuple[int, int], ...]] = {}
     facts_of: dict[str, list[int]] = defaultdict(list)
     for i, atom in enumerate(task.facts):
@@ -141,19 +157,19 @@ def _fact_pairs(task: GroundTask, groups: tuple[tuple[str, ...], ...]) -> dict:
                 fact_pairs[(a, b)] = tuple(
                     (f, task.fact_index.get(_swap(task.facts[f], a, b), -1)) for f in touched
                 )
-    _FACT_PAIRS[key] = (task.facts, fact_pairs)  # a strong ref keeps the id unique
+    by_args: dict[tuple[str, ...], tuple[Pair, ...]] = {}
+    _FACT_PAIRS[key] = (task.facts, fact_pairs, by_args)  # a strong ref keeps the id unique
     while len(_FACT_PAIRS) > _FACT_PAIRS_SIZE:
         _FACT_PAIRS.popitem(last=False)
-    return fact_pairs
+    return fact_pairs, by_args
 
 
 def _build(task: GroundTask, groups: Iterable[tuple[str, ...]]) -> Symmetries:
     groups = tuple(groups)
-    fact_pairs = _fact_pairs(task, groups)
+    fact_pairs, by_args = _fact_pairs(task, groups)
     lower = {b: [(a, b) for a in group[:j]] for group in groups for j, b in enumerate(group)}
     higher = frozenset(b for b, pairs in lower.items() if pairs)
     checks = {}
-    by_args: dict[tuple[str, ...], tuple[Pair, ...]] = {}
     for action in task.actions:
         args = action.args
         if higher.isdisjoint(args):
