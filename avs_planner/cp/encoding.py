@@ -107,6 +107,25 @@ class AtomSpace:
             code += stride * local
         return code
 
+    def decode_many(self, codes: np.ndarray) -> list[Atom]:
+        """`decode` for an array of codes, one fluent at a time on arrays."""
+        codes = np.asarray(codes, dtype=np.int64)
+        which = np.searchsorted(self._starts, codes, side="right") - 1
+        out: list[Atom | None] = [None] * len(codes)
+        for i in np.unique(which).tolist():
+            name = self._fluents[i]
+            at = np.flatnonzero(which == i)
+            rest = codes[at] - self._starts[i]
+            columns = []
+            for stride, type_ in zip(self.strides[name], self.arg_types[name], strict=True):
+                local, rest = np.divmod(rest, stride)
+                names = self.names
+                columns.append([names[g] for g in self.objects_of(type_)[local].tolist()])
+            for k, (j, code) in enumerate(zip(at.tolist(), codes[at].tolist(), strict=True)):
+                atom = (name, *(c[k] for c in columns))
+                out[j] = self._decoded.setdefault(code, atom)
+        return out  # type: ignore[return-value]
+
     def decode(self, code: int) -> Atom:
         atom = self._decoded.get(code)
         if atom is not None:

@@ -121,15 +121,22 @@ class GroundStructure:
         pre_count, add_count = (pre >= 0).sum(axis=1).tolist(), (add >= 0).sum(axis=1).tolist()
         pre_rows, add_rows = pre.tolist(), add.tolist()
         arg_rows = self.arg_ids[at].tolist()
+        starts = np.array([b.start for b in self.blocks], dtype=np.int64)
+        block_rows = (np.searchsorted(starts, at, side="right") - 1).tolist()
+        lowered = [x.lower() for x in names]
+        clause_rows = self.clauses
         for k, row in enumerate(missing):
-            block = self.block_of(row)
-            args = tuple([names[v] for v in arg_rows[k][: len(block.schema.params)]])
-            clauses = tuple((_mask(pos), _mask(neg)) for pos, neg in self.clauses.get(row, ()))
-            name = block.schema.name
+            block = self.blocks[block_rows[k]]
+            schema = block.schema
+            ids = arg_rows[k][: len(schema.params)]
+            clauses = ()
+            if row in clause_rows:
+                clauses = tuple((_mask(pos), _mask(neg)) for pos, neg in clause_rows[row])
             self._rows[row] = (
-                name, args, pre_masks[k], neg_masks[k], add_masks[k], delete_masks[k],
-                tuple(pre_rows[k][: pre_count[k]]), tuple(add_rows[k][: add_count[k]]),
-                clauses, block.assumptive, (name.lower(), *(x.lower() for x in args)),
+                schema.name, tuple([names[v] for v in ids]), pre_masks[k], neg_masks[k],
+                add_masks[k], delete_masks[k], tuple(pre_rows[k][: pre_count[k]]),
+                tuple(add_rows[k][: add_count[k]]), clauses, block.assumptive,
+                (schema.name.lower(), *[lowered[v] for v in ids]),
             )
 
 
@@ -356,7 +363,7 @@ def _assemble(problem, space, static, parts, assumptive) -> GroundStructure:
     used = [a[a >= 0] for key in arrays for a in arrays[key]]
     codes = np.unique(np.concatenate(used + [np.array(clause_codes, dtype=np.int64)]))
     n = len(codes)
-    facts = tuple(space.decode(c) for c in codes.tolist())
+    facts = tuple(space.decode_many(codes))
 
     def renumber(array: np.ndarray, pad: int) -> np.ndarray:
         out = np.searchsorted(codes, array)
