@@ -687,10 +687,11 @@ def _ground(
     actions = []
     by_signature = {}
     costs, probabilities = cost.tolist(), probability.tolist()
+    unread = ~read_mask
     for index, (row, info) in enumerate(zip(rows, st.rows(rows), strict=True)):
         (name, args, pre, neg, add, delete, pre_facts, add_facts, clauses, assume,
          signature) = info
-        if add & ~read_mask:
+        if add & unread:
             add &= read_mask
             add_facts = tuple(f for f in add_facts if read_mask >> f & 1)
         action = GroundAction(
