@@ -27,6 +27,7 @@ typedef uint64_t word;
 
 enum { H_BLIND = 0, H_MAX = 1, H_ADD = 2, H_FF = 3 };
 enum { ST_SOLVED = 0, ST_UNSOLVABLE = 1, ST_THRESHOLD = 2, ST_TIMEOUT = 3, ST_NODE_LIMIT = 4 };
+enum { ST_INTERRUPTED = -2 };
 
 #define BIT(s, f) (((s)[(f) >> 6] >> ((f) & 63)) & 1u)
 
@@ -553,6 +554,7 @@ typedef struct {
     size_t dn, dcap;
     word *succ;
     int oom;
+    PyThreadState *thread; /* saved while the GIL is released (NULL: not released) */
 } Search;
 
 static inline int qless(const QEntry *a, const QEntry *b)
@@ -1285,6 +1287,13 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
             return ST_NODE_LIMIT;
         if (s->timeout >= 0 && now_s() - t0 > s->timeout)
             return ST_TIMEOUT;
+        if (s->thread && (expanded & 1023) == 0) { /* let Ctrl-C through now and then */
+            PyEval_RestoreThread(s->thread);
+            int interrupted = PyErr_CheckSignals();
+            s->thread = PyEval_SaveThread();
+            if (interrupted)
+                return ST_INTERRUPTED;
+        }
         int32_t last = s->n_via[node];
         uint32_t mark = 0;
         if (s->preferred) {
@@ -1474,9 +1483,11 @@ static PyObject *native_search(PyObject *self, PyObject *args)
     int32_t goal_node = -1;
     int64_t expanded = 0;
     int status;
-    Py_BEGIN_ALLOW_THREADS
+    s.thread = PyEval_SaveThread(); /* the GIL is released while searching */
     status = run_search(&s, b[0].buf, &goal_node, &expanded);
-    Py_END_ALLOW_THREADS
+    PyEval_RestoreThread(s.thread);
+    if (status == ST_INTERRUPTED)
+        goto done; /* a signal handler raised (Ctrl-C: KeyboardInterrupt) */
     if (status < 0 || s.oom) {
         PyErr_NoMemory();
         goto done;

@@ -251,14 +251,7 @@ def test_bad_tasks_are_errors_not_crashes():
 def test_generated_avs_problem_and_many_random_tasks():
     """Longer sweep: a generated 8-place AVS problem (dual queue used for hundreds of
     expansions) and more random tasks."""
-    import sys
-
-    sys.path.insert(0, str(ROOT))
-    from avs_planner.pddl import read_text
-    from bench.avs_generator import AvsSize, generate
-
-    domain = (ROOT / "domains/avs/domain.pddl").read_text()
-    pproblem = read_text(domain, generate(AvsSize(8, 2, 2, 4), 0), "domain.pddl", "p8")
+    pproblem = _generated_p8()
     state = world_state(pproblem.problem)
     task = ground(pproblem, state)
     symmetries = find_symmetries(pproblem, state, task)
@@ -295,3 +288,43 @@ def test_packing_from_the_grounder_arrays_equals_packing_from_actions(name):
     assert len(fast) == len(slow)
     for a, b in zip(fast, slow, strict=True):
         assert (a == b) if isinstance(a, int) else bytes(memoryview(a)) == bytes(memoryview(b))
+
+
+def _generated_p8():
+    import sys
+
+    sys.path.insert(0, str(ROOT))
+    from avs_planner.pddl import read_text
+    from bench.avs_generator import AvsSize, generate
+
+    domain = (ROOT / "domains/avs/domain.pddl").read_text()
+    return read_text(domain, generate(AvsSize(8, 2, 2, 4), 0), "domain.pddl", "p8")
+
+
+class _Alarm(Exception):
+    pass
+
+
+@needs_native
+@pytest.mark.skipif(not hasattr(__import__("signal"), "setitimer"), reason="no setitimer")
+def test_a_long_native_search_lets_signals_through():
+    """The GIL is released during the search; signal handlers (Ctrl-C) still run."""
+    import signal
+    import time
+
+    task = ground(_generated_p8())  # blind search at w = 1 runs for many seconds here
+
+    def alarm(signum, frame):
+        raise _Alarm
+
+    previous = signal.signal(signal.SIGALRM, alarm)
+    start = time.perf_counter()
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.3)
+        with pytest.raises(_Alarm):
+            search(task, SearchOptions(heuristic="blind", weight=1.0, engine="native",
+                                       timeout_s=60.0))
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+    assert time.perf_counter() - start < 30.0
