@@ -14,6 +14,7 @@ search). Our plans are checked with UP's sequential plan validator.
 from __future__ import annotations
 
 import argparse
+import gc
 import math
 import statistics
 import sys
@@ -128,7 +129,9 @@ def valid(problem: Problem, up_plan) -> bool:
 
 def bench_case(label: str, pproblem: ProbabilisticProblem, probabilistic: bool) -> dict:
     cache = GroundingCache()
+    gc.collect()  # each timing starts from a collected heap (the planner pauses the GC)
     ours: PlanResult = plan(pproblem, OPTIONS, cache=cache)
+    gc.collect()
     warm = plan(pproblem, OPTIONS, cache=cache).planning_time_s if probabilistic else math.nan
     task = ground(pproblem, cache=cache)
     fd_input = fd_problem(pproblem, task) if probabilistic else pproblem.problem

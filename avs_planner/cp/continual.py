@@ -9,16 +9,15 @@ across these calls, so a replan in an unchanged domain only re-evaluates the sta
 
 from __future__ import annotations
 
-import time
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from enum import Enum
 
 from avs_planner.cp.grounding import GroundingCache, ground, world_state
 from avs_planner.cp.matching import match_virtual_objects, rename_plan
 from avs_planner.cp.monitor import DEFAULT_PROBABILITY_THRESHOLD, MonitorReport, monitor
-from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep, SearchOptions, search
-from avs_planner.cp.symmetry import NO_SYMMETRIES, find_symmetries
+from avs_planner.cp.planner import plan
+from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep, SearchOptions
 from avs_planner.cp.task import Atom, WorldState
 from avs_planner.pddl.model import ProbabilisticProblem
 
@@ -64,16 +63,7 @@ class ContinualPlanner:
         """Plan from `state` (default: the last state given); the plan becomes current."""
         if state is not None:
             self.state = state
-        start = time.perf_counter()
-        task = ground(self.pproblem, self.state, self.cache)
-        symmetries = (
-            find_symmetries(self.pproblem, self.state, task) if self.options.symmetry
-            else NO_SYMMETRIES
-        )
-        grounded = time.perf_counter()
-        result = search(task, self.options, symmetries)
-        result = replace(result, planning_time_s=time.perf_counter() - start,
-                         grounding_time_s=grounded - start)
+        result = plan(self.pproblem, self.options, self.state, self.cache)
         if result.solved and result.probability < self.min_success:
             result = PlanResult(
                 PlanStatus.NO_PLAN_ABOVE_THRESHOLD, planning_time_s=result.planning_time_s,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 
-from avs_planner.cp.grounding import GroundingCache, ground, world_state
+from avs_planner.cp.grounding import GroundingCache, gc_paused, ground, world_state
 from avs_planner.cp.search import PlanResult, SearchOptions, search
 from avs_planner.cp.symmetry import NO_SYMMETRIES, find_symmetries
 from avs_planner.cp.task import GroundTask, WorldState
@@ -20,17 +20,20 @@ def plan(
 ) -> PlanResult:
     """Plan from `state` (default: the problem's :init); planning_time_s includes grounding."""
     options = (options or SearchOptions()).check()
-    start = time.perf_counter()
-    state = world_state(pproblem.problem) if state is None else state
-    task = ground(pproblem, state, cache)
-    symmetries = find_symmetries(pproblem, state, task) if options.symmetry else NO_SYMMETRIES
-    grounded = time.perf_counter()
-    result = search(task, options, symmetries)
-    return replace(
-        result,
-        planning_time_s=time.perf_counter() - start,
-        grounding_time_s=grounded - start,
-    )
+    with gc_paused():
+        start = time.perf_counter()
+        state = world_state(pproblem.problem) if state is None else state
+        task = ground(pproblem, state, cache)
+        symmetries = (
+            find_symmetries(pproblem, state, task) if options.symmetry else NO_SYMMETRIES
+        )
+        grounded = time.perf_counter()
+        result = search(task, options, symmetries)
+        return replace(
+            result,
+            planning_time_s=time.perf_counter() - start,
+            grounding_time_s=grounded - start,
+        )
 
 
 def plan_task(task: GroundTask, options: SearchOptions | None = None) -> PlanResult:
