@@ -29,7 +29,7 @@ Event = Callable[..., None]
 
 @dataclass
 class ExecutorConfig:
-    leg: float = 0.5  # m driven between scans
+    leg: float = 1.0  # m driven between scans
     arrive: float = 0.35  # m from a MOVE's goal counts as there
     max_legs: int = 40
     replan_legs: int = 4  # legs driven on one A* path before searching again (the map grows)
@@ -142,6 +142,37 @@ class Executor:
             if field_[cell] < best_cost:
                 best, best_cost = pid, float(field_[cell])
         return best
+
+    def uncertain_room(self, certain: float, skip: set[str]) -> str | None:
+        """The known room nearest by grid path whose most likely category is below
+        `certain`, not in `skip`."""
+        mind = self.mind
+        pm, cmap = mind.place_map, mind.cmap
+        field_ = distance_field(mind.grid, self.robot.pose[:2], mind.config.robot_radius)
+        best, best_cost = None, math.inf
+        for rid, room in pm.rooms.items():
+            if rid in skip or not cmap.graph.has_room(rid):
+                continue
+            if max(cmap.room_category(rid).values()) >= certain:
+                continue
+            for pid in room.places & set(pm.places):
+                cell = mind.grid.cell_of(pm.places[pid].position)
+                if mind.grid.contains(cell) and field_[cell] < best_cost:
+                    best, best_cost = rid, float(field_[cell])
+        return best
+
+    def visit_room(self, room: str, max_places: int = 4) -> StepOutcome:
+        """Drive through up to `max_places` places of `room`, nearest first (each new place
+        is classified on arrival)."""
+        pm = self.mind.place_map
+        here = self.robot.pose[:2]
+        places = sorted((p for p in pm.rooms[room].places if p in pm.places),
+                        key=lambda p: math.dist(pm.places[p].position, here))
+        outcome = StepOutcome(StepStatus.FAILED, f"{room} has no places")
+        for pid in places[:max_places]:
+            if pid in pm.places:
+                outcome = self.drive_to(pm.places[pid].position)
+        return outcome
 
     def move(self, target: str, state: AvsState) -> StepOutcome:
         goal = state.positions.get(target)

@@ -73,6 +73,7 @@ class SwitchingLoop:
         self.result = LoopResult(Outcome.GAVE_UP, "")
         self.planner: ContinualPlanner | None = None
         self.start_clock = executor.robot.clock
+        self.visited_rooms: set[str] = set()
 
     def run(self) -> LoopResult:
         self.executor.look_around()
@@ -81,7 +82,7 @@ class SwitchingLoop:
                                         min_success=self.config.min_success)
         first = self._fallback(self.planner.replan(state.world_state()))
         self._record_plan(first, "initial")
-        first = self._explore_while_timing_out(first)
+        first = self._recover(first)
         if first is None:
             return self._end(Outcome.GAVE_UP, "planner timed out, nothing to explore")
         if not first.solved:
@@ -102,7 +103,7 @@ class SwitchingLoop:
             state = self.builder.build()
             result = self._monitor(state, outcome)
             if result is not None:
-                result = self._explore_while_timing_out(result)
+                result = self._recover(result)
                 if result is None:
                     return self._end(Outcome.GAVE_UP, "planner timed out, nothing to explore")
                 state = self.builder.build()
@@ -151,18 +152,42 @@ class SwitchingLoop:
                         detail=outcome.detail)
         return outcome
 
-    def _explore_while_timing_out(self, result: PlanResult) -> PlanResult | None:
-        """While the CP times out, explore a placeholder and plan again; None when there is
-        nothing left to explore."""
+    def _recover(self, result: PlanResult) -> PlanResult | None:
+        """While the CP times out, explore (or shrink the problem) and plan again; when no
+        plan reaches the threshold, first look again at rooms whose category is uncertain.
+        None when the CP timed out and nothing is left to explore."""
+        while True:
+            while _timed_out(result):
+                if not self._explore_instead() and not self._shrink():
+                    return None
+                result = self._plan_again("after exploring")
+            if result.solved or not self._visit_uncertain_room():
+                return result
+            result = self._plan_again("after visiting an uncertain room")
+
+    def _plan_again(self, why: str) -> PlanResult:
+        """One CP call on the current beliefs (there is no plan left to monitor)."""
         assert self.planner is not None
-        while _timed_out(result):
-            if not self._explore_instead() and not self._shrink():
-                return None
-            state = self.builder.build()
-            self.planner.update(state.world_state(), state.skeleton())
-            result = self._fallback(self.planner.replan())
-            self._record_plan(result, "after exploring")
+        state = self.builder.build()
+        self.planner.pproblem = state.skeleton()
+        result = self._fallback(self.planner.replan(state.world_state()))
+        self._record_plan(result, why)
         return result
+
+    def _visit_uncertain_room(self) -> bool:
+        """No plan is good enough: the place classifier may have misled the room category
+        beliefs (an elongated office reads as a corridor). Visit the places of the nearest
+        room whose category is uncertain, once per room, so it is classified again."""
+        certain = self.builder.config.certain_category
+        room = self.executor.uncertain_room(certain, self.visited_rooms)
+        if room is None:
+            return False
+        self.visited_rooms.add(room)
+        self.trace.emit("action", action=f"(classify {room})", status="start")
+        outcome = self.executor.visit_room(room)
+        self.trace.emit("action", action=f"(classify {room})", status=outcome.status.value,
+                        detail=outcome.detail, category=self.builder.category_belief(room))
+        return True
 
     def _shrink(self) -> bool:
         """Nothing to explore: plan with one support label fewer (a smaller problem)."""

@@ -355,6 +355,14 @@ class StateBuilder:
                     k = knowledge.category_index(c)
                     values[("p-obj-on", label, support, c)] = self._restrict(c, self._prune(p[k]))
 
+    def category_belief(self, room: str) -> dict[str, float]:
+        """The room's category belief, rounded, most likely first (for traces)."""
+        if room not in self.mind.place_map.rooms or not self.mind.cmap.graph.has_room(room):
+            return {}
+        belief = self.mind.cmap.room_category(room)
+        top = sorted(belief.items(), key=lambda kv: -kv[1])[:3]
+        return {c: round(float(p), 3) for c, p in top}
+
     def search_detect(self, label: str, relation: str) -> float:
         """The p-detect the problem uses for a search (the DT's evidence weight)."""
         cfg = self.config

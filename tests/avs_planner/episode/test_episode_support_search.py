@@ -1,5 +1,6 @@
 """Support objects in a room (a second desk may exist after the first was found), the DT's
-room search skipping known objects, the CP problem skeleton, and path reuse while driving."""
+room search skipping known objects, the CP problem skeleton, path reuse while driving, and
+rooms of uncertain category visited again before giving up."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from avs_planner.cp.search import SearchOptions
 from avs_planner.episode.dt_search import ViewConeSearch
 from avs_planner.episode.executor import Executor, _split_leg
 from avs_planner.episode.mind import Mind
+from avs_planner.episode.outcome import StepStatus
 from avs_planner.episode.robot import Seen, load_spec, open_world
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.viewcones import CameraModel
@@ -80,3 +82,13 @@ def test_a_route_through_a_wall_is_not_clear(corridor) -> None:
     assert executor._clear([(x, y), (x + 1.0, y)])
     assert not executor._clear([(x, y), (x, y + 1.5)])  # the office1 wall at y = 4
     assert not executor._clear([(x, y)])
+
+
+def test_uncertain_rooms_are_found_nearest_first_and_skipped_once_visited(corridor) -> None:
+    mind, _, executor = corridor
+    room, _ = _here(mind)
+    assert executor.uncertain_room(1.01, set()) == room  # every belief is below 1.01
+    assert executor.uncertain_room(0.0, set()) is None  # nothing is below 0
+    others = executor.uncertain_room(1.01, {room})
+    assert others != room
+    assert executor.visit_room(room, max_places=2).status is StepStatus.DONE
