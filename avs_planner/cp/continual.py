@@ -14,7 +14,11 @@ from dataclasses import dataclass
 from enum import Enum
 
 from avs_planner.cp.grounding import GroundingCache, ground, world_state
-from avs_planner.cp.matching import match_virtual_objects, rename_plan
+from avs_planner.cp.matching import (
+    confirmed_assumptions,
+    match_virtual_objects,
+    rename_plan,
+)
 from avs_planner.cp.monitor import DEFAULT_PROBABILITY_THRESHOLD, MonitorReport, monitor
 from avs_planner.cp.planner import plan
 from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep, SearchOptions
@@ -37,6 +41,7 @@ class Update:
     plan: tuple[PlanStep, ...]
     result: PlanResult | None = None
     matched: Mapping[str, str] | None = None
+    confirmed: tuple[str, ...] = ()  # assumptive steps that came true and were dropped
 
 
 class ContinualPlanner:
@@ -91,6 +96,7 @@ class ContinualPlanner:
         observed: Mapping[str, Iterable[Atom]] | None = None,
     ) -> Update:
         """New beliefs arrived: keep the plan if still valid (after matching), else replan."""
+        before = (self.pproblem, self.state)
         if pproblem is not None:
             self.pproblem = pproblem
         self.state = state
@@ -98,10 +104,19 @@ class ContinualPlanner:
         matched: dict[str, str] = {}
         if observed:
             matched = match_virtual_objects(self.plan, task, observed)
+        tasks = [task]
+        if any(s.assumptive and task.action(s.name, s.args) is None for s in self.plan):
+            tasks.append(ground(*before, self.cache))  # where the plan was made or last held
+        drop = set(confirmed_assumptions(self.plan, tasks, state.true_atoms, matched))
+        confirmed = tuple(s.label for i, s in enumerate(self.plan) if i in drop)
+        if drop:
+            self.plan = tuple(s for i, s in enumerate(self.plan) if i not in drop)
+        if matched:
             self.plan = tuple(rename_plan(self.plan, matched))
         report = monitor(self.plan, task, threshold=self.threshold)
         if report.valid and (report.probability >= self.min_success):
-            return Update(Decision.CONTINUE, report, self.plan, matched=matched)
+            return Update(Decision.CONTINUE, report, self.plan, matched=matched,
+                          confirmed=confirmed)
         result = self.replan()
         decision = Decision.REPLANNED if result.solved else Decision.GIVE_UP
-        return Update(decision, report, self.plan, result, matched)
+        return Update(decision, report, self.plan, result, matched, confirmed)

@@ -11,6 +11,7 @@ and follows the plan's order, so it is deterministic.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Set as AbstractSet
 from dataclasses import replace
 
 from avs_planner.cp.search import PlanStep
@@ -71,6 +72,34 @@ def match_virtual_objects(
                 del free[real]
                 break
     return mapping
+
+
+def confirmed_assumptions(
+    plan: Sequence[PlanStep],
+    tasks: Sequence[GroundTask],
+    true_atoms: AbstractSet[Atom],
+    mapping: Mapping[str, str] | None = None,
+) -> list[int]:
+    """Indices of the plan's assumptive steps that came true: every atom the step adds (with
+    matched virtual objects renamed to their real objects) already holds. Such a step has
+    nothing left to assume; kept, it would fail its own precondition (e.g. `(virtual ?o)`
+    after the match) and force a needless replan, so the caller drops it. A step's effects
+    are looked up in the first of `tasks` that has it (the current task may no longer hold
+    an assumption that is now impossible because it came true; an earlier one does)."""
+    mapping = mapping or {}
+    out = []
+    for i, step in enumerate(plan):
+        if not step.assumptive:
+            continue
+        found = ((t, t.action(step.name, step.args)) for t in tasks)
+        task, action = next(((t, a) for t, a in found if a is not None), (None, None))
+        if task is None or action is None or not action.add_facts:
+            continue
+        atoms = [task.facts[f] for f in action.add_facts]
+        renamed = [(a[0], *(mapping.get(x, x) for x in a[1:])) for a in atoms]
+        if all(a in true_atoms for a in renamed):
+            out.append(i)
+    return out
 
 
 def rename_plan(plan: Sequence[PlanStep], mapping: Mapping[str, str]) -> list[PlanStep]:

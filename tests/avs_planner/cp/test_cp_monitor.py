@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from avs_planner.cp.continual import ContinualPlanner, Decision
@@ -9,8 +11,15 @@ from avs_planner.cp.grounding import ground, world_state
 from avs_planner.cp.matching import match_virtual_objects, rename_plan
 from avs_planner.cp.monitor import MonitorStatus, monitor
 from avs_planner.cp.search import SearchOptions
+from avs_planner.pddl import read_text
 
 OPTIONS = SearchOptions(reward=500.0)
+AVS = Path(__file__).resolve().parents[3] / "domains" / "avs"
+
+
+@pytest.fixture(scope="module")
+def corridor_text():
+    return (AVS / "domain.pddl").read_text(), (AVS / "problems" / "corridor.pddl").read_text()
 
 
 @pytest.fixture(scope="module")
@@ -105,3 +114,44 @@ def test_no_match_when_the_observation_contradicts_the_description(planned):
     task = ground(planner.pproblem, planner.state, planner.cache)
     elsewhere = {("label-of", "table2", "table"), ("related", "table2", "in", "room1")}
     assert match_virtual_objects(planner.plan, task, {"table2": elsewhere}) == {}
+
+
+def test_a_confirmed_assumption_is_dropped_instead_of_replanning(corridor_text):
+    """The table the plan assumed is found: the match renames it, the assumptions that came
+    true leave the plan, and the rest of the plan stands (no needless replan)."""
+    domain, problem = corridor_text
+    problem = problem.replace("new-object1 new-object2 new-object3 - visualobject",
+                              "table1 new-object1 new-object2 new-object3 - visualobject")
+    pproblem = read_text(domain, problem, "domain.pddl", "corridor.pddl")
+    planner = ContinualPlanner(pproblem, OPTIONS)
+    assert planner.replan().solved
+    executed = {"(move place0 place1)", "(createviewcones-in table new-room1)",
+                "(searchforobject-in table new-room1 new-object1 place1)"}
+    assert executed <= {s.label for s in planner.plan}
+    planner.plan = tuple(s for s in planner.plan if s.label not in executed)
+    seen = {("label-of", "table1", "table"), ("related", "table1", "in", "new-room1")}
+    state = planner.state.updated(
+        add=[("at", "place1"), ("visited", "place1"), ("viewcones", "table", "in", "new-room1"),
+             ("detected", "table1"), ("defined-exists", "table", "in", "new-room1"),
+             ("leads-to", "place1", "new-room1"), ("in-room", "place1", "new-room1"),
+             ("has-category", "new-room1", "kitchen"), ("defined-leads-to", "place1"),
+             ("defined-category", "new-room1"), *seen],
+        delete=[("at", "place0"), ("virtual", "new-room1")],
+    )
+    update = planner.update(state, observed={"table1": seen})
+    assert update.decision is Decision.CONTINUE, update.report
+    assert update.matched == {"new-object1": "table1"}
+    assert set(update.confirmed) == {
+        "(assume-leads-to-room place1 kitchen new-room1)",
+        "(assume-obj-exists-in table new-room1 kitchen new-object1)",
+    }
+    labels = [s.label for s in update.plan]
+    assert "(createviewcones-on cerealbox table1)" in labels
+    assert all("new-object1" not in label for label in labels)
+    # without the observation nothing is matched: the table assumption is not confirmed
+    # (new-object1 has no label) and the plan still holds with it
+    fresh = ContinualPlanner(pproblem, OPTIONS)
+    fresh.replan()
+    fresh.plan = tuple(s for s in fresh.plan if s.label not in executed)
+    kept = fresh.update(state)
+    assert "(assume-obj-exists-in table new-room1 kitchen new-object1)" not in kept.confirmed
