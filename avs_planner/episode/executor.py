@@ -77,8 +77,9 @@ class Executor:
     # ---- sensing along the way --------------------------------------------------------------
 
     def look_around(self) -> None:
-        """Scan, turn half round, scan again: the first view of a place."""
-        self._sense([self.robot.pose])
+        """Scan, turn half round, scan again: the first view of a place (the place map is
+        updated once, after both scans)."""
+        self.mind.integrate(self.robot.scan())
         self.robot.turn_to(self.robot.pose[2] + math.pi)
         self._sense([self.robot.pose])
 

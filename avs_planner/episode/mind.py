@@ -58,6 +58,11 @@ class Mind:
         self._drop_stale_objects()
         return events
 
+    def integrate(self, scan: LaserScanLike) -> None:
+        """Integrate a scan into the grid only (the next `sense` grows the place map; one
+        place-map update after several scans from one spot gives the same places)."""
+        self.grid.integrate_scan(scan)
+
     def observe_appearance(self, observed: str) -> bool:
         """The place classifier said `observed` at the current place; False if not usable."""
         place = self.place_map.current_place
