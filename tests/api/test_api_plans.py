@@ -11,10 +11,6 @@ from fastapi.testclient import TestClient
 from api.config import Settings
 from api.main import create_app
 
-pytest.importorskip("avs_planner.cp.planner", reason="the continual planner has not landed")
-if not hasattr(pytest.importorskip("avs_planner.pddl"), "check"):
-    pytest.skip("the PDDL linter has not landed", allow_module_level=True)
-
 DOMAIN = """(define (domain lamp)
   (:requirements :strips :typing :action-costs :probabilistic-effects)
   (:types room)
