@@ -328,3 +328,28 @@ def test_a_long_native_search_lets_signals_through():
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
     assert time.perf_counter() - start < 30.0
+
+
+def test_ff_supporter_ties_follow_the_python_action_order():
+    """Two supporters of the goal complete on the same pop with equal cost; Python keeps the
+    lower index. The C core shares counters between actions with equal preconditions (a0 and
+    a2 here), so it must still pick a1: the helpful actions show which one it took."""
+    x, p, q, f, g, z = range(6)
+
+    def action(i, pre, add, cost):
+        return GroundAction(index=i, name=f"a{i}", args=(), pre=sum(1 << b for b in pre),
+                            pre_neg=0, add=1 << add, delete=0, cost=cost, probability=1.0,
+                            pre_facts=tuple(pre), add_facts=(add,))
+
+    actions = (action(0, (f, q), z, 1.0), action(1, (f, p), g, 1.0), action(2, (f, q), g, 1.0),
+               action(3, (), p, 0.0), action(4, (x,), q, 0.0), action(5, (), f, 1.0))
+    facts = tuple((name,) for name in "xpqfgz")
+    task = GroundTask(facts, {a: i for i, a in enumerate(facts)}, actions, 1 << x, 1 << g)
+    from avs_planner.cp.heuristics import get_heuristic
+
+    estimator = get_heuristic("ff").factory(task, 10.0)
+    assert estimator(task.init) == (2.0 + 1.0 + 2.0, 0.0)
+    assert estimator.helpful[task.init] == {3, 5}
+    if native.AVAILABLE:
+        ((hc, hl, helpful),) = native.estimates(task, "ff", 10.0, [task.init])
+        assert (hc, hl) == (5.0, 0.0) and set(helpful) == {3, 5}
