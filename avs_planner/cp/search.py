@@ -4,6 +4,10 @@ A node carries its cost c and success probability p. Two paths to the same state
 merged when one dominates the other in both c and p, because the better g now need not be
 the better g later (the rest of the plan scales R(1 - p)). With an admissible heuristic and
 weight 1 the first goal popped is optimal for the objective.
+
+`SearchOptions.engine` picks where it runs: this module (python) or its C port
+`avs_planner/cp/_native.c` (native, packed by `avs_planner.cp.native`), which returns the same
+plan and the same expanded/generated counts; "auto" takes the C port when it was built.
 """
 
 from __future__ import annotations
