@@ -14,7 +14,7 @@ import sys
 import time
 from array import array
 from collections import OrderedDict
-from itertools import accumulate
+from itertools import accumulate, chain
 
 from avs_planner.cp.symmetry import Symmetries
 from avs_planner.cp.task import GroundTask
@@ -171,23 +171,54 @@ def task_arrays(task: GroundTask) -> tuple:
 
 def pack_symmetries(symmetries: Symmetries, n_actions: int, n_facts: int) -> tuple:
     """(act_off, pair_ids, pair_off, fact pairs) for `Symmetries.prunes`; empty if none."""
-    if not symmetries.checks:
+    import numpy as np
+
+    checks = symmetries.checks
+    if not checks:
         return b"", b"", b"", b""
-    pair_index = {pair: i for i, pair in enumerate(symmetries.fact_pairs)}
-    act_off, pair_ids = array("q", [0]), array("q")
-    for a in range(n_actions):
-        for pair in symmetries.checks.get(a, ()):
-            pair_ids.append(pair_index[pair])
-        act_off.append(len(pair_ids))
-    if len(act_off) != n_actions + 1 or any(not 0 <= a < n_actions for a in symmetries.checks):
+    pair_index, pair_off, fg = _pack_fact_pairs(symmetries.fact_pairs, n_facts)
+    actions = np.fromiter(checks.keys(), np.int64, len(checks))
+    if actions.min() < 0 or actions.max() >= n_actions:
         raise PlanningError("native search: symmetries name actions outside the task")
+    if len(actions) > 1 and not (np.diff(actions) > 0).all():
+        checks = {a: checks[a] for a in sorted(checks)}
+        actions.sort()
+    try:
+        ids = np.fromiter(map(pair_index.__getitem__, chain.from_iterable(checks.values())),
+                          np.int64)
+    except KeyError:
+        raise PlanningError("native search: a symmetry check names an unknown pair") from None
+    act_off = np.zeros(n_actions + 1, dtype="<i8")
+    act_off[actions + 1] = np.fromiter(map(len, checks.values()), np.int64, len(checks))
+    np.cumsum(act_off, out=act_off)
+    return act_off.tobytes(), ids.astype("<i8").tobytes(), pair_off, fg
+
+
+_fact_pairs_packed: OrderedDict[int, tuple] = OrderedDict()
+
+
+def _pack_fact_pairs(fact_pairs, n_facts: int) -> tuple[dict, bytes, bytes]:
+    """Pair ids and the flattened (f, g) lists; cached per fact_pairs mapping (the symmetry
+    finder keeps one per fact table)."""
+    key = (id(fact_pairs), n_facts)
+    hit = _fact_pairs_packed.get(key)
+    if hit is not None and hit[0] is fact_pairs:
+        _fact_pairs_packed.move_to_end(key)
+        return hit[1]
+    pair_index = {pair: i for i, pair in enumerate(fact_pairs)}
     pair_off, fg = array("q", [0]), array("q")
-    for pairs in symmetries.fact_pairs.values():
+    for pairs in fact_pairs.values():
         for f, g in pairs:
+            if not (0 <= f < n_facts and -1 <= g < n_facts):
+                raise PlanningError("native search: symmetries name facts outside the task")
             fg.append(f)
             fg.append(g)
         pair_off.append(len(fg) // 2)
-    return act_off, pair_ids, pair_off, fg
+    packed = (pair_index, pair_off.tobytes(), fg.tobytes())
+    _fact_pairs_packed[key] = (fact_pairs, packed)  # strong ref: the id stays unique
+    while len(_fact_pairs_packed) > _CACHE_SIZE:
+        _fact_pairs_packed.popitem(last=False)
+    return packed
 
 
 def run(

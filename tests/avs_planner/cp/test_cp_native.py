@@ -353,3 +353,13 @@ def test_ff_supporter_ties_follow_the_python_action_order():
     if native.AVAILABLE:
         ((hc, hl, helpful),) = native.estimates(task, "ff", 10.0, [task.init])
         assert (hc, hl) == (5.0, 0.0) and set(helpful) == {3, 5}
+
+
+@needs_native
+def test_symmetry_packing_does_not_depend_on_the_order_of_checks():
+    task, symmetries = _avs("corridor")
+    shuffled = dict(reversed(list(symmetries.checks.items())))
+    n_actions, n_facts = len(task.actions), len(task.facts)
+    assert native.pack_symmetries(replace(symmetries, checks=shuffled), n_actions, n_facts) \
+        == native.pack_symmetries(symmetries, n_actions, n_facts)
+    same(task, SearchOptions(reward=500.0), replace(symmetries, checks=shuffled))
