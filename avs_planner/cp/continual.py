@@ -74,7 +74,7 @@ class ContinualPlanner:
                 PlanStatus.NO_PLAN_ABOVE_THRESHOLD, planning_time_s=result.planning_time_s,
                 expanded=result.expanded, generated=result.generated, reward=result.reward,
                 heuristic=result.heuristic, weight=result.weight,
-                extra={"best_probability": result.probability},
+                extra={**result.extra, "best_probability": result.probability},
             )
         self.results.append(result)
         self.plan = result.plan
