@@ -4,7 +4,8 @@ Importing this module registers the engine (and with it UP's `replanner[avs]`) i
 default factory; `import avs_planner.up_engine` is enough. UP's model has no success
 probabilities, so for plain UP problems every action succeeds (p = 1) and the objective is
 the plan cost; pass `params={"success": {action_name: FNode}}` to plan with probabilities,
-plus optionally `reward`, `weight`, `heuristic`, `node_limit`, `min_success`.
+plus optionally `reward`, `weight`, `heuristic`, `node_limit`, `min_success`, `engine`
+("auto", "native" or "python").
 """
 
 from __future__ import annotations
@@ -67,6 +68,7 @@ class AvsPlanner(Engine, OneshotPlannerMixin):
             heuristic=str(params.pop("heuristic", "ff")),
             node_limit=params.pop("node_limit", None),
             min_success=float(params.pop("min_success", 0.0)),
+            engine=str(params.pop("engine", "auto")),
         )
         if params:
             raise up.exceptions.UPUsageError(f"unknown avs parameters: {sorted(params)}")

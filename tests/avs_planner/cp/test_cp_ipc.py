@@ -65,6 +65,10 @@ def test_up_engine_solves_and_reports_statuses():
     with OneshotPlanner(name="avs", params={"heuristic": "hmax", "weight": 1.0}) as planner:
         optimal = planner.solve(_read("blocks", 1))
     assert optimal.status is PlanGenerationResultStatus.SOLVED_OPTIMALLY
+    with OneshotPlanner(name="avs", params={"heuristic": "hmax", "weight": 1.0,
+                                            "engine": "python"}) as planner:
+        same = planner.solve(_read("blocks", 1))
+    assert [str(a) for a in same.plan.actions] == [str(a) for a in optimal.plan.actions]
     assert "replanner[avs]" in get_environment().factory.engines
 
 
