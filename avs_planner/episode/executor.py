@@ -87,8 +87,7 @@ class Executor:
         before = self.mind.place_map.current_place
         events = self.mind.sense(self.robot.scan(), poses, self.robot.clock)
         place = self.mind.place_map.current_place
-        if place is not None and (place != before or place not in self.mind.classified) \
-                and self.mind.can_classify(self.robot.pose[:2]):
+        if place is not None and (place != before or place not in self.mind.classified):
             observed = self.robot.classify_place()
             if observed is not None:
                 self.mind.observe_appearance(observed)

@@ -50,9 +50,6 @@ class LoopConfig:
     wall_budget_s: float = 600.0
     max_steps: int = 120
     dump_dir: str | None = None  # write problems the CP timed out on here
-    # before giving up, rooms whose likeliest category is below this are visited again (an
-    # office read as a corridor at 0.93 is "certain" to the state builder, whose bar is 0.9)
-    recheck_below: float = 0.99
 
 
 @dataclass
@@ -180,8 +177,9 @@ class SwitchingLoop:
     def _visit_uncertain_room(self) -> bool:
         """No plan is good enough: the place classifier may have misled the room category
         beliefs (an elongated office reads as a corridor). Visit the places of the nearest
-        room whose category is not near-certain, once per room, so it is classified again."""
-        room = self.executor.uncertain_room(self.config.recheck_below, self.visited_rooms)
+        room whose category is uncertain, once per room, so it is classified again."""
+        certain = self.builder.config.certain_category
+        room = self.executor.uncertain_room(certain, self.visited_rooms)
         if room is None:
             return False
         self.visited_rooms.add(room)

@@ -63,13 +63,6 @@ class Mind:
         place-map update after several scans from one spot gives the same places)."""
         self.grid.integrate_scan(scan)
 
-    def can_classify(self, position: tuple[float, float], door_margin: float = 0.8) -> bool:
-        """A place-classifier output is credited to the current place only away from known
-        doors: at a door the camera sees both rooms (and the robot may stand in the other
-        one), so corridor readings would pile up on the places of an office's doorway."""
-        return all(math.dist(door.centre, position) > door_margin
-                   for door in self.place_map.doors.values())
-
     def observe_appearance(self, observed: str) -> bool:
         """The place classifier said `observed` at the current place; False if not usable."""
         place = self.place_map.current_place

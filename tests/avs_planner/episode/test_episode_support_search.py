@@ -15,7 +15,6 @@ from avs_planner.episode.outcome import StepStatus
 from avs_planner.episode.robot import Seen, load_spec, open_world
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.viewcones import CameraModel
-from conceptual_map.places.model import Door
 
 OPTIONS = SearchOptions(weight=3.0, heuristic="hadd", node_limit=4000)
 
@@ -93,12 +92,3 @@ def test_uncertain_rooms_are_found_nearest_first_and_skipped_once_visited(corrid
     others = executor.uncertain_room(1.01, {room})
     assert others != room
     assert executor.visit_room(room, max_places=2).status is StepStatus.DONE
-
-
-def test_place_readings_near_a_door_are_not_credited_to_a_place() -> None:
-    mind = Mind()
-    assert mind.can_classify((7.0, 4.0))
-    mind.place_map.doors["door1"] = Door("door1", (7.0, 4.0), 0.9,
-                                         ((6.55, 4.0), (7.45, 4.0)), True)
-    assert not mind.can_classify((7.0, 4.3))
-    assert mind.can_classify((7.0, 5.5))
