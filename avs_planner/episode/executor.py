@@ -34,8 +34,10 @@ class ExecutorConfig:
     max_legs: int = 40
     replan_legs: int = 4  # legs driven on one A* path before searching again (the map grows)
     dt_policy: str = "pouct"
-    dt_sims: int = 50  # POUCT simulations per decision: the DT's default, measured by its
-    # owner as good as 150-200 at a third of the time
+    # POUCT simulations per decision. The DT's own benchmark found 50 as good as 150 on its
+    # synthetic instances, but in episodes 50 rejected searches that 150 confirmed (scenario
+    # f, 20 seeds: 16/20 found with 50, 18/20 with 150; bench/episode_bench.py)
+    dt_sims: int = 150
     # a look counts as a detection only when a second frame sees the label again within
     # `agree` m (a phantom rarely repeats), so misses are likelier and phantoms rarer than
     # the camera's own 0.2 / 0.05

@@ -50,6 +50,9 @@ class LoopConfig:
     wall_budget_s: float = 600.0
     max_steps: int = 120
     dump_dir: str | None = None  # write problems the CP timed out on here
+    # before giving up, room categories believed below this are doubted once (see
+    # SwitchingLoop._doubt_categories); the state builder's own threshold is 0.9
+    doubt_category: float = 0.999
 
 
 @dataclass
@@ -161,9 +164,14 @@ class SwitchingLoop:
                 if not self._explore_instead() and not self._shrink():
                     return None
                 result = self._plan_again("after exploring")
-            if result.solved or not self._visit_uncertain_room():
+            if result.solved:
                 return result
-            result = self._plan_again("after visiting an uncertain room")
+            if self._visit_uncertain_room():
+                result = self._plan_again("after visiting an uncertain room")
+            elif self._doubt_categories():
+                result = self._plan_again("doubting room categories believed certain")
+            else:
+                return result
 
     def _plan_again(self, why: str) -> PlanResult:
         """One CP call on the current beliefs (there is no plan left to monitor)."""
@@ -187,6 +195,20 @@ class SwitchingLoop:
         outcome = self.executor.visit_room(room)
         self.trace.emit("action", action=f"(classify {room})", status=outcome.status.value,
                         detail=outcome.detail, category=self.builder.category_belief(room))
+        return True
+
+    def _doubt_categories(self) -> bool:
+        """No plan is good enough and no uncertain room is left to look at again: the place
+        classifier may be confidently wrong about a room (readings taken in an office's
+        doorway see the corridor). Once per episode, rooms believed up to `doubt_category`
+        become uncertain again, so the planner may assume another category for them (and
+        `_visit_uncertain_room` may re-classify them)."""
+        cfg = self.builder.config
+        doubt = self.config.doubt_category
+        if cfg.certain_category >= doubt:
+            return False
+        self.builder.config = replace(cfg, certain_category=doubt)
+        self.trace.emit("belief", doubt_categories=doubt, reason="no plan above the threshold")
         return True
 
     def _shrink(self) -> bool:

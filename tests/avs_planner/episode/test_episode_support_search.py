@@ -1,8 +1,10 @@
 """Support objects in a room (a second desk may exist after the first was found), the DT's
 room search skipping known objects, the CP problem skeleton, path reuse while driving, and
-rooms of uncertain category visited again before giving up."""
+rooms of uncertain category visited again (and certain ones doubted) before giving up."""
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import pytest
 
@@ -10,10 +12,12 @@ from avs_planner.cp.continual import ContinualPlanner
 from avs_planner.cp.search import SearchOptions
 from avs_planner.episode.dt_search import ViewConeSearch
 from avs_planner.episode.executor import Executor, _split_leg
+from avs_planner.episode.loop import LoopConfig, SwitchingLoop
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import StepStatus
 from avs_planner.episode.robot import Seen, load_spec, open_world
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
+from avs_planner.episode.trace import Trace
 from avs_planner.episode.viewcones import CameraModel
 
 OPTIONS = SearchOptions(weight=3.0, heuristic="hadd", node_limit=4000)
@@ -92,3 +96,25 @@ def test_uncertain_rooms_are_found_nearest_first_and_skipped_once_visited(corrid
     others = executor.uncertain_room(1.01, {room})
     assert others != room
     assert executor.visit_room(room, max_places=2).status is StepStatus.DONE
+
+
+def test_categories_believed_certain_are_doubted_once_before_giving_up(corridor) -> None:
+    mind, builder, executor = corridor
+    room, _ = _here(mind)
+    belief = mind.cmap.room_category(room)
+    best = max(belief, key=belief.get)
+    # make the current room's reading "certain" for the builder's threshold, as a doorway
+    # misreading does, but below the loop's doubt threshold
+    builder.config = replace(builder.config, certain_category=belief[best] - 1e-6)
+    assert ("has-category", room, best) in builder.build().atoms
+    events = []
+    trace = Trace(lambda: executor.robot.clock)
+    trace.emit = lambda type_, **fields: events.append((type_, fields))  # type: ignore[method-assign]
+    loop = SwitchingLoop(builder, executor, trace, LoopConfig(doubt_category=1.0))
+    assert loop._doubt_categories()
+    assert builder.config.certain_category == 1.0
+    state = builder.build()
+    assert ("has-category", room, best) not in state.atoms  # the planner may assume again
+    assert any(k[:2] == ("p-room-category", room) for k in state.values)
+    assert events and events[0][1]["doubt_categories"] == 1.0
+    assert not loop._doubt_categories()  # once per episode
