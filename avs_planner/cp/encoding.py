@@ -144,8 +144,9 @@ class AtomSpace:
 VectorExpr = Callable[[AtomSpace, Columns, int, Mapping[Atom, float]], np.ndarray]
 """(space, columns, rows, numeric values) -> one value per row."""
 
-_ARITH = {"PLUS": operator.add, "MINUS": operator.sub, "TIMES": operator.mul,
-          "DIV": operator.truediv}
+ARITH: dict[str, Callable[[float, float], float]] = {
+    "PLUS": operator.add, "MINUS": operator.sub, "TIMES": operator.mul, "DIV": operator.truediv,
+}
 
 
 def compile_vector(node: FNode | None, where: str, default: float) -> VectorExpr:
@@ -156,14 +157,14 @@ def compile_vector(node: FNode | None, where: str, default: float) -> VectorExpr
         value = float(Fraction(str(node.constant_value())))
         return lambda space, cols, rows, values: np.full(rows, value)
     if node.is_fluent_exp():
-        template = (node.fluent().name, *(_term(a) for a in node.args))
+        template = (node.fluent().name, *(term(a) for a in node.args))
         return lambda space, cols, rows, values: _lookup(
             space, template, cols, rows, values, where
         )
     kind = node.node_type.name
-    if kind in _ARITH and node.args:
+    if kind in ARITH and node.args:
         parts = [compile_vector(a, where, default) for a in node.args]
-        op = _ARITH[kind]
+        op = ARITH[kind]
 
         def arith(space, cols, rows, values):
             acc = parts[0](space, cols, rows, values)
@@ -176,7 +177,8 @@ def compile_vector(node: FNode | None, where: str, default: float) -> VectorExpr
     raise PlanningError(f"{where}: unsupported numeric expression {node}")
 
 
-def _term(node: FNode) -> str:
+def term(node: FNode) -> str:
+    """A lifted atom's argument: `?name` for a parameter, else the object's name."""
     if node.is_parameter_exp():
         return "?" + node.parameter().name
     if node.is_object_exp():

@@ -7,7 +7,6 @@ and a table of static numeric values, so evaluating them per ground action is ch
 
 from __future__ import annotations
 
-import operator
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from fractions import Fraction
@@ -20,7 +19,8 @@ from unified_planning.model import (
     Type,
 )
 
-from avs_planner.cp.encoding import VectorExpr, compile_vector
+from avs_planner.cp.encoding import ARITH, VectorExpr, compile_vector
+from avs_planner.cp.encoding import term as _term
 from avs_planner.errors import PlanningError
 from avs_planner.pddl.model import ProbabilisticProblem
 
@@ -53,25 +53,9 @@ class LiftedSchema:
     prob_vec: VectorExpr | None = None
 
 
-def _term(node: FNode) -> Term:
-    if node.is_parameter_exp():
-        return "?" + node.parameter().name
-    if node.is_object_exp():
-        return node.object().name
-    raise PlanningError(f"unsupported argument {node} (only parameters and objects)")
-
-
 def atom_template(node: FNode) -> AtomTemplate:
     """`(pred ?x obj)` of a boolean fluent expression."""
     return (node.fluent().name, *(_term(a) for a in node.args))
-
-
-_ARITH: dict[str, Callable[[float, float], float]] = {
-    "PLUS": operator.add,
-    "MINUS": operator.sub,
-    "TIMES": operator.mul,
-    "DIV": operator.truediv,
-}
 
 
 def compile_numeric(node: FNode, where: str) -> NumExpr:
@@ -90,9 +74,9 @@ def compile_numeric(node: FNode, where: str) -> NumExpr:
 
         return fluent_value
     kind = node.node_type.name
-    if kind in _ARITH and node.args:
+    if kind in ARITH and node.args:
         parts = [compile_numeric(a, where) for a in node.args]
-        op = _ARITH[kind]
+        op = ARITH[kind]
 
         def arith(b: Binding, v: Mapping[tuple[str, ...], float]) -> float:
             acc = parts[0](b, v)

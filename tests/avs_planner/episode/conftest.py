@@ -11,9 +11,7 @@ from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.viewcones import CameraModel
 
 
-@pytest.fixture(scope="module")
-def corridor_mind():
-    """Robot at the office corridor start, one look around; yields (mind, builder, robot)."""
+def _look_around_the_corridor():
     robot = open_world(load_spec("office", start=(6.0, 3.2, 0.0)), seed=1)
     mind = Mind()
     builder = StateBuilder(mind, SearchTask("cerealbox"))
@@ -21,5 +19,21 @@ def corridor_mind():
     executor = Executor(robot, mind, builder, CameraModel(robot.camera_height, cam.hfov,
                                                           cam.detect_range), lambda *a, **k: None)
     executor.look_around()
+    return robot, mind, builder, executor
+
+
+@pytest.fixture(scope="module")
+def corridor_mind():
+    """Robot at the office corridor start, one look around; yields (mind, builder, robot)."""
+    robot, mind, builder, _ = _look_around_the_corridor()
     yield mind, builder, robot
+    robot.world.close()
+
+
+@pytest.fixture()
+def corridor():
+    """The same, fresh for each test (tests change the mind); yields (mind, builder,
+    executor)."""
+    robot, mind, builder, executor = _look_around_the_corridor()
+    yield mind, builder, executor
     robot.world.close()

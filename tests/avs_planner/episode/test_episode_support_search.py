@@ -11,30 +11,14 @@ import pytest
 from avs_planner.cp.continual import ContinualPlanner
 from avs_planner.cp.search import SearchOptions
 from avs_planner.episode.dt_search import ViewConeSearch
-from avs_planner.episode.executor import Executor, _split_leg
+from avs_planner.episode.executor import _split_leg
 from avs_planner.episode.loop import LoopConfig, SwitchingLoop
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import StepStatus
-from avs_planner.episode.robot import Seen, load_spec, open_world
-from avs_planner.episode.state_builder import SearchTask, StateBuilder
+from avs_planner.episode.robot import Seen
 from avs_planner.episode.trace import Trace
-from avs_planner.episode.viewcones import CameraModel
 
 OPTIONS = SearchOptions(weight=3.0, heuristic="hadd", node_limit=4000)
-
-
-@pytest.fixture()
-def corridor():
-    """A fresh mind (tests here add objects to it) after one look around the corridor."""
-    robot = open_world(load_spec("office", start=(6.0, 3.2, 0.0)), seed=1)
-    mind = Mind()
-    builder = StateBuilder(mind, SearchTask("cerealbox"))
-    cam = robot.robot.model.camera
-    executor = Executor(robot, mind, builder, CameraModel(robot.camera_height, cam.hfov,
-                                                          cam.detect_range), lambda *a, **k: None)
-    executor.look_around()
-    yield mind, builder, executor
-    robot.world.close()
 
 
 def _here(mind: Mind) -> tuple[str, tuple[float, float]]:
