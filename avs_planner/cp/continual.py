@@ -5,6 +5,12 @@ belief state (`WorldState`, and a new `ProbabilisticProblem` only when objects c
 calls `update`; the planner keeps the rest of the current plan when it is still valid, renames
 virtual objects that a detection matched, and otherwise replans. Grounding structure is cached
 across these calls, so a replan in an unchanged domain only re-evaluates the state.
+
+Grounding takes the whole initial state (true atoms and numeric values) from the `WorldState`,
+never from the problem's :init, so a problem holding only the domain, the objects and the goal
+is enough when every call passes a state (the switching loop builds one such problem per
+object set and reuses it, which keeps the grounding cache warm). Assumptive steps that came
+true (see `matching.confirmed_assumptions`) leave the plan in `update`.
 """
 
 from __future__ import annotations
