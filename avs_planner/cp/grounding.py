@@ -401,8 +401,10 @@ def _assemble(problem, space, static, parts, assumptive) -> GroundStructure:
     )
 
 
-def _goal(problem: Problem, structure: GroundStructure) -> tuple[int, int, bool]:
-    """Goal bitsets (positive, negative) and whether a static goal atom makes it impossible."""
+def _goal(problem: Problem, structure: GroundStructure, true_atoms: frozenset[Atom]
+          ) -> tuple[int, int, bool]:
+    """Goal bitsets (positive, negative) and whether a goal atom no action touches (so its
+    truth is the initial state's) makes it impossible."""
     pos = neg = 0
     impossible = False
     index = structure.fact_index
@@ -416,7 +418,7 @@ def _goal(problem: Problem, structure: GroundStructure) -> tuple[int, int, bool]
             i = index.get(atom)
             if i is None:
                 # never mentioned by any action: its truth is fixed by the initial state
-                impossible |= (atom in structure.static_atoms) == negated
+                impossible |= (atom in true_atoms) == negated
                 continue
             if negated:
                 neg |= 1 << i
@@ -659,7 +661,7 @@ def _ground(
     n = len(st.facts)
     init_ids = [i for i in map(st.fact_index.get, state.true_atoms) if i is not None]
     init = _mask(init_ids)
-    goal, goal_neg, impossible = _goal(pproblem.problem, st)
+    goal, goal_neg, impossible = _goal(pproblem.problem, st, state.true_atoms)
     reached = np.zeros(n + 2, dtype=bool)
     reached[init_ids] = True
     reached[n] = True  # the padding of preconditions

@@ -10,6 +10,8 @@ import pytest
 
 from avs_planner.cp.encoding import AtomSpace
 from avs_planner.cp.grounding import GroundingCache, ground
+from avs_planner.cp.planner import plan
+from avs_planner.cp.search import PlanStatus
 from avs_planner.errors import PlanningError
 from avs_planner.pddl import read_text
 
@@ -117,3 +119,16 @@ def test_bad_numeric_values_name_the_action(shapes):
     missing = PROBLEM.replace("(= (weight b1) 2)", "")
     with pytest.raises(PlanningError, match=r"no value for \(weight b1\)"):
         ground(read_text(DOMAIN, missing, "shapes.pddl", "p.pddl"), cache=GroundingCache())
+
+
+def test_a_goal_no_action_touches_is_decided_by_the_initial_state():
+    domain = """(define (domain d) (:requirements :strips :typing) (:types t)
+      (:predicates (p ?x - t) (q))
+      (:action a :parameters (?x - t) :precondition (p ?x) :effect (q)))"""
+    holds = "(define (problem h) (:domain d) (:objects o - t) (:init (q)) (:goal (q)))"
+    fails = "(define (problem f) (:domain d) (:objects o - t) (:init) (:goal (q)))"
+    # (p o) is static and false, so no ground action mentions (q): the initial state decides
+    solved = plan(read_text(domain, holds, "d.pddl", "h.pddl"), cache=GroundingCache())
+    assert solved.status is PlanStatus.SOLVED and solved.plan == ()
+    unsolvable = plan(read_text(domain, fails, "d.pddl", "f.pddl"), cache=GroundingCache())
+    assert unsolvable.status is PlanStatus.UNSOLVABLE
