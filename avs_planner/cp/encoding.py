@@ -33,6 +33,8 @@ class AtomSpace:
         self.object_id: dict[str, int] = {n: i for i, n in enumerate(self.names)}
         self._of_type: dict[str, np.ndarray] = {}
         self._local: dict[str, np.ndarray] = {}
+        self._locals: dict[str, tuple[np.ndarray, ...]] = {}  # per fluent, per argument
+        self._names_of: dict[str, list[str]] = {}
         self.base: dict[str, int] = {}
         self.strides: dict[str, tuple[int, ...]] = {}
         self.arg_types: dict[str, tuple[Type, ...]] = {}
@@ -48,6 +50,7 @@ class AtomSpace:
             self.base[fluent.name] = total
             self.strides[fluent.name] = tuple(strides)
             self.arg_types[fluent.name] = types
+            self._locals[fluent.name] = tuple(self._local_of(t) for t in types)
             self._starts.append(total)
             self._fluents.append(fluent.name)
             total += max(math.prod(sizes), 1)
@@ -73,6 +76,14 @@ class AtomSpace:
             self._local[key] = local
         return ids
 
+    def names_of(self, type_: Type) -> list[str]:
+        """Object names of `type_` (subtypes included), in the problem's order."""
+        key = str(type_)
+        names = self._names_of.get(key)
+        if names is None:
+            names = self._names_of[key] = [self.names[i] for i in self.objects_of(type_)]
+        return names
+
     def _local_of(self, type_: Type) -> np.ndarray:
         self.objects_of(type_)
         return self._local[str(type_)]
@@ -81,13 +92,12 @@ class AtomSpace:
         """Codes of a lifted atom `(f ?x obj ...)` under `rows` bindings."""
         name = template[0]
         code = np.full(rows, self.base[name], dtype=np.int64)
-        types = self.arg_types[name]
-        for term, stride, type_ in zip(template[1:], self.strides[name], types, strict=True):
-            local = self._local_of(type_)
-            if term[0] == "?":
-                code += stride * local[columns[term]]
+        for term_, stride, local in zip(template[1:], self.strides[name], self._locals[name],
+                                        strict=True):
+            if term_[0] == "?":
+                code += stride * local[columns[term_]]
             else:
-                code += stride * int(local[self.object_id[term]])
+                code += stride * int(local[self.object_id[term_]])
         return code
 
     def encode(self, atom: Atom) -> int | None:
@@ -96,15 +106,12 @@ class AtomSpace:
         if base is None or len(atom) - 1 != len(self.strides[atom[0]]):
             return None
         code = base
-        for obj, stride, type_ in zip(atom[1:], self.strides[atom[0]], self.arg_types[atom[0]],
+        for obj, stride, local in zip(atom[1:], self.strides[atom[0]], self._locals[atom[0]],
                                       strict=True):
             gid = self.object_id.get(obj)
-            if gid is None:
+            if gid is None or local[gid] < 0:
                 return None
-            local = int(self._local_of(type_)[gid])
-            if local < 0:
-                return None
-            code += stride * local
+            code += stride * int(local[gid])
         return code
 
     def decode_many(self, codes: np.ndarray) -> list[Atom]:
@@ -192,8 +199,7 @@ def _lookup(space: AtomSpace, template, cols, rows, values, where) -> np.ndarray
     codes = space.encode_rows(template, cols, rows)
     unique, inverse = np.unique(codes, return_inverse=True)
     found = np.empty(len(unique))
-    for i, code in enumerate(unique.tolist()):
-        atom = space.decode(code)
+    for i, atom in enumerate(space.decode_many(unique)):
         value = values.get(atom)
         if value is None:
             raise PlanningError(f"{where}: no value for ({' '.join(atom)}) in :init")

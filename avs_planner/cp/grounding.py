@@ -308,9 +308,7 @@ def build_structure(
     ))
     if static_names is None:
         static_names = frozenset(f.name for f in problem.get_static_fluents())
-    formulas = FormulaGrounder(
-        static, static_names, lambda t: list(dict.fromkeys(o.name for o in problem.objects(t)))
-    )
+    formulas = FormulaGrounder(static, static_names, space.names_of)
     parts = []  # (schema, columns, rows, pre, neg, add, delete, clauses per row)
     total = 0
     for schema in schemas:
