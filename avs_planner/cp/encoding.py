@@ -151,7 +151,7 @@ class AtomSpace:
 VectorExpr = Callable[[AtomSpace, Columns, int, Mapping[Atom, float]], np.ndarray]
 """(space, columns, rows, numeric values) -> one value per row."""
 
-ARITH: dict[str, Callable[[float, float], float]] = {
+_ARITH: dict[str, Callable[[float, float], float]] = {
     "PLUS": operator.add, "MINUS": operator.sub, "TIMES": operator.mul, "DIV": operator.truediv,
 }
 
@@ -169,9 +169,9 @@ def compile_vector(node: FNode | None, where: str, default: float) -> VectorExpr
             space, template, cols, rows, values, where
         )
     kind = node.node_type.name
-    if kind in ARITH and node.args:
+    if kind in _ARITH and node.args:
         parts = [compile_vector(a, where, default) for a in node.args]
-        op = ARITH[kind]
+        op = _ARITH[kind]
 
         def arith(space, cols, rows, values):
             acc = parts[0](space, cols, rows, values)

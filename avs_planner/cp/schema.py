@@ -1,15 +1,13 @@
 """Lifted action schemas compiled from a UP problem into plain tuples the grounder joins over.
 
 Terms are strings: a parameter is `?name`, anything else is an object name. Numeric
-expressions (action costs, success probabilities) become closures over a parameter binding
-and a table of static numeric values, so evaluating them per ground action is cheap.
+expressions (action costs, success probabilities) become `encoding.VectorExpr`s, evaluated
+for many bindings at once from the numeric values of the state.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from fractions import Fraction
 
 from unified_planning.model import (
     FNode,
@@ -19,15 +17,13 @@ from unified_planning.model import (
     Type,
 )
 
-from avs_planner.cp.encoding import ARITH, VectorExpr, compile_vector
+from avs_planner.cp.encoding import VectorExpr, compile_vector
 from avs_planner.cp.encoding import term as _term
 from avs_planner.errors import PlanningError
 from avs_planner.pddl.model import ProbabilisticProblem
 
 Term = str
 AtomTemplate = tuple[str, ...]  # (predicate, term, ...)
-Binding = Mapping[str, str]
-NumExpr = Callable[[Binding, Mapping[tuple[str, ...], float]], float]
 
 
 @dataclass(frozen=True)
@@ -45,47 +41,15 @@ class LiftedSchema:
     not_equal: tuple[tuple[Term, Term], ...]
     add: tuple[AtomTemplate, ...]
     delete: tuple[AtomTemplate, ...]
-    cost: NumExpr
-    probability: NumExpr
+    cost: VectorExpr
+    probability: VectorExpr
     complex: tuple[FNode, ...] = ()
     never: bool = False
-    cost_vec: VectorExpr | None = None  # the same expressions over arrays of bindings
-    prob_vec: VectorExpr | None = None
 
 
 def atom_template(node: FNode) -> AtomTemplate:
     """`(pred ?x obj)` of a boolean fluent expression."""
     return (node.fluent().name, *(_term(a) for a in node.args))
-
-
-def compile_numeric(node: FNode, where: str) -> NumExpr:
-    """A closure evaluating a numeric UP expression under a binding and static values."""
-    if node.is_constant():
-        return _constant(float(Fraction(str(node.constant_value()))))
-    if node.is_fluent_exp():
-        name = node.fluent().name
-        terms = tuple(_term(a) for a in node.args)
-
-        def fluent_value(b: Binding, v: Mapping[tuple[str, ...], float]) -> float:
-            key = (name, *(b[t] if t[0] == "?" else t for t in terms))
-            if key not in v:
-                raise PlanningError(f"{where}: no value for ({' '.join(key)}) in :init")
-            return v[key]
-
-        return fluent_value
-    kind = node.node_type.name
-    if kind in ARITH and node.args:
-        parts = [compile_numeric(a, where) for a in node.args]
-        op = ARITH[kind]
-
-        def arith(b: Binding, v: Mapping[tuple[str, ...], float]) -> float:
-            acc = parts[0](b, v)
-            for part in parts[1:]:
-                acc = op(acc, part(b, v))
-            return acc
-
-        return arith
-    raise PlanningError(f"{where}: unsupported numeric expression {node}")
 
 
 def _conjuncts(node: FNode) -> list[FNode]:
@@ -153,17 +117,10 @@ def compile_schemas(
             raise PlanningError(f"action {action.name}: only instantaneous actions are supported")
         parts = _split_preconditions(action, static)
         add, delete = _split_effects(action)
-        cost_node = costs.get(action.name)
-        if cost_node is None:
-            cost = _constant(0.0 if has_metric else 1.0)
-        else:
-            cost = compile_numeric(cost_node, f"cost of {action.name}")
-        prob_node = pproblem.success.get(action.name)
-        prob = (
-            _constant(1.0)
-            if prob_node is None
-            else compile_numeric(prob_node, f"success probability of {action.name}")
-        )
+        cost = compile_vector(costs.get(action.name), f"cost of {action.name}",
+                              0.0 if has_metric else 1.0)
+        prob = compile_vector(pproblem.success.get(action.name),
+                              f"success probability of {action.name}", 1.0)
         schemas.append(
             LiftedSchema(
                 name=action.name,
@@ -175,13 +132,6 @@ def compile_schemas(
                 add=tuple(add), delete=tuple(delete),
                 cost=cost, probability=prob, never=bool(parts["never"]),
                 complex=tuple(parts["complex"]),
-                cost_vec=compile_vector(cost_node, f"cost of {action.name}",
-                                        0.0 if has_metric else 1.0),
-                prob_vec=compile_vector(prob_node, f"success probability of {action.name}", 1.0),
             )
         )
     return tuple(schemas)
-
-
-def _constant(value: float) -> NumExpr:
-    return lambda b, v: value

@@ -1,0 +1,394 @@
+"""The cached part of grounding: every ground action consistent with types and static atoms.
+
+It depends only on the domain, the objects and the static atoms (`GroundingCache` keys it so).
+Atoms are integer codes (`encoding.AtomSpace`); a schema's bindings are joined over its static
+preconditions as columns of object ids; the ground actions' conditions and effects are rows of
+fact-id arrays that the per-call stage (`grounding.ground`) runs its fixpoints over.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from unified_planning.model import Problem
+
+from avs_planner.cp.encoding import AtomSpace, Columns
+from avs_planner.cp.formulas import FormulaGrounder
+from avs_planner.cp.schema import AtomTemplate, LiftedSchema
+from avs_planner.cp.task import Atom
+from avs_planner.errors import PlanningError
+
+MAX_GROUND_ACTIONS = 2_000_000
+MAX_BINDINGS = 20_000_000  # partial bindings of one schema while joining its static atoms
+_PAD_TRUE = -1  # padding code of precondition arrays (an always-true fact)
+_PAD_NONE = -2  # padding code of the other arrays (a fact nothing reads or makes true)
+
+
+@dataclass(frozen=True)
+class _Block:
+    """The ground actions of one schema: rows start..stop of the structure's arrays."""
+
+    schema: LiftedSchema
+    start: int
+    stop: int
+    columns: Mapping[str, np.ndarray]  # parameter -> object id, one per row
+    assumptive: bool
+
+    def select(self, mask: np.ndarray) -> tuple[Columns, int]:
+        """Columns of the rows where `mask` (over this block's rows) is true."""
+        return {p: c[mask] for p, c in self.columns.items()}, int(mask.sum())
+
+
+@dataclass(frozen=True)
+class GroundStructure:
+    """The cached part of grounding: fact table and every statically possible ground action.
+
+    Rows of `pre`, `pre_neg`, `add`, `delete` are ground actions, entries fact ids; padding is
+    fact id `len(facts)` in `pre` (read as true) and `len(facts) + 1` elsewhere (never true)."""
+
+    facts: tuple[Atom, ...]
+    fact_index: Mapping[Atom, int]
+    space: AtomSpace
+    blocks: tuple[_Block, ...]
+    pre: np.ndarray
+    pre_neg: np.ndarray
+    add: np.ndarray
+    delete: np.ndarray
+    clauses: Mapping[int, tuple[tuple[tuple[int, ...], tuple[int, ...]], ...]]
+    arg_ids: np.ndarray  # (rows, max arity) object ids of the arguments, padded with -1
+    _rows: dict[int, tuple] = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def size(self) -> int:
+        return len(self.pre)
+
+    def block_of(self, row: int) -> _Block:
+        for block in self.blocks:
+            if block.start <= row < block.stop:
+                return block
+        raise IndexError(row)
+
+    def label(self, row: int) -> str:
+        block = self.block_of(row)
+        names = self.space.names
+        args = (names[int(block.columns[p][row - block.start])] for p in block.schema.params)
+        return "(" + " ".join((block.schema.name, *args)) + ")"
+
+    def rows(self, rows: list[int]) -> list[tuple]:
+        """Per row: (name, args, pre, pre_neg, add, delete, pre_facts, add_facts, clauses,
+        assumptive, signature) of the ground action, built once per structure."""
+        known = self._rows
+        missing = [r for r in rows if r not in known]
+        if missing:
+            self._build_rows(missing)
+        return [known[r] for r in rows]
+
+    def _build_rows(self, missing: list[int]) -> None:
+        n = len(self.facts)
+        names = self.space.names
+        at = np.array(missing, dtype=np.int64)
+        pre, neg, add, delete = (fact_matrix(a[at], n, None)
+                                 for a in (self.pre, self.pre_neg, self.add, self.delete))
+        pre_masks, neg_masks, add_masks, delete_masks = (
+            _row_masks(m, n) for m in (pre, neg, add, delete)
+        )
+        pre_count, add_count = (pre >= 0).sum(axis=1).tolist(), (add >= 0).sum(axis=1).tolist()
+        pre_rows, add_rows = pre.tolist(), add.tolist()
+        arg_rows = self.arg_ids[at].tolist()
+        starts = np.array([b.start for b in self.blocks], dtype=np.int64)
+        block_rows = (np.searchsorted(starts, at, side="right") - 1).tolist()
+        lowered = [x.lower() for x in names]
+        clause_rows = self.clauses
+        for k, row in enumerate(missing):
+            block = self.blocks[block_rows[k]]
+            schema = block.schema
+            ids = arg_rows[k][: len(schema.params)]
+            clauses = ()
+            if row in clause_rows:
+                clauses = tuple((bitset(pos), bitset(neg)) for pos, neg in clause_rows[row])
+            self._rows[row] = (
+                schema.name, tuple([names[v] for v in ids]), pre_masks[k], neg_masks[k],
+                add_masks[k], delete_masks[k], tuple(pre_rows[k][: pre_count[k]]),
+                tuple(add_rows[k][: add_count[k]]), clauses, block.assumptive,
+                (schema.name.lower(), *[lowered[v] for v in ids]),
+            )
+
+
+def _row_masks(matrix: np.ndarray, n: int) -> list[int]:
+    """Each row's fact ids (>= 0; -1 is padding) as a Python int bitset."""
+    words = n // 64 + 1
+    out = np.zeros((matrix.shape[0], words), dtype=np.uint64)
+    rows, cols = np.nonzero(matrix >= 0)
+    facts = matrix[rows, cols]
+    np.bitwise_or.at(out, (rows, facts // 64),
+                     np.left_shift(np.uint64(1), (facts % 64).astype(np.uint64)))
+    data, size = out.tobytes(), 8 * words
+    return [int.from_bytes(data[i:i + size], "little") for i in range(0, len(data), size)]
+
+
+def bitset(ids) -> int:
+    """A Python int bitset of fact ids."""
+    bits = 0
+    for i in ids:
+        bits |= 1 << i
+    return bits
+
+
+def _member(codes: np.ndarray, sorted_codes: np.ndarray) -> np.ndarray:
+    if len(sorted_codes) == 0:
+        return np.zeros(len(codes), dtype=bool)
+    at = np.minimum(np.searchsorted(sorted_codes, codes), len(sorted_codes) - 1)
+    return sorted_codes[at] == codes
+
+
+def _term_params(terms: Sequence[str]) -> frozenset[str]:
+    return frozenset(t for t in terms if t[0] == "?")
+
+
+def _bindings(
+    schema: LiftedSchema, space: AtomSpace, static_codes: np.ndarray
+) -> tuple[dict[str, np.ndarray], int]:
+    """Every parameter binding consistent with types, static atoms and (in)equalities, as
+    columns of object ids in lexicographic order of the schema's parameters. A join: one
+    parameter at a time (the one closing most constraints first), filtering as soon as a
+    constraint's parameters are all bound."""
+    params = schema.params
+    domain = {p: space.objects_of(t) for p, t in zip(params, schema.param_types, strict=True)}
+    pending = (
+        [("in", t, _term_params(t[1:])) for t in schema.static_pos]
+        + [("out", t, _term_params(t[1:])) for t in schema.static_neg]
+        + [("eq", pair, _term_params(pair)) for pair in schema.equal]
+        + [("ne", pair, _term_params(pair)) for pair in schema.not_equal]
+    )
+    columns: dict[str, np.ndarray] = {}
+    rows = 1
+
+    def value(term: str, rows: int) -> np.ndarray:
+        if term[0] == "?":
+            return columns[term]
+        return np.full(rows, space.object_id[term], dtype=np.int64)
+
+    def apply(ready: list) -> None:
+        nonlocal columns, rows
+        mask = np.ones(rows, dtype=bool)
+        for kind, item, _ in ready:
+            if kind in ("in", "out"):
+                hit = _member(space.encode_rows(item, columns, rows), static_codes)
+                mask &= hit if kind == "in" else ~hit
+            else:
+                same = value(item[0], rows) == value(item[1], rows)
+                mask &= same if kind == "eq" else ~same
+        if not mask.all():
+            columns = {p: c[mask] for p, c in columns.items()}
+            rows = int(mask.sum())
+
+    bound: set[str] = set()
+    apply([c for c in pending if not c[2]])
+    pending = [c for c in pending if c[2]]
+    remaining = list(params)
+    while remaining and rows:
+        param = min(remaining, key=lambda p, pending=pending: (
+            -sum(1 for c in pending if c[2] <= bound | {p}), len(domain[p]), params.index(p)
+        ))
+        remaining.remove(param)
+        objects = domain[param]
+        if rows * len(objects) > MAX_BINDINGS:
+            raise PlanningError(
+                f"action {schema.name}: more than {MAX_BINDINGS} partial bindings to ground"
+            )
+        columns = {p: np.repeat(c, len(objects)) for p, c in columns.items()}
+        columns[param] = np.tile(objects, rows)
+        rows *= len(objects)
+        bound.add(param)
+        apply([c for c in pending if c[2] <= bound])
+        pending = [c for c in pending if not c[2] <= bound]
+    if not rows or remaining:
+        return {p: np.zeros(0, dtype=np.int64) for p in params}, 0
+    if params:
+        order = np.lexsort([columns[p] for p in reversed(params)])
+        columns = {p: columns[p][order] for p in params}
+    return columns, rows
+
+
+def _codes(templates: Sequence[AtomTemplate], space: AtomSpace, columns: Columns,
+           rows: int) -> np.ndarray:
+    if not templates:
+        return np.empty((rows, 0), dtype=np.int64)
+    return np.stack([space.encode_rows(t, columns, rows) for t in templates], axis=1)
+
+
+def _pad(lists: list[list[int]], pad: int) -> np.ndarray:
+    width = max((len(x) for x in lists), default=0)
+    out = np.full((len(lists), width), pad, dtype=np.int64)
+    for i, x in enumerate(lists):
+        out[i, : len(x)] = x
+    return out
+
+
+def _complex_rows(schema, space, columns, rows, formulas):
+    """Per binding: CNF of the quantified/disjunctive conditions. Unit clauses become extra
+    pre/pre_neg codes; longer ones are kept per row. Rows with an empty clause are dropped."""
+    keep = np.ones(rows, dtype=bool)
+    extra_pos: list[list[int]] = []
+    extra_neg: list[list[int]] = []
+    clauses: list[tuple] = []
+    names = space.names
+
+    def code(atom: Atom) -> int:
+        c = space.encode(atom)
+        if c is None:
+            raise PlanningError(f"action {schema.name}: cannot ground condition atom {atom}")
+        return c
+
+    for i in range(rows):
+        binding = {p: names[int(columns[p][i])] for p in schema.params}
+        cnf = [c for node in schema.complex for c in formulas.cnf(node, binding)]
+        pos: list[int] = []
+        neg: list[int] = []
+        longer = []
+        for clause in sorted(cnf, key=lambda c: sorted(c)):
+            if not clause:
+                keep[i] = False
+                break
+            if len(clause) == 1:
+                ((atom, positive),) = clause
+                (pos if positive else neg).append(code(atom))
+            else:
+                longer.append((
+                    tuple(code(a) for a, positive in sorted(clause) if positive),
+                    tuple(code(a) for a, positive in sorted(clause) if not positive),
+                ))
+        extra_pos.append(pos)
+        extra_neg.append(neg)
+        clauses.append(tuple(longer))
+    return keep, _pad(extra_pos, _PAD_TRUE), _pad(extra_neg, _PAD_NONE), clauses
+
+
+def _widen(array: np.ndarray, width: int, pad: int) -> np.ndarray:
+    if array.shape[1] == width:
+        return array
+    out = np.full((array.shape[0], width), pad, dtype=np.int64)
+    out[:, : array.shape[1]] = array
+    return out
+
+
+def build_structure(
+    problem: Problem, schemas: Sequence[LiftedSchema], static: frozenset[Atom],
+    assumptive: Mapping[str, bool], static_names: frozenset[str] | None = None,
+) -> GroundStructure:
+    """Ground every action over the objects, filtered by types and static atoms."""
+    space = AtomSpace(problem)
+    static_codes = np.unique(np.array(
+        [c for c in (space.encode(a) for a in static) if c is not None], dtype=np.int64
+    ))
+    if static_names is None:
+        static_names = frozenset(f.name for f in problem.get_static_fluents())
+    formulas = FormulaGrounder(static, static_names, space.names_of)
+    parts = []  # (schema, columns, rows, pre, neg, add, delete, clauses per row)
+    total = 0
+    for schema in schemas:
+        if schema.never:
+            continue
+        columns, rows = _bindings(schema, space, static_codes)
+        if not rows:
+            continue
+        pre = _codes(schema.pre_pos, space, columns, rows)
+        neg = _codes(schema.pre_neg, space, columns, rows)
+        clauses: list[tuple] = [()] * rows
+        if schema.complex:
+            keep, more_pos, more_neg, clauses = _complex_rows(
+                schema, space, columns, rows, formulas
+            )
+            pre = np.concatenate([pre, more_pos], axis=1)
+            neg = np.concatenate([neg, more_neg], axis=1)
+        else:
+            keep = np.ones(rows, dtype=bool)
+        for i in range(pre.shape[1]):  # a condition and its negation: never applicable
+            for j in range(neg.shape[1]):
+                keep &= pre[:, i] != neg[:, j]
+        add = _codes(schema.add, space, columns, rows)
+        delete = _codes(schema.delete, space, columns, rows)
+        for j in range(delete.shape[1]):  # add wins over delete (PDDL: deletes first)
+            for i in range(add.shape[1]):
+                delete[:, j] = np.where(delete[:, j] == add[:, i], _PAD_NONE, delete[:, j])
+        if not keep.all():
+            columns = {p: c[keep] for p, c in columns.items()}
+            pre, neg, add, delete = pre[keep], neg[keep], add[keep], delete[keep]
+            clauses = [c for c, k in zip(clauses, keep.tolist(), strict=True) if k]
+            rows = int(keep.sum())
+        total += rows
+        if total > MAX_GROUND_ACTIONS:
+            raise PlanningError(f"grounding exceeds {MAX_GROUND_ACTIONS} actions")
+        if rows:
+            parts.append((schema, columns, rows, pre, neg, add, delete, clauses))
+    return _assemble(space, parts, assumptive)
+
+
+def _assemble(space: AtomSpace, parts: list, assumptive: Mapping[str, bool]) -> GroundStructure:
+    """Concatenate the schemas' rows and renumber the atom codes they use as fact ids."""
+    arrays = {k: [] for k in ("pre", "neg", "add", "delete")}
+    clause_codes: list = []
+    for _, _, _, pre, neg, add, delete, clauses in parts:
+        for key, array in zip(arrays, (pre, neg, add, delete), strict=True):
+            arrays[key].append(array)
+        clause_codes.extend(c for row in clauses for clause in row for side in clause
+                            for c in side)
+    used = [a[a >= 0] for key in arrays for a in arrays[key]]
+    codes = np.unique(np.concatenate(used + [np.array(clause_codes, dtype=np.int64)]))
+    n = len(codes)
+    facts = tuple(space.decode_many(codes))
+
+    def renumber(array: np.ndarray, pad: int) -> np.ndarray:
+        out = np.searchsorted(codes, array)
+        out[array == _PAD_TRUE] = n
+        out[array == _PAD_NONE] = n + 1
+        return out
+
+    stacked = {}
+    for key, pad in (("pre", _PAD_TRUE), ("neg", _PAD_NONE), ("add", _PAD_NONE),
+                     ("delete", _PAD_NONE)):
+        width = max((a.shape[1] for a in arrays[key]), default=0)
+        joined = (np.concatenate([_widen(a, width, pad) for a in arrays[key]])
+                  if arrays[key] else np.empty((0, 0), dtype=np.int64))
+        stacked[key] = renumber(joined, pad)
+    blocks, clauses, start = [], {}, 0
+    index_of = {c: i for i, c in enumerate(codes.tolist())}
+    arity = max((len(part[0].params) for part in parts), default=0)
+    arg_ids = np.full((sum(part[2] for part in parts), arity), -1, dtype=np.int64)
+    for schema, columns, rows, *_, row_clauses in parts:
+        blocks.append(_Block(schema, start, start + rows, columns, assumptive[schema.name]))
+        for j, param in enumerate(schema.params):
+            arg_ids[start:start + rows, j] = columns[param]
+        for i, row in enumerate(row_clauses):
+            if row:
+                clauses[start + i] = tuple(
+                    (tuple(index_of[c] for c in pos), tuple(index_of[c] for c in neg))
+                    for pos, neg in row
+                )
+        start += rows
+    return GroundStructure(
+        facts=facts, fact_index={a: i for i, a in enumerate(facts)},
+        space=space, blocks=tuple(blocks), pre=stacked["pre"],
+        pre_neg=stacked["neg"], add=stacked["add"], delete=stacked["delete"], clauses=clauses,
+        arg_ids=arg_ids,
+    )
+
+
+def fact_matrix(ids: np.ndarray, n: int, read: np.ndarray | None) -> np.ndarray:
+    """Rows of fact ids sorted and unique, padding (ids >= n) and, if `read` is given,
+    facts nothing reads replaced by -1 at the end of the row."""
+    big = np.iinfo(np.int64).max
+    valid = ids < n
+    if read is not None:
+        valid[valid] = read[ids[valid]]
+    out = np.where(valid, ids, big)
+    out.sort(axis=1)
+    if out.shape[1] > 1:
+        dup = np.zeros(out.shape, dtype=bool)
+        dup[:, 1:] = out[:, 1:] == out[:, :-1]
+        out[dup] = big
+        out.sort(axis=1)
+    out[out == big] = -1
+    return out
