@@ -7,7 +7,8 @@ probabilities evaluated from numeric values) is rebuilt for every call.
 
 Both stages work on arrays: the structure (`structure.py`) holds the ground actions as rows of
 fact ids, and the reachability and relevance fixpoints here run over those arrays. Only the
-ground actions that survive become `GroundAction` objects.
+ground actions that survive are kept, as arrays; their `GroundAction` objects are built
+when read (`action_table.py`).
 """
 
 from __future__ import annotations
@@ -20,9 +21,10 @@ from contextlib import contextmanager
 import numpy as np
 from unified_planning.model import FNode, Problem
 
+from avs_planner.cp.action_table import ActionTable
 from avs_planner.cp.schema import LiftedSchema, compile_schemas
 from avs_planner.cp.structure import GroundStructure, bitset, build_structure, fact_matrix
-from avs_planner.cp.task import Atom, GroundAction, GroundTask, TaskArrays, WorldState
+from avs_planner.cp.task import Atom, GroundTask, TaskArrays, WorldState
 from avs_planner.errors import PlanningError
 from avs_planner.pddl.model import ProbabilisticProblem
 
@@ -302,38 +304,28 @@ def _ground(
     read[_ids(goal | goal_neg)] = True
     read[st.pre[kept]] = True
     read[st.pre_neg[kept]] = True
-    rows = np.flatnonzero(kept).tolist()
-    for row in rows:
-        for pos, neg in st.clauses.get(row, ()):
-            read[list(pos)] = True
-            read[list(neg)] = True
+    kept_rows = np.flatnonzero(kept)
+    clauses = {}  # action index -> clauses as bitsets (few rows have any)
+    for row, row_clauses in st.clauses.items():
+        if kept[row]:
+            for pos, neg in row_clauses:
+                read[list(pos)] = True
+                read[list(neg)] = True
+            clauses[int(np.searchsorted(kept_rows, row))] = tuple(
+                (bitset(pos), bitset(neg)) for pos, neg in row_clauses
+            )
     read_mask = _bits(read[:n])
-    actions = []
-    by_signature = {}
-    costs, probabilities = cost.tolist(), probability.tolist()
-    unread = ~read_mask
-    for index, (row, info) in enumerate(zip(rows, st.rows(rows), strict=True)):
-        (name, args, pre, neg, add, delete, pre_facts, add_facts, clauses, assume,
-         signature) = info
-        if add & unread:
-            add &= read_mask
-            add_facts = tuple(f for f in add_facts if read_mask >> f & 1)
-        action = GroundAction(
-            index, name, args, pre, neg, add, delete & read_mask, costs[row],
-            probabilities[row], assume, pre_facts, add_facts, clauses,
-        )
-        actions.append(action)
-        by_signature[signature] = action
-    kept_rows = np.array(rows, dtype=np.int64)
+    cost, probability = cost[kept_rows], probability[kept_rows]
     arrays = TaskArrays(
         pre=fact_matrix(st.pre[kept_rows], n, None),
         pre_neg=fact_matrix(st.pre_neg[kept_rows], n, None),
         add=fact_matrix(st.add[kept_rows], n, read),
         delete=fact_matrix(st.delete[kept_rows], n, read),
-        cost=cost[kept_rows], probability=probability[kept_rows],
+        cost=cost, probability=probability, clauses=clauses,
+        arg_ids=st.arg_ids[kept_rows], objects=st.space.names,
     )
     return GroundTask(
-        facts=structure.facts, fact_index=structure.fact_index, actions=tuple(actions),
-        init=init, goal=goal, goal_neg=goal_neg, goal_impossible=impossible,
-        by_signature=by_signature, arrays=arrays,
+        facts=structure.facts, fact_index=structure.fact_index,
+        actions=ActionTable(st, kept_rows, cost, probability, read_mask),
+        init=init, goal=goal, goal_neg=goal_neg, goal_impossible=impossible, arrays=arrays,
     )

@@ -73,8 +73,9 @@ def _check_actions(task: GroundTask) -> tuple[bytes, bytes, bytes]:
     import numpy as np
 
     actions = task.actions
-    if not all(map(operator.eq, map(operator.attrgetter("index"), actions),
-                   range(len(actions)))):
+    # the grounder's arrays are index-aligned by construction; hand-built tuples are checked
+    if task.arrays is None and not all(map(
+            operator.eq, map(operator.attrgetter("index"), actions), range(len(actions)))):
         bad = next(a for i, a in enumerate(actions) if a.index != i)
         raise PlanningError(f"native search: action {bad.label} has index {bad.index}, "
                             f"not {actions.index(bad)}")
@@ -96,13 +97,22 @@ def _check_actions(task: GroundTask) -> tuple[bytes, bytes, bytes]:
 
 
 def _clauses(task: GroundTask, n_bytes: int, n_facts: int) -> tuple[array, bytes, bytes]:
-    offsets = array("q", [0])
-    offsets.extend(accumulate(map(len, map(operator.attrgetter("clauses"), task.actions))))
+    """CSR offsets per action and the packed (pos, neg) bitsets of the disjunctive clauses."""
+    if task.arrays is not None:
+        by_action = task.arrays.clauses
+    else:
+        by_action = {a.index: a.clauses for a in task.actions if a.clauses}
+    counts = [0] * len(task.actions)
     pos_words, neg_words = [], []
-    for a in (a for a in task.actions if a.clauses):
-        for pos, neg in a.clauses:
-            pos_words.append(_bits(pos, n_bytes, n_facts, lambda a=a: a.label))
-            neg_words.append(_bits(neg, n_bytes, n_facts, lambda a=a: a.label))
+    for i in sorted(by_action):
+        if not 0 <= i < len(counts):
+            raise PlanningError("native search: a clause names an action outside the task")
+        counts[i] = len(by_action[i])
+        for pos, neg in by_action[i]:
+            pos_words.append(_bits(pos, n_bytes, n_facts, lambda i=i: task.actions[i].label))
+            neg_words.append(_bits(neg, n_bytes, n_facts, lambda i=i: task.actions[i].label))
+    offsets = array("q", [0])
+    offsets.extend(accumulate(counts))
     return offsets, b"".join(pos_words), b"".join(neg_words)
 
 

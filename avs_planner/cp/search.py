@@ -191,7 +191,10 @@ def _lazy(task: GroundTask, options: SearchOptions) -> bool:
     classical tasks, hurts where R(1 - p) jumps dominate g); never with admissible h."""
     lazy = options.lazy
     if lazy is None:
-        lazy = all(a.probability == 1.0 for a in task.actions)
+        if task.arrays is not None:
+            lazy = bool((task.arrays.probability == 1.0).all())
+        else:
+            lazy = all(a.probability == 1.0 for a in task.actions)
     return lazy and not get_heuristic(options.heuristic).admissible
 
 
@@ -209,7 +212,8 @@ def _native_search(
         options.timeout_s, options.node_limit, _lazy(task, options), _preferred(options),
         symmetries, start,
     )
-    steps = [task.actions[i] for i in path]
+    take = getattr(task.actions, "take", None)  # an ActionTable builds only these
+    steps = take(path) if take is not None else [task.actions[i] for i in path]
     return _finish(task, options, PlanStatus(status), steps, start, expanded, generated,
                    engine="native")
 

@@ -6,7 +6,7 @@ without grounding again (the continual planner's replans from a new state use it
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
@@ -110,15 +110,25 @@ class TaskArrays:
     delete: np.ndarray
     cost: np.ndarray
     probability: np.ndarray
+    clauses: Mapping[int, tuple[tuple[int, int], ...]] = field(default_factory=dict)
+    """Action index -> its disjunctive preconditions as in `GroundAction.clauses` (only the
+    actions that have some)."""
+    arg_ids: np.ndarray | None = None
+    """(actions, max arity) object ids of each action's arguments, padded with -1."""
+    objects: Sequence[str] = ()
+    """Object names by id (the ids of `arg_ids`)."""
 
 
 @dataclass(frozen=True)
 class GroundTask:
-    """Facts, reachable ground actions, initial state and goal of one planning call."""
+    """Facts, reachable ground actions, initial state and goal of one planning call.
+
+    `actions` is a tuple, or (from the grounder) an `ActionTable` that builds each
+    `GroundAction` on first access; action i has index i either way."""
 
     facts: tuple[Atom, ...]
     fact_index: Mapping[Atom, int]
-    actions: tuple[GroundAction, ...]
+    actions: Sequence[GroundAction]
     init: int
     goal: int
     goal_neg: int = 0
@@ -144,6 +154,9 @@ class GroundTask:
 
     def action(self, name: str, args: Iterable[str]) -> GroundAction | None:
         """The ground action with this name and arguments, if it is in the task."""
+        find = getattr(self.actions, "find", None)
+        if find is not None:
+            return find(name, tuple(args))
         return self.by_signature.get((name.lower(), *(a.lower() for a in args)))
 
     def with_init(self, init: int) -> GroundTask:

@@ -291,9 +291,6 @@ def test_packing_from_the_grounder_arrays_equals_packing_from_actions(name):
 
 
 def _generated_p8():
-    import sys
-
-    sys.path.insert(0, str(ROOT))
     from avs_planner.pddl import read_text
     from bench.avs_generator import AvsSize, generate
 

@@ -1,0 +1,68 @@
+"""The grounder's lazy action table: the same actions as building them all, found by name
+and arguments without building the others, and the symmetries read from its arrays."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pytest
+
+from avs_planner.cp.action_table import ActionTable
+from avs_planner.cp.grounding import GroundingCache, ground, world_state
+from avs_planner.cp.symmetry import find_symmetries
+from avs_planner.pddl import read_text
+from bench.avs_generator import AvsSize, generate
+
+from .conftest import AVS_DOMAIN
+
+
+@pytest.fixture(scope="module")
+def generated():
+    text = generate(AvsSize(8, 2, 2, 4), 0)
+    return read_text(AVS_DOMAIN.read_text(), text, "domain.pddl", "p8.pddl")
+
+
+def test_every_action_is_found_by_name_and_arguments(corridor, generated):
+    for pproblem in (corridor, generated):
+        task = ground(pproblem, cache=GroundingCache())
+        assert isinstance(task.actions, ActionTable)
+        for action in task.actions:
+            assert task.action(action.name, action.args) == action
+            assert task.action(action.name.upper(), [a.upper() for a in action.args]) == action
+
+
+def test_lookup_misses_say_none(corridor):
+    task = ground(corridor, cache=GroundingCache())
+    move = next(a for a in task.actions if a.name == "move")
+    assert task.action("move", move.args[:-1]) is None  # wrong arity
+    assert task.action("move", (*move.args[:-1], "no-such-place")) is None
+    assert task.action("no-such-action", move.args) is None
+    # a ground action the grounder pruned (a move from a place to itself is not in the task)
+    assert task.action("move", (move.args[0], move.args[0])) is None
+
+
+def test_lazy_access_in_any_order_gives_the_same_actions(generated):
+    cache = GroundingCache()
+    state = world_state(generated.problem)
+    eager = tuple(ground(generated, state, cache).actions)
+    lazy = ground(generated, state, cache).actions
+    picked = [len(lazy) - 1, 7, 0, 7]
+    assert lazy.take(picked) == [eager[i] for i in picked]
+    assert lazy[-1] == eager[-1] and lazy[3] == eager[3]
+    assert lazy[2:9] == eager[2:9]
+    assert tuple(lazy) == eager and lazy == eager
+    assert all(a.index == i for i, a in enumerate(lazy))
+    with pytest.raises(IndexError):
+        lazy[len(eager)]
+
+
+def test_symmetries_from_the_arrays_match_those_from_the_actions(generated, corridor):
+    for pproblem in (corridor, generated):
+        state = world_state(pproblem.problem)
+        task = ground(pproblem, state, GroundingCache())
+        from_arrays = find_symmetries(pproblem, state, task)
+        plain = replace(task, actions=tuple(task.actions), arrays=None)
+        from_actions = find_symmetries(pproblem, state, plain)
+        assert from_arrays.checks  # both problems pre-allocate interchangeable objects
+        assert dict(from_arrays.checks) == dict(from_actions.checks)
+        assert from_arrays.groups == from_actions.groups
