@@ -10,8 +10,8 @@ $(BIN)/python:
 	$(BIN)/python -m pip install -q --upgrade pip
 
 # Stamp files: reinstall when pyproject.toml, setup.py or the C search core change (the
-# install compiles avs_planner/cp/_native.c in place).
-NATIVE := setup.py avs_planner/cp/_native.c
+# install compiles the extensions in avs_planner/cp in place).
+NATIVE := setup.py avs_planner/cp/_native.c avs_planner/cp/_fixpoint.c
 
 $(VENV)/.installed: pyproject.toml $(NATIVE) | $(BIN)/python
 	$(BIN)/python -m pip install -q -e .

@@ -1,4 +1,5 @@
-"""Build of the optional compiled search core; the project's metadata is in pyproject.toml."""
+"""Build of the optional compiled search core and grounding fixpoints; the project's
+metadata is in pyproject.toml."""
 
 from setuptools import Extension, setup
 
@@ -10,6 +11,12 @@ setup(
             # -ffp-contract=off: no fused multiply-add, so every float matches the Python search
             extra_compile_args=["-O2", "-std=c11", "-ffp-contract=off"],
             optional=True,
-        )
+        ),
+        Extension(
+            "avs_planner.cp._fixpoint",
+            ["avs_planner/cp/_fixpoint.c"],
+            extra_compile_args=["-O2", "-std=c11"],
+            optional=True,
+        ),
     ]
 )

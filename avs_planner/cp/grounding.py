@@ -28,6 +28,11 @@ from avs_planner.cp.task import Atom, GroundTask, TaskArrays, WorldState
 from avs_planner.errors import PlanningError
 from avs_planner.pddl.model import ProbabilisticProblem
 
+try:  # the compiled fixpoints; the numpy versions below compute the same when not built
+    from avs_planner.cp import _fixpoint
+except ImportError:
+    _fixpoint = None
+
 
 def world_state(problem: Problem) -> WorldState:
     """The problem's initial state as atoms and numeric values (explicit :init entries)."""
@@ -88,6 +93,17 @@ def _ids(mask: int) -> list[int]:
 def _reachable(st: GroundStructure, init: np.ndarray, allowed: np.ndarray) -> np.ndarray:
     """Relaxed reachability (negative preconditions and clauses ignored) over the rows in
     `allowed`: the rows that may ever apply. `init` is a boolean array over fact ids + pads."""
+    if _fixpoint is None:
+        return _reachable_numpy(st, init, allowed)
+    n = len(st.facts)
+    flags = _fixpoint.reachable(
+        st.size, st.pre, st.pre.shape[1], st.add, st.add.shape[1], n + 2, n + 1,
+        np.ascontiguousarray(init, dtype=bool), np.ascontiguousarray(allowed, dtype=bool),
+    )
+    return np.frombuffer(flags, dtype=bool)
+
+
+def _reachable_numpy(st: GroundStructure, init: np.ndarray, allowed: np.ndarray) -> np.ndarray:
     reached = init.copy()
     active = np.zeros(st.size, dtype=bool)
     waiting = np.flatnonzero(allowed)
@@ -111,6 +127,50 @@ def _relevant(st: GroundStructure, allowed: np.ndarray, goal: int, goal_neg: int
     """Backward relevance: keep actions that add a fact needed true or delete one needed
     false, where needs grow by the kept actions' conditions. Dropping the rest loses no plan
     (they can be cut from any plan, which only lowers its cost and raises its probability)."""
+    if _fixpoint is None:
+        return _relevant_numpy(st, allowed, goal, goal_neg)
+    offsets, positives, negatives = _clause_csr(st)
+    goal_ids = np.array(_ids(goal), dtype=np.int64)
+    goal_neg_ids = np.array(_ids(goal_neg), dtype=np.int64)
+    flags = _fixpoint.relevant(
+        st.size, len(st.facts), len(st.facts) + 2, st.add, st.add.shape[1],
+        st.delete, st.delete.shape[1], st.pre, st.pre.shape[1], st.pre_neg,
+        st.pre_neg.shape[1], offsets, positives, len(positives), negatives, len(negatives),
+        np.ascontiguousarray(allowed, dtype=bool), goal_ids, len(goal_ids), goal_neg_ids,
+        len(goal_neg_ids),
+    )
+    return np.frombuffer(flags, dtype=bool)
+
+
+_CLAUSE_CSR: OrderedDict[int, tuple[GroundStructure, tuple]] = OrderedDict()
+
+
+def _clause_csr(st: GroundStructure) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The structure's clause facts per row for `_fixpoint.relevant`: interleaved offsets
+    (row r's positives start at [2r], its negatives at [2r + 1]) and the two fact lists;
+    kept for the last few structures."""
+    hit = _CLAUSE_CSR.get(id(st))
+    if hit is not None and hit[0] is st:
+        return hit[1]
+    counts = np.zeros((st.size + 1, 2), dtype=np.int64)
+    positives: list[int] = []
+    negatives: list[int] = []
+    for row in sorted(st.clauses):
+        for pos, neg in st.clauses[row]:
+            positives.extend(pos)
+            negatives.extend(neg)
+        counts[row + 1] = (len(positives), len(negatives))
+    offsets = np.maximum.accumulate(counts, axis=0)  # rows without clauses repeat the last
+    csr = (offsets.ravel(), np.array(positives, dtype=np.int64),
+           np.array(negatives, dtype=np.int64))
+    _CLAUSE_CSR[id(st)] = (st, csr)  # a strong ref keeps the id unique
+    while len(_CLAUSE_CSR) > 16:
+        _CLAUSE_CSR.popitem(last=False)
+    return csr
+
+
+def _relevant_numpy(st: GroundStructure, allowed: np.ndarray, goal: int, goal_neg: int
+                    ) -> np.ndarray:
     n = len(st.facts)
     need_true = np.zeros(n + 2, dtype=bool)
     need_false = np.zeros(n + 2, dtype=bool)
