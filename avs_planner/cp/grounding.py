@@ -22,16 +22,12 @@ import numpy as np
 from unified_planning.model import FNode, Problem
 
 from avs_planner.cp.action_table import ActionTable
+from avs_planner.cp.derived import ids_of, reachable, relevant, task_rows
 from avs_planner.cp.schema import LiftedSchema, compile_schemas
-from avs_planner.cp.structure import GroundStructure, bitset, build_structure, fact_matrix
+from avs_planner.cp.structure import GroundStructure, bitset, build_structure
 from avs_planner.cp.task import Atom, GroundTask, TaskArrays, WorldState
 from avs_planner.errors import PlanningError
 from avs_planner.pddl.model import ProbabilisticProblem
-
-try:  # the compiled fixpoints; the numpy versions below compute the same when not built
-    from avs_planner.cp import _fixpoint
-except ImportError:
-    _fixpoint = None
 
 
 def world_state(problem: Problem) -> WorldState:
@@ -78,122 +74,6 @@ def _flatten(node: FNode) -> list[FNode]:
     if node.is_and():
         return [c for a in node.args for c in _flatten(a)]
     return [node]
-
-
-def _ids(mask: int) -> list[int]:
-    out, i = [], 0
-    while mask:
-        if mask & 1:
-            out.append(i)
-        mask >>= 1
-        i += 1
-    return out
-
-
-def _reachable(st: GroundStructure, init: np.ndarray, allowed: np.ndarray) -> np.ndarray:
-    """Relaxed reachability (negative preconditions and clauses ignored) over the rows in
-    `allowed`: the rows that may ever apply. `init` is a boolean array over fact ids + pads."""
-    if _fixpoint is None:
-        return _reachable_numpy(st, init, allowed)
-    n = len(st.facts)
-    flags = _fixpoint.reachable(
-        st.size, st.pre, st.pre.shape[1], st.add, st.add.shape[1], n + 2, n + 1,
-        np.ascontiguousarray(init, dtype=bool), np.ascontiguousarray(allowed, dtype=bool),
-    )
-    return np.frombuffer(flags, dtype=bool)
-
-
-def _reachable_numpy(st: GroundStructure, init: np.ndarray, allowed: np.ndarray) -> np.ndarray:
-    reached = init.copy()
-    active = np.zeros(st.size, dtype=bool)
-    waiting = np.flatnonzero(allowed)
-    none = len(st.facts) + 1
-    while len(waiting):
-        ok = reached[st.pre[waiting]].all(axis=1)
-        if not ok.any():
-            break
-        new = waiting[ok]
-        waiting = waiting[~ok]
-        active[new] = True
-        before = int(reached.sum())
-        reached[st.add[new]] = True
-        reached[none] = False
-        if int(reached.sum()) == before:
-            break
-    return active
-
-
-def _relevant(st: GroundStructure, allowed: np.ndarray, goal: int, goal_neg: int) -> np.ndarray:
-    """Backward relevance: keep actions that add a fact needed true or delete one needed
-    false, where needs grow by the kept actions' conditions. Dropping the rest loses no plan
-    (they can be cut from any plan, which only lowers its cost and raises its probability)."""
-    if _fixpoint is None:
-        return _relevant_numpy(st, allowed, goal, goal_neg)
-    offsets, positives, negatives = _clause_csr(st)
-    goal_ids = np.array(_ids(goal), dtype=np.int64)
-    goal_neg_ids = np.array(_ids(goal_neg), dtype=np.int64)
-    flags = _fixpoint.relevant(
-        st.size, len(st.facts), len(st.facts) + 2, st.add, st.add.shape[1],
-        st.delete, st.delete.shape[1], st.pre, st.pre.shape[1], st.pre_neg,
-        st.pre_neg.shape[1], offsets, positives, len(positives), negatives, len(negatives),
-        np.ascontiguousarray(allowed, dtype=bool), goal_ids, len(goal_ids), goal_neg_ids,
-        len(goal_neg_ids),
-    )
-    return np.frombuffer(flags, dtype=bool)
-
-
-_CLAUSE_CSR: OrderedDict[int, tuple[GroundStructure, tuple]] = OrderedDict()
-
-
-def _clause_csr(st: GroundStructure) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The structure's clause facts per row for `_fixpoint.relevant`: interleaved offsets
-    (row r's positives start at [2r], its negatives at [2r + 1]) and the two fact lists;
-    kept for the last few structures."""
-    hit = _CLAUSE_CSR.get(id(st))
-    if hit is not None and hit[0] is st:
-        return hit[1]
-    counts = np.zeros((st.size + 1, 2), dtype=np.int64)
-    positives: list[int] = []
-    negatives: list[int] = []
-    for row in sorted(st.clauses):
-        for pos, neg in st.clauses[row]:
-            positives.extend(pos)
-            negatives.extend(neg)
-        counts[row + 1] = (len(positives), len(negatives))
-    offsets = np.maximum.accumulate(counts, axis=0)  # rows without clauses repeat the last
-    csr = (offsets.ravel(), np.array(positives, dtype=np.int64),
-           np.array(negatives, dtype=np.int64))
-    _CLAUSE_CSR[id(st)] = (st, csr)  # a strong ref keeps the id unique
-    while len(_CLAUSE_CSR) > 16:
-        _CLAUSE_CSR.popitem(last=False)
-    return csr
-
-
-def _relevant_numpy(st: GroundStructure, allowed: np.ndarray, goal: int, goal_neg: int
-                    ) -> np.ndarray:
-    n = len(st.facts)
-    need_true = np.zeros(n + 2, dtype=bool)
-    need_false = np.zeros(n + 2, dtype=bool)
-    need_true[_ids(goal)] = True
-    need_false[_ids(goal_neg)] = True
-    kept = np.zeros(st.size, dtype=bool)
-    waiting = np.flatnonzero(allowed)
-    while len(waiting):
-        hit = need_true[st.add[waiting]].any(axis=1) | need_false[st.delete[waiting]].any(axis=1)
-        if not hit.any():
-            break
-        new = waiting[hit]
-        waiting = waiting[~hit]
-        kept[new] = True
-        need_true[st.pre[new]] = True
-        need_false[st.pre_neg[new]] = True
-        for row in new.tolist():
-            for pos, neg in st.clauses.get(row, ()):
-                need_true[list(pos)] = True
-                need_false[list(neg)] = True
-        need_true[n:] = False
-        need_false[n:] = False
-    return kept
 
 
 def _evaluate(st: GroundStructure, rows: np.ndarray, values: Mapping[Atom, float],
@@ -254,6 +134,7 @@ class GroundingCache:
         self._schemas: OrderedDict[tuple, tuple[LiftedSchema, ...]] = OrderedDict()
         self._structures: OrderedDict[tuple, GroundStructure] = OrderedDict()
         self._problem_keys: OrderedDict[int, tuple] = OrderedDict()
+        self._initial: OrderedDict[int, tuple[ProbabilisticProblem, WorldState]] = OrderedDict()
         self.hits = 0
         self.misses = 0
 
@@ -292,6 +173,18 @@ class GroundingCache:
         if len(self._problem_keys) > self.size:
             self._problem_keys.popitem(last=False)
         return key, static_names
+
+    def initial_state(self, pproblem: ProbabilisticProblem) -> WorldState:
+        """`world_state` of the problem's :init, kept for the last few problem objects (a
+        problem is not changed once planned)."""
+        hit = self._initial.get(id(pproblem))
+        if hit is not None and hit[0] is pproblem:
+            return hit[1]
+        state = world_state(pproblem.problem)
+        self._initial[id(pproblem)] = (pproblem, state)  # a strong ref keeps the id unique
+        while len(self._initial) > self.size:
+            self._initial.popitem(last=False)
+        return state
 
     def structure(self, pproblem: ProbabilisticProblem, state: WorldState) -> GroundStructure:
         problem = pproblem.problem
@@ -339,7 +232,7 @@ def _ground(
     pproblem: ProbabilisticProblem, state: WorldState | None, cache: GroundingCache | None
 ) -> GroundTask:
     cache = DEFAULT_CACHE if cache is None else cache
-    state = world_state(pproblem.problem) if state is None else state
+    state = cache.initial_state(pproblem) if state is None else state
     structure = cache.structure(pproblem, state)
     st = structure
     n = len(st.facts)
@@ -351,17 +244,17 @@ def _ground(
     reached[n] = True  # the padding of preconditions
     # drop actions that can never succeed (p = 0), then what only they made reachable;
     # only reachable actions are evaluated (others may read values :init does not give)
-    reachable = _reachable(st, reached, np.ones(st.size, dtype=bool))
-    probability = _evaluate(st, reachable, state.values, "prob")
-    _check(st, reachable, probability, "prob")
-    possible = reachable & (probability > 0.0)
-    kept = _relevant(st, _reachable(st, reached, possible), goal, goal_neg)
+    may_apply = reachable(st, reached, np.ones(st.size, dtype=bool))
+    probability = _evaluate(st, may_apply, state.values, "prob")
+    _check(st, may_apply, probability, "prob")
+    possible = may_apply & (probability > 0.0)
+    kept = relevant(st, reachable(st, reached, possible), goal, goal_neg)
     cost = _evaluate(st, kept, state.values, "cost")
     _check(st, kept, cost, "cost")
     # effects on facts nothing reads are dropped (e.g. `visited` of ordinary places), so
     # states differing only there merge
     read = np.zeros(n + 2, dtype=bool)
-    read[_ids(goal | goal_neg)] = True
+    read[ids_of(goal | goal_neg)] = True
     read[st.pre[kept]] = True
     read[st.pre_neg[kept]] = True
     kept_rows = np.flatnonzero(kept)
@@ -376,11 +269,9 @@ def _ground(
             )
     read_mask = _bits(read[:n])
     cost, probability = cost[kept_rows], probability[kept_rows]
+    (pre, pre_neg, add, delete), bits = task_rows(st, kept_rows, read)
     arrays = TaskArrays(
-        pre=fact_matrix(st.pre[kept_rows], n, None),
-        pre_neg=fact_matrix(st.pre_neg[kept_rows], n, None),
-        add=fact_matrix(st.add[kept_rows], n, read),
-        delete=fact_matrix(st.delete[kept_rows], n, read),
+        pre=pre, pre_neg=pre_neg, add=add, delete=delete, bits=bits,
         cost=cost, probability=probability, clauses=clauses,
         arg_ids=st.arg_ids[kept_rows], objects=st.space.names,
     )

@@ -14,7 +14,7 @@ import sys
 import time
 from array import array
 from collections import OrderedDict
-from itertools import accumulate, chain
+from itertools import chain
 
 from avs_planner.cp.symmetry import Symmetries
 from avs_planner.cp.task import GroundTask
@@ -96,24 +96,26 @@ def _check_actions(task: GroundTask) -> tuple[bytes, bytes, bytes]:
     return cost.tobytes(), probability.tobytes(), logs[inverse].tobytes()
 
 
-def _clauses(task: GroundTask, n_bytes: int, n_facts: int) -> tuple[array, bytes, bytes]:
+def _clauses(task: GroundTask, n_bytes: int, n_facts: int) -> tuple[bytes, bytes, bytes]:
     """CSR offsets per action and the packed (pos, neg) bitsets of the disjunctive clauses."""
+    import numpy as np
+
     if task.arrays is not None:
         by_action = task.arrays.clauses
     else:
         by_action = {a.index: a.clauses for a in task.actions if a.clauses}
-    counts = [0] * len(task.actions)
+    n_actions = len(task.actions)
+    offsets = np.zeros(n_actions + 1, dtype="<i8")
     pos_words, neg_words = [], []
     for i in sorted(by_action):
-        if not 0 <= i < len(counts):
+        if not 0 <= i < n_actions:
             raise PlanningError("native search: a clause names an action outside the task")
-        counts[i] = len(by_action[i])
+        offsets[i + 1] = len(by_action[i])
         for pos, neg in by_action[i]:
             pos_words.append(_bits(pos, n_bytes, n_facts, lambda i=i: task.actions[i].label))
             neg_words.append(_bits(neg, n_bytes, n_facts, lambda i=i: task.actions[i].label))
-    offsets = array("q", [0])
-    offsets.extend(accumulate(counts))
-    return offsets, b"".join(pos_words), b"".join(neg_words)
+    np.cumsum(offsets, out=offsets)
+    return offsets.tobytes(), b"".join(pos_words), b"".join(neg_words)
 
 
 def _csr(lists, n_facts: int, where: str) -> tuple[array, array]:
@@ -174,7 +176,14 @@ def task_arrays(task: GroundTask) -> tuple:
 
     pre, neg, add, delete = (matrix(m) for m in (arrays.pre, arrays.pre_neg, arrays.add,
                                                  arrays.delete))
-    return (n_facts, n_actions, bitsets(pre), bitsets(neg), bitsets(add), bitsets(delete),
+    given = arrays.bits
+    if given is not None and all(
+        b.dtype == np.dtype("<u8") and b.shape == (n_actions, n_words) for b in given
+    ):
+        masks = tuple(np.ascontiguousarray(b).tobytes() for b in given)
+    else:
+        masks = (bitsets(pre), bitsets(neg), bitsets(add), bitsets(delete))
+    return (n_facts, n_actions, *masks,
             *_check_actions(task), *csr(pre), *csr(add),
             *_clauses(task, 8 * n_words, n_facts))
 

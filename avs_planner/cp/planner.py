@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 
-from avs_planner.cp.grounding import GroundingCache, gc_paused, ground, world_state
+from avs_planner.cp.grounding import DEFAULT_CACHE, GroundingCache, gc_paused, ground
 from avs_planner.cp.search import PlanResult, SearchOptions, search
 from avs_planner.cp.symmetry import NO_SYMMETRIES, find_symmetries
 from avs_planner.cp.task import GroundTask, WorldState
@@ -22,7 +22,8 @@ def plan(
     options = (options or SearchOptions()).check()
     with gc_paused():
         start = time.perf_counter()
-        state = world_state(pproblem.problem) if state is None else state
+        if state is None:
+            state = (DEFAULT_CACHE if cache is None else cache).initial_state(pproblem)
         task = ground(pproblem, state, cache)
         symmetries = (
             find_symmetries(pproblem, state, task) if options.symmetry else NO_SYMMETRIES

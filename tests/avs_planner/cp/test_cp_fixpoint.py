@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from unified_planning.io import PDDLReader
 
-from avs_planner.cp import grounding
+from avs_planner.cp import derived
 from avs_planner.cp.grounding import GroundingCache, world_state
 from avs_planner.pddl import read_text
 from avs_planner.pddl.model import ProbabilisticProblem
@@ -44,7 +44,7 @@ DISJUNCTIVE_PROBLEM = """
   (:goal (and (at r4))))
 """
 
-needs_fixpoint = pytest.mark.skipif(grounding._fixpoint is None,
+needs_fixpoint = pytest.mark.skipif(derived._fixpoint is None,
                                     reason="compiled fixpoints not built")
 
 
@@ -52,7 +52,7 @@ def test_the_compiled_fixpoints_are_built():
     """CI must not fall back silently: set AVS_ALLOW_NO_NATIVE=1 where no compiler exists."""
     if os.environ.get("AVS_ALLOW_NO_NATIVE") == "1":
         pytest.skip("AVS_ALLOW_NO_NATIVE=1")
-    assert grounding._fixpoint is not None, "avs_planner.cp._fixpoint did not import"
+    assert derived._fixpoint is not None, "avs_planner.cp._fixpoint did not import"
 
 
 def _problems(corridor):
@@ -82,12 +82,12 @@ def test_compiled_fixpoints_match_numpy(corridor):
             init[:n] = rng.random(n) < (0.1 if trial % 2 else 0.4)
             init[n] = True
             allowed = rng.random(st.size) < (1.0 if trial < 3 else 0.7)
-            reach = grounding._reachable(st, init, allowed)
-            assert np.array_equal(reach, grounding._reachable_numpy(st, init, allowed))
+            reach = derived.reachable(st, init, allowed)
+            assert np.array_equal(reach, derived.reachable_numpy(st, init, allowed))
             goal = sum(1 << f for f in pick.sample(range(n), min(n, 3)))
             goal_neg = sum(1 << f for f in pick.sample(range(n), min(n, trial % 3)))
-            kept = grounding._relevant(st, reach, goal, goal_neg)
-            assert np.array_equal(kept, grounding._relevant_numpy(st, reach, goal, goal_neg))
+            kept = derived.relevant(st, reach, goal, goal_neg)
+            assert np.array_equal(kept, derived.relevant_numpy(st, reach, goal, goal_neg))
             assert not (kept & ~reach).any()
     assert clause_rows  # the disjunctive domain exercised the clause facts
 

@@ -1,0 +1,198 @@
+"""Arrays derived from a grounding structure, and the per-call fixpoints that run on them.
+
+`derived(st)` is computed once per cached `GroundStructure` (kept for the last few): each
+row's facts sorted and unique, as fact-id matrices and as uint64 bitset words, and the rows'
+clause facts as CSR. A planning call then takes its kept rows from these (`task_rows`) instead
+of sorting and packing again. `reachable` and `relevant` are the grounder's two fixpoints, in C
+(`avs_planner.cp._fixpoint`) when built, else in numpy (the same result; tests compare them).
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from dataclasses import dataclass
+
+import numpy as np
+
+from avs_planner.cp.structure import GroundStructure, fact_matrix
+
+try:  # the compiled fixpoints; the numpy versions below compute the same when not built
+    from avs_planner.cp import _fixpoint
+except ImportError:
+    _fixpoint = None
+
+_BIG = np.iinfo(np.int64).max
+
+
+def ids_of(mask: int) -> np.ndarray:
+    """The fact ids of a Python int bitset, ascending."""
+    if not mask:
+        return np.zeros(0, dtype=np.int64)
+    data = np.frombuffer(mask.to_bytes((mask.bit_length() + 7) // 8, "little"), np.uint8)
+    return np.flatnonzero(np.unpackbits(data, bitorder="little")).astype(np.int64)
+
+
+def bit_words(matrix: np.ndarray, n_facts: int) -> np.ndarray:
+    """Each row's fact ids (>= 0; -1 is padding) as little-endian uint64 words, one spare bit
+    so that n_facts = 0 still has a word (the native core's layout)."""
+    words = n_facts // 64 + 1
+    out = np.zeros((matrix.shape[0], words), dtype="<u8")
+    rows, cols = np.nonzero(matrix >= 0)
+    facts = matrix[rows, cols]
+    np.bitwise_or.at(out, (rows, facts >> 6),
+                     np.left_shift(np.uint64(1), (facts & 63).astype(np.uint64)))
+    return out
+
+
+@dataclass(frozen=True)
+class Derived:
+    """Per structure row: sorted unique fact ids (-1 padded at the end) and bitset words of
+    pre, pre_neg, add, delete; clause facts as (interleaved offsets, positives, negatives)."""
+
+    pre: np.ndarray
+    pre_neg: np.ndarray
+    add: np.ndarray
+    delete: np.ndarray
+    pre_bits: np.ndarray
+    neg_bits: np.ndarray
+    add_bits: np.ndarray
+    delete_bits: np.ndarray
+    clauses: tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+_DERIVED: OrderedDict[int, tuple[GroundStructure, Derived]] = OrderedDict()
+
+
+def derived(st: GroundStructure) -> Derived:
+    """The structure's derived arrays, kept for the last few structures."""
+    hit = _DERIVED.get(id(st))
+    if hit is not None and hit[0] is st:
+        _DERIVED.move_to_end(id(st))
+        return hit[1]
+    n = len(st.facts)
+    pre, neg, add, delete = (fact_matrix(m, n, None)
+                             for m in (st.pre, st.pre_neg, st.add, st.delete))
+    value = Derived(pre, neg, add, delete, bit_words(pre, n), bit_words(neg, n),
+                    bit_words(add, n), bit_words(delete, n), _clause_csr(st))
+    _DERIVED[id(st)] = (st, value)  # a strong ref keeps the id unique
+    while len(_DERIVED) > 16:
+        _DERIVED.popitem(last=False)
+    return value
+
+
+def _clause_csr(st: GroundStructure) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Clause facts per row for `_fixpoint.relevant`: interleaved offsets (row r's
+    positives start at [2r], its negatives at [2r + 1]) and the two fact lists."""
+    counts = np.zeros((st.size + 1, 2), dtype=np.int64)
+    positives: list[int] = []
+    negatives: list[int] = []
+    for row in sorted(st.clauses):
+        for pos, neg in st.clauses[row]:
+            positives.extend(pos)
+            negatives.extend(neg)
+        counts[row + 1] = (len(positives), len(negatives))
+    offsets = np.maximum.accumulate(counts, axis=0)  # rows without clauses repeat the last
+    return (offsets.ravel(), np.array(positives, dtype=np.int64),
+            np.array(negatives, dtype=np.int64))
+
+
+def task_rows(st: GroundStructure, kept_rows: np.ndarray, read: np.ndarray
+              ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
+    """The kept rows' (pre, pre_neg, add, delete) fact-id matrices and bitset words, with
+    add and delete facts that `read` (bool over fact ids + pads) does not mark removed:
+    what `fact_matrix(rows, n, read)` gives, from the cached sorted rows."""
+    d = derived(st)
+    n = len(st.facts)
+    read_words = bit_words(np.flatnonzero(read[:n])[None, :], n)[0]
+    matrices = [d.pre[kept_rows], d.pre_neg[kept_rows]]
+    for m in (d.add[kept_rows], d.delete[kept_rows]):
+        drop = (m >= 0) & ~read[m]
+        if drop.any():
+            m = np.where(drop | (m < 0), _BIG, m)
+            m.sort(axis=1)
+            m[m == _BIG] = -1
+        matrices.append(m)
+    bits = (d.pre_bits[kept_rows], d.neg_bits[kept_rows], d.add_bits[kept_rows] & read_words,
+            d.delete_bits[kept_rows] & read_words)
+    return tuple(matrices), bits
+
+
+def reachable(st: GroundStructure, init: np.ndarray, allowed: np.ndarray) -> np.ndarray:
+    """Relaxed reachability (negative preconditions and clauses ignored) over the rows in
+    `allowed`: the rows that may ever apply. `init` is a boolean array over fact ids + pads."""
+    if _fixpoint is None:
+        return reachable_numpy(st, init, allowed)
+    n = len(st.facts)
+    flags = _fixpoint.reachable(
+        st.size, st.pre, st.pre.shape[1], st.add, st.add.shape[1], n + 2, n + 1,
+        np.ascontiguousarray(init, dtype=bool), np.ascontiguousarray(allowed, dtype=bool),
+    )
+    return np.frombuffer(flags, dtype=bool)
+
+
+def reachable_numpy(st: GroundStructure, init: np.ndarray, allowed: np.ndarray) -> np.ndarray:
+    reached = init.copy()
+    active = np.zeros(st.size, dtype=bool)
+    waiting = np.flatnonzero(allowed)
+    none = len(st.facts) + 1
+    while len(waiting):
+        ok = reached[st.pre[waiting]].all(axis=1)
+        if not ok.any():
+            break
+        new = waiting[ok]
+        waiting = waiting[~ok]
+        active[new] = True
+        before = int(reached.sum())
+        reached[st.add[new]] = True
+        reached[none] = False
+        if int(reached.sum()) == before:
+            break
+    return active
+
+
+def relevant(st: GroundStructure, allowed: np.ndarray, goal: int, goal_neg: int) -> np.ndarray:
+    """Backward relevance: keep actions that add a fact needed true or delete one needed
+    false, where needs grow by the kept actions' conditions. Dropping the rest loses no plan
+    (they can be cut from any plan, which only lowers its cost and raises its probability)."""
+    if _fixpoint is None:
+        return relevant_numpy(st, allowed, goal, goal_neg)
+    offsets, positives, negatives = derived(st).clauses
+    goal_ids = ids_of(goal)
+    goal_neg_ids = ids_of(goal_neg)
+    flags = _fixpoint.relevant(
+        st.size, len(st.facts), len(st.facts) + 2, st.add, st.add.shape[1],
+        st.delete, st.delete.shape[1], st.pre, st.pre.shape[1], st.pre_neg,
+        st.pre_neg.shape[1], offsets, positives, len(positives), negatives, len(negatives),
+        np.ascontiguousarray(allowed, dtype=bool), goal_ids, len(goal_ids), goal_neg_ids,
+        len(goal_neg_ids),
+    )
+    return np.frombuffer(flags, dtype=bool)
+
+
+def relevant_numpy(st: GroundStructure, allowed: np.ndarray, goal: int, goal_neg: int
+                    ) -> np.ndarray:
+    n = len(st.facts)
+    need_true = np.zeros(n + 2, dtype=bool)
+    need_false = np.zeros(n + 2, dtype=bool)
+    need_true[ids_of(goal)] = True
+    need_false[ids_of(goal_neg)] = True
+    kept = np.zeros(st.size, dtype=bool)
+    waiting = np.flatnonzero(allowed)
+    while len(waiting):
+        hit = need_true[st.add[waiting]].any(axis=1) | need_false[st.delete[waiting]].any(axis=1)
+        if not hit.any():
+            break
+        new = waiting[hit]
+        waiting = waiting[~hit]
+        kept[new] = True
+        need_true[st.pre[new]] = True
+        need_false[st.pre_neg[new]] = True
+        for row in new.tolist():
+            for pos, neg in st.clauses.get(row, ()):
+                need_true[list(pos)] = True
+                need_false[list(neg)] = True
+        need_true[n:] = False
+        need_false[n:] = False
+    return kept
+
+
