@@ -1,16 +1,16 @@
 """Arrays derived from a grounding structure, and the per-call fixpoints that run on them.
 
-`derived(st)` is computed once per cached `GroundStructure` (kept for the last few): each
-row's facts sorted and unique, as fact-id matrices and as uint64 bitset words, and the rows'
-clause facts as CSR. A planning call then takes its kept rows from these (`task_rows`) instead
-of sorting and packing again. `reachable` and `relevant` are the grounder's two fixpoints, in C
-(`avs_planner.cp._fixpoint`) when built, else in numpy (the same result; tests compare them).
+`derived(st)` is kept per cached `GroundStructure` (for the last few). It fills in, as calls
+need rows, each row's facts sorted and unique, as fact-id matrices and as uint64 bitset words;
+it also holds the rows' clause facts as CSR. A planning call takes its kept rows from these
+(`task_rows`) instead of sorting and packing them again. `reachable` and `relevant` are the
+grounder's two fixpoints, in C (`avs_planner.cp._fixpoint`) when built, else in numpy (the
+same result; tests compare them).
 """
 
 from __future__ import annotations
 
 from collections import OrderedDict
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -44,20 +44,32 @@ def bit_words(matrix: np.ndarray, n_facts: int) -> np.ndarray:
     return out
 
 
-@dataclass(frozen=True)
 class Derived:
-    """Per structure row: sorted unique fact ids (-1 padded at the end) and bitset words of
-    pre, pre_neg, add, delete; clause facts as (interleaved offsets, positives, negatives)."""
+    """Per structure row, filled on first use (a call only needs its kept rows): sorted
+    unique fact ids (-1 padded at the end) and bitset words of pre, pre_neg, add, delete.
+    Also the rows' clause facts as (interleaved offsets, positives, negatives)."""
 
-    pre: np.ndarray
-    pre_neg: np.ndarray
-    add: np.ndarray
-    delete: np.ndarray
-    pre_bits: np.ndarray
-    neg_bits: np.ndarray
-    add_bits: np.ndarray
-    delete_bits: np.ndarray
-    clauses: tuple[np.ndarray, np.ndarray, np.ndarray]
+    def __init__(self, st: GroundStructure):
+        self._st = st
+        self._done = np.zeros(st.size, dtype=bool)
+        n_words = len(st.facts) // 64 + 1
+        self.matrices = tuple(np.empty(m.shape, dtype=np.int64)
+                              for m in (st.pre, st.pre_neg, st.add, st.delete))
+        self.bits = tuple(np.empty((st.size, n_words), dtype="<u8") for _ in range(4))
+        self.clauses = _clause_csr(st)
+
+    def rows(self, rows: np.ndarray) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
+        """The four matrices and bitset words of these rows (computing the missing ones)."""
+        missing = rows[~self._done[rows]]
+        if len(missing):
+            st, n = self._st, len(self._st.facts)
+            for source, matrix, bits in zip((st.pre, st.pre_neg, st.add, st.delete),
+                                            self.matrices, self.bits, strict=True):
+                sorted_rows = fact_matrix(source[missing], n, None)
+                matrix[missing] = sorted_rows
+                bits[missing] = bit_words(sorted_rows, n)
+            self._done[missing] = True
+        return (tuple(m[rows] for m in self.matrices), tuple(b[rows] for b in self.bits))
 
 
 _DERIVED: OrderedDict[int, tuple[GroundStructure, Derived]] = OrderedDict()
@@ -69,11 +81,7 @@ def derived(st: GroundStructure) -> Derived:
     if hit is not None and hit[0] is st:
         _DERIVED.move_to_end(id(st))
         return hit[1]
-    n = len(st.facts)
-    pre, neg, add, delete = (fact_matrix(m, n, None)
-                             for m in (st.pre, st.pre_neg, st.add, st.delete))
-    value = Derived(pre, neg, add, delete, bit_words(pre, n), bit_words(neg, n),
-                    bit_words(add, n), bit_words(delete, n), _clause_csr(st))
+    value = Derived(st)
     _DERIVED[id(st)] = (st, value)  # a strong ref keeps the id unique
     while len(_DERIVED) > 16:
         _DERIVED.popitem(last=False)
@@ -101,20 +109,20 @@ def task_rows(st: GroundStructure, kept_rows: np.ndarray, read: np.ndarray
     """The kept rows' (pre, pre_neg, add, delete) fact-id matrices and bitset words, with
     add and delete facts that `read` (bool over fact ids + pads) does not mark removed:
     what `fact_matrix(rows, n, read)` gives, from the cached sorted rows."""
-    d = derived(st)
     n = len(st.facts)
+    (pre, pre_neg, add, delete), (pre_bits, neg_bits, add_bits, delete_bits) = (
+        derived(st).rows(kept_rows)
+    )
     read_words = bit_words(np.flatnonzero(read[:n])[None, :], n)[0]
-    matrices = [d.pre[kept_rows], d.pre_neg[kept_rows]]
-    for m in (d.add[kept_rows], d.delete[kept_rows]):
+    matrices = [pre, pre_neg]
+    for m in (add, delete):
         drop = (m >= 0) & ~read[m]
         if drop.any():
             m = np.where(drop | (m < 0), _BIG, m)
             m.sort(axis=1)
             m[m == _BIG] = -1
         matrices.append(m)
-    bits = (d.pre_bits[kept_rows], d.neg_bits[kept_rows], d.add_bits[kept_rows] & read_words,
-            d.delete_bits[kept_rows] & read_words)
-    return tuple(matrices), bits
+    return tuple(matrices), (pre_bits, neg_bits, add_bits & read_words, delete_bits & read_words)
 
 
 def reachable(st: GroundStructure, init: np.ndarray, allowed: np.ndarray) -> np.ndarray:

@@ -1,6 +1,7 @@
-"""The compiled grounding fixpoints (`avs_planner.cp._fixpoint`) compute what the numpy
-versions compute: relaxed reachability and backward relevance, on structures of AVS, IPC and
-a domain with disjunctive preconditions, from random initial states, allowed rows and goals."""
+"""cp/derived.py: the per-structure rows filled in on demand equal a fresh sort, and the
+compiled grounding fixpoints (`avs_planner.cp._fixpoint`) compute what the numpy versions
+compute: relaxed reachability and backward relevance, on structures of AVS, IPC and a domain
+with disjunctive preconditions, from random initial states, allowed rows and goals."""
 
 from __future__ import annotations
 
@@ -102,3 +103,22 @@ def test_compiled_fixpoints_reject_facts_out_of_range():
         _fixpoint.reachable(1, pre, 2, add, 1, 3, 2, np.ones(3, bool), np.ones(1, bool))
     with pytest.raises(ValueError, match="bytes"):
         _fixpoint.reachable(2, pre, 2, add, 1, 3, 2, np.ones(3, bool), np.ones(1, bool))
+
+
+def test_derived_rows_filled_in_any_order_match_a_fresh_sort(corridor):
+    from avs_planner.cp.derived import Derived, bit_words
+    from avs_planner.cp.structure import fact_matrix
+
+    st = GroundingCache().structure(corridor, world_state(corridor.problem))
+    n = len(st.facts)
+    d = Derived(st)
+    rng = np.random.default_rng(3)
+    for _ in range(3):  # overlapping subsets: later calls reuse rows the earlier ones filled
+        rows = np.sort(rng.choice(st.size, size=st.size // 3, replace=False))
+        matrices, bits = d.rows(rows)
+        for source, m, b in zip((st.pre, st.pre_neg, st.add, st.delete), matrices, bits,
+                                strict=True):
+            expected = fact_matrix(source[rows], n, None)
+            assert np.array_equal(m, expected)
+            assert np.array_equal(b, bit_words(expected, n))
+    assert d.rows(np.zeros(0, dtype=np.int64))[0][0].shape[0] == 0
