@@ -196,6 +196,8 @@ def pack_symmetries(symmetries: Symmetries, n_actions: int, n_facts: int) -> tup
     if not checks:
         return b"", b"", b"", b""
     pair_index, pair_off, fg = _pack_fact_pairs(symmetries.fact_pairs, n_facts)
+    if symmetries.grouped is not None:
+        return (*_pack_grouped(symmetries.grouped, pair_index, n_actions), pair_off, fg)
     actions = np.fromiter(checks.keys(), np.int64, len(checks))
     if actions.min() < 0 or actions.max() >= n_actions:
         raise PlanningError("native search: symmetries name actions outside the task")
@@ -211,6 +213,34 @@ def pack_symmetries(symmetries: Symmetries, n_actions: int, n_facts: int) -> tup
     act_off[actions + 1] = np.fromiter(map(len, checks.values()), np.int64, len(checks))
     np.cumsum(act_off, out=act_off)
     return act_off.tobytes(), ids.astype("<i8").tobytes(), pair_off, fg
+
+
+def _pack_grouped(grouped: tuple, pair_index: dict, n_actions: int) -> tuple[bytes, bytes]:
+    """(act_off, pair ids) from `Symmetries.grouped`: the pair ids are looked up once per
+    distinct pair list and gathered per action with array arithmetic."""
+    import numpy as np
+
+    actions, which, pair_lists = grouped
+    actions = np.asarray(actions, dtype=np.int64)
+    if len(actions) and (actions[0] < 0 or actions[-1] >= n_actions
+                         or not (np.diff(actions) > 0).all()):
+        raise PlanningError("native search: symmetries name actions outside the task")
+    try:
+        lists = [np.fromiter(map(pair_index.__getitem__, pairs), np.int64, len(pairs))
+                 for pairs in pair_lists]
+    except KeyError:
+        raise PlanningError("native search: a symmetry check names an unknown pair") from None
+    lengths = np.array([len(x) for x in lists], dtype=np.int64)
+    flat = np.concatenate(lists) if lists else np.zeros(0, dtype=np.int64)
+    starts = np.cumsum(lengths) - lengths
+    counts = lengths[which]
+    act_off = np.zeros(n_actions + 1, dtype="<i8")
+    act_off[actions + 1] = counts
+    np.cumsum(act_off, out=act_off)
+    ends = np.cumsum(counts)
+    total = int(ends[-1]) if len(ends) else 0
+    gather = np.repeat(starts[which] - (ends - counts), counts) + np.arange(total)
+    return act_off.tobytes(), flat[gather].astype("<i8").tobytes()
 
 
 _fact_pairs_packed: OrderedDict[int, tuple] = OrderedDict()

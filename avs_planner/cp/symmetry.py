@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections import OrderedDict, defaultdict
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from unified_planning.model import FNode, Problem
@@ -88,6 +88,9 @@ class Symmetries:
     groups: tuple[tuple[str, ...], ...]
     fact_pairs: Mapping[Pair, tuple[tuple[int, int], ...]]
     checks: Mapping[int, tuple[Pair, ...]]  # action index -> pairs that may prune it
+    grouped: tuple | None = field(default=None, compare=False, repr=False)
+    """`checks` in array form when built from the task's arrays: (actions, ascending; the
+    index of each one's pairs in `pair_lists`; pair_lists), for the native packer."""
 
     def prunes(self, action_index: int, state: int) -> bool:
         """True if a lower interchangeable object makes this action redundant in `state`."""
@@ -172,7 +175,11 @@ def _build(task: GroundTask, groups: Iterable[tuple[str, ...]]) -> Symmetries:
     higher = frozenset(b for b, pairs in lower.items() if pairs)
     arrays = task.arrays
     if arrays is not None and arrays.arg_ids is not None:
-        return Symmetries(groups, fact_pairs, _checks_from_ids(arrays, lower, higher, by_args))
+        grouped = _checks_from_ids(arrays, lower, higher, by_args)
+        hit, inverse, pair_lists = grouped
+        checks = dict(zip(hit.tolist(), map(pair_lists.__getitem__, inverse.tolist()),
+                          strict=True))
+        return Symmetries(groups, fact_pairs, checks, grouped)
     checks = {}
     for action in task.actions:
         args = action.args
@@ -187,8 +194,9 @@ def _build(task: GroundTask, groups: Iterable[tuple[str, ...]]) -> Symmetries:
     return Symmetries(groups, fact_pairs, checks)
 
 
-def _checks_from_ids(arrays, lower, higher, by_args) -> dict[int, tuple[Pair, ...]]:
-    """`checks` from the task's argument-id matrix, without building the actions. An
+def _checks_from_ids(arrays, lower, higher, by_args) -> tuple:
+    """`checks` from the task's argument-id matrix, without building the actions, as
+    (actions, index into the pair lists per action, pair lists). An
     action's pairs depend only on which higher objects it names, in order, so the rows are
     reduced to those (others -1) and the pairs found once per distinct reduced row;
     `by_args` memoises them per reduced id tuple."""
@@ -196,12 +204,13 @@ def _checks_from_ids(arrays, lower, higher, by_args) -> dict[int, tuple[Pair, ..
     is_higher = np.zeros(len(names) + 1, dtype=bool)  # the last slot is the -1 padding
     is_higher[[i for i, name in enumerate(names) if name in higher]] = True
     ids = arrays.arg_ids
+    none = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), [])
     if not ids.size:
-        return {}
+        return none
     marked = is_higher[ids]
     hit = np.flatnonzero(marked.any(axis=1))
     if not len(hit):
-        return {}
+        return none
     reduced = np.where(marked[hit], ids[hit], -1)
     base = len(names) + 1
     if base ** reduced.shape[1] < 2**62:  # one int64 key per row: a 1-D unique is ~10x faster
@@ -219,5 +228,4 @@ def _checks_from_ids(arrays, lower, higher, by_args) -> dict[int, tuple[Pair, ..
                 p for x in dict.fromkeys(row) if x >= 0 for p in lower.get(names[x], ())
             )
         pairs_of.append(pairs)
-    return dict(zip(hit.tolist(), map(pairs_of.__getitem__, inverse.ravel().tolist()),
-                    strict=True))
+    return hit, inverse.ravel(), pairs_of

@@ -7,6 +7,7 @@ from dataclasses import replace
 
 import pytest
 
+from avs_planner.cp import native
 from avs_planner.cp.action_table import ActionTable
 from avs_planner.cp.grounding import GroundingCache, ground, world_state
 from avs_planner.cp.symmetry import find_symmetries
@@ -66,3 +67,10 @@ def test_symmetries_from_the_arrays_match_those_from_the_actions(generated, corr
         assert from_arrays.checks  # both problems pre-allocate interchangeable objects
         assert dict(from_arrays.checks) == dict(from_actions.checks)
         assert from_arrays.groups == from_actions.groups
+        if native.AVAILABLE:  # the array form packs to the same bytes as the mapping
+            n_actions, n_facts = len(task.actions), len(task.facts)
+            grouped = native.pack_symmetries(from_arrays, n_actions, n_facts)
+            mapped = native.pack_symmetries(replace(from_arrays, grouped=None), n_actions,
+                                            n_facts)
+            assert [bytes(memoryview(x)) for x in grouped] == \
+                [bytes(memoryview(x)) for x in mapped]
