@@ -132,3 +132,22 @@ def test_a_goal_no_action_touches_is_decided_by_the_initial_state():
     assert solved.status is PlanStatus.SOLVED and solved.plan == ()
     unsolvable = plan(read_text(domain, fails, "d.pddl", "f.pddl"), cache=GroundingCache())
     assert unsolvable.status is PlanStatus.UNSOLVABLE
+
+
+def test_static_fluent_names_match_up(shapes, corridor):
+    from unified_planning.io import PDDLReader
+
+    from avs_planner.cp.grounding import static_fluent_names
+
+    from .conftest import IPC
+
+    problems = [shapes.problem, corridor.problem]
+    for domain in ("blocks", "elevators", "logistics", "gripper"):
+        if (IPC / domain).is_dir():
+            problems.append(PDDLReader().parse_problem(
+                str(IPC / domain / "domain.pddl"), str(IPC / domain / "instance-1.pddl")))
+    for problem in problems:
+        expected = frozenset(f.name for f in problem.get_static_fluents())
+        assert static_fluent_names(problem) == expected
+    assert "door" in static_fluent_names(shapes.problem)
+    assert "in" not in static_fluent_names(shapes.problem)
