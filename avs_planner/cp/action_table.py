@@ -9,6 +9,7 @@ by name and arguments through the grounding structure without building the other
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Iterator, Sequence
 from typing import overload
 
@@ -51,7 +52,7 @@ class ActionTable(Sequence[GroundAction]):
             return self._all[i]
         if isinstance(i, slice):
             return tuple(self)[i]
-        n = len(self._rows)
+        i, n = operator.index(i), len(self._rows)
         if not -n <= i < n:
             raise IndexError("action index out of range")
         i %= n
@@ -77,8 +78,11 @@ class ActionTable(Sequence[GroundAction]):
         return f"ActionTable({len(self)} actions)"
 
     def take(self, indices) -> list[GroundAction]:
-        """The actions at these indices, building (and keeping) the missing ones together."""
-        indices = list(indices)
+        """The actions at these indices (0 <= i < len), building (and keeping) the missing
+        ones together."""
+        indices = [operator.index(i) for i in indices]
+        if indices and not 0 <= min(indices) <= max(indices) < len(self._rows):
+            raise IndexError("action index out of range")
         built = self._built
         missing = [i for i in indices if i not in built]
         if missing:
