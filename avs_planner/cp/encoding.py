@@ -31,7 +31,7 @@ class AtomSpace:
         self.problem = problem
         self.names: list[str] = [o.name for o in problem.all_objects]
         self.object_id: dict[str, int] = {n: i for i, n in enumerate(self.names)}
-        self._of_type: dict[str, np.ndarray] = {}
+        self._of_type: dict[str, np.ndarray] = self._members(problem)
         self._local: dict[str, np.ndarray] = {}
         self._locals: dict[str, tuple[np.ndarray, ...]] = {}  # per fluent, per argument
         self._names_of: dict[str, list[str]] = {}
@@ -62,18 +62,28 @@ class AtomSpace:
         self.size = total
         self._decoded: dict[int, Atom] = {}
 
+    @staticmethod
+    def _members(problem: Problem) -> dict[str, np.ndarray]:
+        """Object ids of every type that has objects (subtypes included), in the problem's
+        order: one pass over the objects and their types' ancestors, instead of a pass over
+        all objects per type (`Problem.objects(type)`), which dominated small problems."""
+        by_type: dict[Type, list[int]] = {}
+        for i, obj in enumerate(problem.all_objects):
+            by_type.setdefault(obj.type, []).append(i)
+        members: dict[str, list[int]] = {}
+        for type_, ids in by_type.items():
+            ancestor: Type | None = type_
+            while ancestor is not None:
+                members.setdefault(str(ancestor), []).extend(ids)
+                ancestor = ancestor.father  # type: ignore[attr-defined]
+        return {k: np.sort(np.array(v, dtype=np.int64)) for k, v in members.items()}
+
     def objects_of(self, type_: Type) -> np.ndarray:
         """Object ids of `type_` (subtypes included), in the problem's order."""
         key = str(type_)
         ids = self._of_type.get(key)
         if ids is None:
-            names = dict.fromkeys(o.name for o in self.problem.objects(type_))
-            ids = self._of_type[key] = np.fromiter(
-                (self.object_id[n] for n in names), dtype=np.int64, count=len(names)
-            )
-            local = np.full(len(self.names), -1, dtype=np.int64)
-            local[ids] = np.arange(len(ids))
-            self._local[key] = local
+            ids = self._of_type[key] = np.zeros(0, dtype=np.int64)  # a type without objects
         return ids
 
     def names_of(self, type_: Type) -> list[str]:
@@ -81,12 +91,18 @@ class AtomSpace:
         key = str(type_)
         names = self._names_of.get(key)
         if names is None:
-            names = self._names_of[key] = [self.names[i] for i in self.objects_of(type_)]
+            names = self._names_of[key] = [self.names[i] for i in self.objects_of(type_).tolist()]
         return names
 
     def _local_of(self, type_: Type) -> np.ndarray:
-        self.objects_of(type_)
-        return self._local[str(type_)]
+        """Each object's position among the objects of `type_`, -1 if not of that type."""
+        key = str(type_)
+        local = self._local.get(key)
+        if local is None:
+            ids = self.objects_of(type_)
+            local = self._local[key] = np.full(len(self.names), -1, dtype=np.int64)
+            local[ids] = np.arange(len(ids))
+        return local
 
     def encode_rows(self, template: tuple[str, ...], columns: Columns, rows: int) -> np.ndarray:
         """Codes of a lifted atom `(f ?x obj ...)` under `rows` bindings."""
