@@ -318,7 +318,7 @@ def build_structure(
     if static_names is None:
         static_names = frozenset(f.name for f in problem.get_static_fluents())
     formulas = FormulaGrounder(static, static_names, space.names_of)
-    parts = []  # (schema, columns, rows, pre, neg, add, delete, clauses per row)
+    parts = []  # (schema, columns, rows, pre, neg, add, delete, {row: its longer clauses})
     total = 0
     for schema in schemas:
         if schema.never:
@@ -328,7 +328,7 @@ def build_structure(
             continue
         pre = _codes(schema.pre_pos, space, columns, rows)
         neg = _codes(schema.pre_neg, space, columns, rows)
-        clauses: list[tuple] = [()] * rows
+        clauses: list[tuple] | None = None  # per row, only for schemas with complex conditions
         if schema.complex:
             keep, more_pos, more_neg, clauses = _complex_rows(
                 schema, space, columns, rows, formulas
@@ -348,13 +348,15 @@ def build_structure(
         if not keep.all():
             columns = {p: c[keep] for p, c in columns.items()}
             pre, neg, add, delete = pre[keep], neg[keep], add[keep], delete[keep]
-            clauses = [c for c, k in zip(clauses, keep.tolist(), strict=True) if k]
+            if clauses is not None:
+                clauses = [c for c, k in zip(clauses, keep.tolist(), strict=True) if k]
             rows = int(keep.sum())
         total += rows
         if total > MAX_GROUND_ACTIONS:
             raise PlanningError(f"grounding exceeds {MAX_GROUND_ACTIONS} actions")
         if rows:
-            parts.append((schema, columns, rows, pre, neg, add, delete, clauses))
+            sparse = {i: c for i, c in enumerate(clauses) if c} if clauses else {}
+            parts.append((schema, columns, rows, pre, neg, add, delete, sparse))
     return _assemble(space, parts, assumptive)
 
 
@@ -367,8 +369,10 @@ def _assemble(space: AtomSpace, parts: list, assumptive: Mapping[str, bool]) -> 
         width = max((a.shape[1] for a in arrays), default=0)
         stacked[key] = (np.concatenate([_widen(a, width, pad) for a in arrays])
                         if arrays else np.empty((0, 0), dtype=np.int64))
-    row_clauses = [clauses for part in parts for clauses in part[7]]
-    distinct_clauses = [row for row in dict.fromkeys(row_clauses) if row]
+    starts = np.cumsum([0] + [part[2] for part in parts]).tolist()
+    row_clauses = {start + i: c for part, start in zip(parts, starts, strict=False)
+                   for i, c in part[7].items()}
+    distinct_clauses = list(dict.fromkeys(row_clauses.values()))
     clause_codes = np.array([c for row in distinct_clauses for clause in row for side in clause
                              for c in side], dtype=np.int64)
     codes, renumber = _fact_numbering(space.size, list(stacked.values()), clause_codes)
@@ -380,10 +384,10 @@ def _assemble(space: AtomSpace, parts: list, assumptive: Mapping[str, bool]) -> 
                    for pos, neg in row)
         for row in distinct_clauses
     }
-    clauses = {i: renumbered[row] for i, row in enumerate(row_clauses) if row}
+    clauses = {i: renumbered[row] for i, row in row_clauses.items()}
     blocks, start = [], 0
     arity = max((len(part[0].params) for part in parts), default=0)
-    arg_ids = np.full((len(row_clauses), arity), -1, dtype=np.int64)
+    arg_ids = np.full((starts[-1], arity), -1, dtype=np.int64)
     for schema, columns, rows, *_ in parts:
         blocks.append(_Block(schema, start, start + rows, columns, assumptive[schema.name]))
         for j, param in enumerate(schema.params):
