@@ -107,13 +107,21 @@ class AtomSpace:
     def encode_rows(self, template: tuple[str, ...], columns: Columns, rows: int) -> np.ndarray:
         """Codes of a lifted atom `(f ?x obj ...)` under `rows` bindings."""
         name = template[0]
-        code = np.full(rows, self.base[name], dtype=np.int64)
+        const = self.base[name]
+        code = None  # built in place from the first parameter's lookup: few numpy calls
         for term_, stride, local in zip(template[1:], self.strides[name], self._locals[name],
                                         strict=True):
             if term_[0] == "?":
-                code += stride * local[columns[term_]]
+                part = local[columns[term_]]
+                if stride != 1:
+                    part *= stride
+                code = part if code is None else np.add(code, part, out=code)
             else:
-                code += stride * int(local[self.object_id[term_]])
+                const += stride * int(local[self.object_id[term_]])
+        if code is None:
+            return np.full(rows, const, dtype=np.int64)
+        if const:
+            code += const
         return code
 
     def encode(self, atom: Atom) -> int | None:

@@ -137,6 +137,17 @@ def bitset(ids) -> int:
     return bits
 
 
+def _code_set(codes: np.ndarray, space_size: int) -> Callable[[np.ndarray], np.ndarray]:
+    """Membership test for a set of atom codes: a lookup table over a small code space (one
+    numpy call per test; joins test many times), else a binary search over sorted codes."""
+    if space_size <= _DENSE_CODES:
+        table = np.zeros(space_size, dtype=bool)
+        table[codes] = True
+        return table.__getitem__
+    sorted_codes = np.unique(codes)
+    return lambda queries: _member(queries, sorted_codes)
+
+
 def _member(codes: np.ndarray, sorted_codes: np.ndarray) -> np.ndarray:
     if len(sorted_codes) == 0:
         return np.zeros(len(codes), dtype=bool)
@@ -149,7 +160,7 @@ def _term_params(terms: Sequence[str]) -> frozenset[str]:
 
 
 def _bindings(
-    schema: LiftedSchema, space: AtomSpace, static_codes: np.ndarray
+    schema: LiftedSchema, space: AtomSpace, is_static: Callable[[np.ndarray], np.ndarray]
 ) -> tuple[dict[str, np.ndarray], int]:
     """Every parameter binding consistent with types, static atoms and (in)equalities, as
     columns of object ids in lexicographic order of the schema's parameters. A join: one
@@ -173,17 +184,19 @@ def _bindings(
 
     def apply(ready: list) -> None:
         nonlocal columns, rows
-        mask = np.ones(rows, dtype=bool)
+        mask = None
         for kind, item, _ in ready:
             if kind in ("in", "out"):
-                hit = _member(space.encode_rows(item, columns, rows), static_codes)
-                mask &= hit if kind == "in" else ~hit
+                hit = is_static(space.encode_rows(item, columns, rows))
+                ok = hit if kind == "in" else ~hit
             else:
                 same = value(item[0], rows) == value(item[1], rows)
-                mask &= same if kind == "eq" else ~same
-        if not mask.all():
-            columns = {p: c[mask] for p, c in columns.items()}
-            rows = int(mask.sum())
+                ok = same if kind == "eq" else ~same
+            mask = ok if mask is None else np.logical_and(mask, ok, out=mask)
+        if mask is not None and not mask.all():
+            at = np.flatnonzero(mask)
+            columns = {p: c[at] for p, c in columns.items()}
+            rows = len(at)
 
     bound: set[str] = set()
     apply([c for c in pending if not c[2]])
@@ -298,23 +311,15 @@ def _ground_cnf(
     return True, pos, neg, tuple(longer)
 
 
-def _widen(array: np.ndarray, width: int, pad: int) -> np.ndarray:
-    if array.shape[1] == width:
-        return array
-    out = np.full((array.shape[0], width), pad, dtype=np.int64)
-    out[:, : array.shape[1]] = array
-    return out
-
-
 def build_structure(
     problem: Problem, schemas: Sequence[LiftedSchema], static: frozenset[Atom],
     assumptive: Mapping[str, bool], static_names: frozenset[str] | None = None,
 ) -> GroundStructure:
     """Ground every action over the objects, filtered by types and static atoms."""
     space = AtomSpace(problem)
-    static_codes = np.unique(np.array(
+    is_static = _code_set(np.array(
         [c for c in (space.encode(a) for a in static) if c is not None], dtype=np.int64
-    ))
+    ), space.size)
     if static_names is None:
         static_names = frozenset(f.name for f in problem.get_static_fluents())
     formulas = FormulaGrounder(static, static_names, space.names_of)
@@ -323,7 +328,7 @@ def build_structure(
     for schema in schemas:
         if schema.never:
             continue
-        columns, rows = _bindings(schema, space, static_codes)
+        columns, rows = _bindings(schema, space, is_static)
         if not rows:
             continue
         pre = _codes(schema.pre_pos, space, columns, rows)
@@ -362,14 +367,15 @@ def build_structure(
 
 def _assemble(space: AtomSpace, parts: list, assumptive: Mapping[str, bool]) -> GroundStructure:
     """Concatenate the schemas' rows and renumber the atom codes they use as fact ids."""
+    starts = np.cumsum([0] + [part[2] for part in parts]).tolist()
     stacked = {}
     for k, (key, pad) in enumerate((("pre", _PAD_TRUE), ("neg", _PAD_NONE), ("add", _PAD_NONE),
                                     ("delete", _PAD_NONE))):
         arrays = [part[3 + k] for part in parts]
         width = max((a.shape[1] for a in arrays), default=0)
-        stacked[key] = (np.concatenate([_widen(a, width, pad) for a in arrays])
-                        if arrays else np.empty((0, 0), dtype=np.int64))
-    starts = np.cumsum([0] + [part[2] for part in parts]).tolist()
+        out = stacked[key] = np.full((starts[-1], width), pad, dtype=np.int64)
+        for array, start in zip(arrays, starts, strict=False):
+            out[start:start + len(array), : array.shape[1]] = array
     row_clauses = {start + i: c for part, start in zip(parts, starts, strict=False)
                    for i, c in part[7].items()}
     distinct_clauses = list(dict.fromkeys(row_clauses.values()))

@@ -1,6 +1,6 @@
 """The cached grounding structure: complex conditions grounded once per distinct binding of
-the parameters they read (results must not leak between bindings), and the two ways of
-numbering the atom codes as fact ids (dense table, sorted search) agreeing."""
+the parameters they read (results must not leak between bindings), and the two ways (dense
+table, sorted search) of numbering atom codes as fact ids and of testing static atoms agreeing."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import itertools
 import numpy as np
 
 from avs_planner.cp.grounding import GroundingCache, world_state
-from avs_planner.cp.structure import _PAD_NONE, _PAD_TRUE, _fact_numbering
+from avs_planner.cp.structure import _PAD_NONE, _PAD_TRUE, _code_set, _fact_numbering
 from avs_planner.pddl import read_text
 
 DOMAIN = """
@@ -78,3 +78,11 @@ def test_dense_and_sorted_fact_numbering_agree():
         want = np.where(array == _PAD_TRUE, n, np.where(array == _PAD_NONE, n + 1,
                                                           np.searchsorted(expected, array)))
         assert dense(array).tolist() == by_search(array).tolist() == want.tolist()
+
+
+def test_dense_and_sorted_code_sets_agree():
+    codes = np.array([7, 3, 499, 3, 0], dtype=np.int64)
+    queries = np.arange(500, dtype=np.int64)
+    dense = _code_set(codes, 500)(queries)
+    by_search = _code_set(codes, 10**15)(queries)  # too big for a table
+    assert dense.tolist() == by_search.tolist() == np.isin(queries, codes).tolist()
