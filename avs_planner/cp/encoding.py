@@ -9,6 +9,7 @@ evaluated for many ground actions in one go.
 
 from __future__ import annotations
 
+import itertools
 import math
 import operator
 from collections.abc import Callable, Mapping
@@ -61,6 +62,7 @@ class AtomSpace:
                 )
         self.size = total
         self._decoded: dict[int, Atom] = {}
+        self._name_arrays: dict[str, np.ndarray] = {}
 
     @staticmethod
     def _members(problem: Problem) -> dict[str, np.ndarray]:
@@ -139,23 +141,37 @@ class AtomSpace:
         return code
 
     def decode_many(self, codes: np.ndarray) -> list[Atom]:
-        """`decode` for an array of codes, one fluent at a time on arrays."""
+        """`decode` for an array of codes: sorted, each fluent's codes are one slice, split
+        into argument columns on arrays and zipped into atoms (no per-code Python work but
+        the memo, which keeps one tuple object per atom)."""
         codes = np.asarray(codes, dtype=np.int64)
-        which = np.searchsorted(self._starts, codes, side="right") - 1
-        out: list[Atom | None] = [None] * len(codes)
-        for i in np.unique(which).tolist():
-            name = self._fluents[i]
-            at = np.flatnonzero(which == i)
-            rest = codes[at] - self._starts[i]
+        order = np.argsort(codes, kind="stable")
+        ordered = codes[order]
+        bounds = np.searchsorted(ordered, self._starts).tolist() + [len(codes)]
+        atoms: list[Atom] = []
+        for i, name in enumerate(self._fluents):
+            lo, hi = bounds[i], bounds[i + 1]
+            if lo == hi:
+                continue
+            rest = ordered[lo:hi] - self._starts[i]
             columns = []
             for stride, type_ in zip(self.strides[name], self.arg_types[name], strict=True):
                 local, rest = np.divmod(rest, stride)
-                names = self.names
-                columns.append([names[g] for g in self.objects_of(type_)[local].tolist()])
-            for k, (j, code) in enumerate(zip(at.tolist(), codes[at].tolist(), strict=True)):
-                atom = (name, *(c[k] for c in columns))
-                out[j] = self._decoded.setdefault(code, atom)
-        return out  # type: ignore[return-value]
+                columns.append(self._name_array(type_)[local].tolist())
+            atoms.extend(zip(itertools.repeat(name, hi - lo), *columns, strict=True))
+        decoded = self._decoded
+        out: list[Atom] = [()] * len(codes)
+        for j, code, atom in zip(order.tolist(), ordered.tolist(), atoms, strict=True):
+            out[j] = decoded.setdefault(code, atom)
+        return out
+
+    def _name_array(self, type_: Type) -> np.ndarray:
+        """Object names of `type_` as a numpy object array, for decoding on arrays."""
+        key = str(type_)
+        array = self._name_arrays.get(key)
+        if array is None:
+            array = self._name_arrays[key] = np.array(self.names_of(type_), dtype=object)
+        return array
 
     def decode(self, code: int) -> Atom:
         atom = self._decoded.get(code)

@@ -1,6 +1,7 @@
 """The cached grounding structure: complex conditions grounded once per distinct binding of
 the parameters they read (results must not leak between bindings), and the two ways (dense
-table, sorted search) of numbering atom codes as fact ids and of testing static atoms agreeing."""
+table, sorted search) of numbering atom codes as fact ids and of testing static atoms agreeing,
+and decoding many codes at once (sorted internally) keeping the caller's order."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import itertools
 
 import numpy as np
 
+from avs_planner.cp.encoding import AtomSpace
 from avs_planner.cp.grounding import GroundingCache, world_state
 from avs_planner.cp.structure import _PAD_NONE, _PAD_TRUE, _code_set, _fact_numbering
 from avs_planner.pddl import read_text
@@ -86,3 +88,16 @@ def test_dense_and_sorted_code_sets_agree():
     dense = _code_set(codes, 500)(queries)
     by_search = _code_set(codes, 10**15)(queries)  # too big for a table
     assert dense.tolist() == by_search.tolist() == np.isin(queries, codes).tolist()
+
+
+def test_decode_many_keeps_input_order_and_one_tuple_per_atom():
+    pproblem = read_text(DOMAIN, PROBLEM, "domain.pddl", "problem.pddl")
+    space = AtomSpace(pproblem.problem)
+    atoms = [("seen", "t2"), ("at", "t3", "r1"), ("link", "r2", "r1"), ("at", "t1", "r3"),
+             ("seen", "t2"), ("dark", "r2")]
+    codes = np.array([space.encode(a) for a in atoms], dtype=np.int64)  # unsorted, a repeat
+    first = space.decode(int(codes[1]))
+    decoded = space.decode_many(codes)
+    assert decoded == atoms
+    assert decoded[1] is first and decoded[0] is decoded[4]
+    assert space.decode_many(codes[:0]) == []
