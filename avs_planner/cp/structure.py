@@ -342,14 +342,12 @@ def build_structure(
             neg = np.concatenate([neg, more_neg], axis=1)
         else:
             keep = np.ones(rows, dtype=bool)
-        for i in range(pre.shape[1]):  # a condition and its negation: never applicable
-            for j in range(neg.shape[1]):
-                keep &= pre[:, i] != neg[:, j]
+        if pre.shape[1] and neg.shape[1]:  # a condition and its negation: never applicable
+            keep &= ~(pre[:, :, None] == neg[:, None, :]).any(axis=(1, 2))
         add = _codes(schema.add, space, columns, rows)
         delete = _codes(schema.delete, space, columns, rows)
-        for j in range(delete.shape[1]):  # add wins over delete (PDDL: deletes first)
-            for i in range(add.shape[1]):
-                delete[:, j] = np.where(delete[:, j] == add[:, i], _PAD_NONE, delete[:, j])
+        if add.shape[1] and delete.shape[1]:  # add wins over delete (PDDL: deletes first)
+            delete[(delete[:, :, None] == add[:, None, :]).any(axis=2)] = _PAD_NONE
         if not keep.all():
             columns = {p: c[keep] for p, c in columns.items()}
             pre, neg, add, delete = pre[keep], neg[keep], add[keep], delete[keep]
