@@ -202,25 +202,27 @@ def _bindings(
     apply([c for c in pending if not c[2]])
     pending = [c for c in pending if c[2]]
     remaining = list(params)
+    chosen: list[str] = []
     while remaining and rows:
         param = min(remaining, key=lambda p, pending=pending: (
             -sum(1 for c in pending if c[2] <= bound | {p}), len(domain[p]), params.index(p)
         ))
         remaining.remove(param)
+        chosen.append(param)
         objects = domain[param]
         if rows * len(objects) > MAX_BINDINGS:
             raise PlanningError(
                 f"action {schema.name}: more than {MAX_BINDINGS} partial bindings to ground"
             )
         columns = {p: np.repeat(c, len(objects)) for p, c in columns.items()}
-        columns[param] = np.tile(objects, rows)
+        columns[param] = np.repeat(objects[None, :], rows, axis=0).ravel()  # np.tile, faster
         rows *= len(objects)
         bound.add(param)
         apply([c for c in pending if c[2] <= bound])
         pending = [c for c in pending if not c[2] <= bound]
     if not rows or remaining:
         return {p: np.zeros(0, dtype=np.int64) for p in params}, 0
-    if params:
+    if chosen != list(params):  # joined in another order: sort the rows lexicographically
         order = np.lexsort([columns[p] for p in reversed(params)])
         columns = {p: columns[p][order] for p in params}
     return columns, rows
