@@ -261,9 +261,10 @@ def _complex_rows(
     """Per binding: CNF of the quantified/disjunctive conditions. Unit clauses become extra
     pre/pre_neg codes; longer ones are kept per row. Rows with an empty clause are dropped.
     The CNF is grounded once per distinct binding of the parameters the conditions read
-    (e.g. `?r` of createviewcones-in, not `?l`): grounding a quantifier is ~1000x the cost
-    of copying its result to the rows that share it."""
-    read = [p for p in schema.params if p in _read_params(schema.complex)]
+    (e.g. `?r` of createviewcones-in, not `?l`): grounding a quantifier walks the formula
+    once per object; copying its result to the rows that share it is one array gather."""
+    mentioned = _read_params(schema.complex)
+    read = [p for p in schema.params if p in mentioned]
     if read:
         keys = np.stack([columns[p] for p in read], axis=1)
         distinct, inverse = np.unique(keys, axis=0, return_inverse=True)
