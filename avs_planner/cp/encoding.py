@@ -9,6 +9,7 @@ evaluated for many ground actions in one go.
 
 from __future__ import annotations
 
+import itertools
 import math
 import operator
 from collections.abc import Callable, Mapping
@@ -31,7 +32,7 @@ class AtomSpace:
         self.problem = problem
         self.names: list[str] = [o.name for o in problem.all_objects]
         self.object_id: dict[str, int] = {n: i for i, n in enumerate(self.names)}
-        self._of_type: dict[str, np.ndarray] = {}
+        self._of_type: dict[str, np.ndarray] = self._members(problem)
         self._local: dict[str, np.ndarray] = {}
         self._locals: dict[str, tuple[np.ndarray, ...]] = {}  # per fluent, per argument
         self._names_of: dict[str, list[str]] = {}
@@ -61,19 +62,30 @@ class AtomSpace:
                 )
         self.size = total
         self._decoded: dict[int, Atom] = {}
+        self._name_arrays: dict[str, np.ndarray] = {}
+
+    @staticmethod
+    def _members(problem: Problem) -> dict[str, np.ndarray]:
+        """Object ids of every type that has objects (subtypes included), in the problem's
+        order: one pass over the objects and their types' ancestors, instead of a pass over
+        all objects per type (`Problem.objects(type)`), which dominated small problems."""
+        by_type: dict[Type, list[int]] = {}
+        for i, obj in enumerate(problem.all_objects):
+            by_type.setdefault(obj.type, []).append(i)
+        members: dict[str, list[int]] = {}
+        for type_, ids in by_type.items():
+            ancestor: Type | None = type_
+            while ancestor is not None:
+                members.setdefault(str(ancestor), []).extend(ids)
+                ancestor = ancestor.father  # type: ignore[attr-defined]
+        return {k: np.sort(np.array(v, dtype=np.int64)) for k, v in members.items()}
 
     def objects_of(self, type_: Type) -> np.ndarray:
         """Object ids of `type_` (subtypes included), in the problem's order."""
         key = str(type_)
         ids = self._of_type.get(key)
         if ids is None:
-            names = dict.fromkeys(o.name for o in self.problem.objects(type_))
-            ids = self._of_type[key] = np.fromiter(
-                (self.object_id[n] for n in names), dtype=np.int64, count=len(names)
-            )
-            local = np.full(len(self.names), -1, dtype=np.int64)
-            local[ids] = np.arange(len(ids))
-            self._local[key] = local
+            ids = self._of_type[key] = np.zeros(0, dtype=np.int64)  # a type without objects
         return ids
 
     def names_of(self, type_: Type) -> list[str]:
@@ -81,23 +93,37 @@ class AtomSpace:
         key = str(type_)
         names = self._names_of.get(key)
         if names is None:
-            names = self._names_of[key] = [self.names[i] for i in self.objects_of(type_)]
+            names = self._names_of[key] = [self.names[i] for i in self.objects_of(type_).tolist()]
         return names
 
     def _local_of(self, type_: Type) -> np.ndarray:
-        self.objects_of(type_)
-        return self._local[str(type_)]
+        """Each object's position among the objects of `type_`, -1 if not of that type."""
+        key = str(type_)
+        local = self._local.get(key)
+        if local is None:
+            ids = self.objects_of(type_)
+            local = self._local[key] = np.full(len(self.names), -1, dtype=np.int64)
+            local[ids] = np.arange(len(ids))
+        return local
 
     def encode_rows(self, template: tuple[str, ...], columns: Columns, rows: int) -> np.ndarray:
         """Codes of a lifted atom `(f ?x obj ...)` under `rows` bindings."""
         name = template[0]
-        code = np.full(rows, self.base[name], dtype=np.int64)
+        const = self.base[name]
+        code = None  # built in place from the first parameter's lookup: few numpy calls
         for term_, stride, local in zip(template[1:], self.strides[name], self._locals[name],
                                         strict=True):
             if term_[0] == "?":
-                code += stride * local[columns[term_]]
+                part = local[columns[term_]]
+                if stride != 1:
+                    part *= stride
+                code = part if code is None else np.add(code, part, out=code)
             else:
-                code += stride * int(local[self.object_id[term_]])
+                const += stride * int(local[self.object_id[term_]])
+        if code is None:
+            return np.full(rows, const, dtype=np.int64)
+        if const:
+            code += const
         return code
 
     def encode(self, atom: Atom) -> int | None:
@@ -115,23 +141,37 @@ class AtomSpace:
         return code
 
     def decode_many(self, codes: np.ndarray) -> list[Atom]:
-        """`decode` for an array of codes, one fluent at a time on arrays."""
+        """`decode` for an array of codes: sorted, each fluent's codes are one slice, split
+        into argument columns on arrays and zipped into atoms (no per-code Python work but
+        the memo, which keeps one tuple object per atom)."""
         codes = np.asarray(codes, dtype=np.int64)
-        which = np.searchsorted(self._starts, codes, side="right") - 1
-        out: list[Atom | None] = [None] * len(codes)
-        for i in np.unique(which).tolist():
-            name = self._fluents[i]
-            at = np.flatnonzero(which == i)
-            rest = codes[at] - self._starts[i]
+        order = np.argsort(codes, kind="stable")
+        ordered = codes[order]
+        bounds = np.searchsorted(ordered, self._starts).tolist() + [len(codes)]
+        atoms: list[Atom] = []
+        for i, name in enumerate(self._fluents):
+            lo, hi = bounds[i], bounds[i + 1]
+            if lo == hi:
+                continue
+            rest = ordered[lo:hi] - self._starts[i]
             columns = []
             for stride, type_ in zip(self.strides[name], self.arg_types[name], strict=True):
                 local, rest = np.divmod(rest, stride)
-                names = self.names
-                columns.append([names[g] for g in self.objects_of(type_)[local].tolist()])
-            for k, (j, code) in enumerate(zip(at.tolist(), codes[at].tolist(), strict=True)):
-                atom = (name, *(c[k] for c in columns))
-                out[j] = self._decoded.setdefault(code, atom)
-        return out  # type: ignore[return-value]
+                columns.append(self._name_array(type_)[local].tolist())
+            atoms.extend(zip(itertools.repeat(name, hi - lo), *columns, strict=True))
+        decoded = self._decoded
+        out: list[Atom] = [()] * len(codes)
+        for j, code, atom in zip(order.tolist(), ordered.tolist(), atoms, strict=True):
+            out[j] = decoded.setdefault(code, atom)
+        return out
+
+    def _name_array(self, type_: Type) -> np.ndarray:
+        """Object names of `type_` as a numpy object array, for decoding on arrays."""
+        key = str(type_)
+        array = self._name_arrays.get(key)
+        if array is None:
+            array = self._name_arrays[key] = np.array(self.names_of(type_), dtype=object)
+        return array
 
     def decode(self, code: int) -> Atom:
         atom = self._decoded.get(code)

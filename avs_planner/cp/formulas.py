@@ -10,7 +10,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Callable, Iterable, Mapping
 
-from unified_planning.model import FNode, Type
+from unified_planning.model import FNode, OperatorKind, Type
 
 from avs_planner.cp.task import Atom
 from avs_planner.errors import PlanningError
@@ -21,6 +21,12 @@ Cnf = list[Clause]
 TRUE: Cnf = []
 FALSE: Cnf = [frozenset()]
 MAX_CLAUSES = 4096
+_FLUENT, _AND, _OR, _NOT = (OperatorKind.FLUENT_EXP, OperatorKind.AND, OperatorKind.OR,
+                            OperatorKind.NOT)
+_IMPLIES, _FORALL, _EXISTS = OperatorKind.IMPLIES, OperatorKind.FORALL, OperatorKind.EXISTS
+_BOOL, _EQUALS = OperatorKind.BOOL_CONSTANT, OperatorKind.EQUALS
+_PARAM, _VARIABLE, _OBJECT = (OperatorKind.PARAM_EXP, OperatorKind.VARIABLE_EXP,
+                              OperatorKind.OBJECT_EXP)
 
 
 class FormulaGrounder:
@@ -33,46 +39,52 @@ class FormulaGrounder:
         self.objects_of = objects_of
 
     def cnf(self, node: FNode, binding: Mapping[str, str], positive: bool = True) -> Cnf:
-        if node.is_and() or node.is_or():
-            parts = [self.cnf(a, binding, positive) for a in node.args]
-            return _and(parts) if node.is_and() == positive else _or(parts)
-        if node.is_not():
-            return self.cnf(node.arg(0), binding, not positive)
-        if node.is_implies():
-            left, right = node.arg(0), node.arg(1)
-            parts = [self.cnf(left, binding, not positive), self.cnf(right, binding, positive)]
-            return _or(parts) if positive else _and(parts)
-        if node.is_forall() or node.is_exists():
-            return self._quantifier(node, binding, positive)
-        if node.is_bool_constant():
-            return TRUE if node.bool_constant_value() == positive else FALSE
-        if node.is_equals():
-            same = self._term(node.arg(0), binding) == self._term(node.arg(1), binding)
-            return TRUE if same == positive else FALSE
-        if node.is_fluent_exp():
+        # One read of the node's kind, most frequent kinds first: a chain of `is_...()`
+        # calls cost more than the grounding itself on quantified conditions.
+        kind = node.node_type
+        if kind is _FLUENT:
             atom = (node.fluent().name, *(self._term(a, binding) for a in node.args))
             if atom[0] in self.static_names:
                 return TRUE if (atom in self.static) == positive else FALSE
             return [frozenset([(atom, positive)])]
+        if kind is _AND or kind is _OR:
+            parts = [self.cnf(a, binding, positive) for a in node.args]
+            return _and(parts) if (kind is _AND) == positive else _or(parts)
+        if kind is _NOT:
+            return self.cnf(node.arg(0), binding, not positive)
+        if kind is _IMPLIES:
+            left, right = node.arg(0), node.arg(1)
+            parts = [self.cnf(left, binding, not positive), self.cnf(right, binding, positive)]
+            return _or(parts) if positive else _and(parts)
+        if kind is _FORALL or kind is _EXISTS:
+            return self._quantifier(node, binding, positive)
+        if kind is _BOOL:
+            return TRUE if node.bool_constant_value() == positive else FALSE
+        if kind is _EQUALS:
+            same = self._term(node.arg(0), binding) == self._term(node.arg(1), binding)
+            return TRUE if same == positive else FALSE
         raise PlanningError(f"unsupported condition {node}")
 
     def _quantifier(self, node: FNode, binding: Mapping[str, str], positive: bool) -> Cnf:
         variables = node.variables()
         domains = [self.objects_of(v.type) for v in variables]
+        keys = ["?v:" + v.name for v in variables]
+        body = node.arg(0)
         parts = []
         for values in itertools.product(*domains):
             inner = dict(binding)
-            inner.update({"?v:" + v.name: o for v, o in zip(variables, values, strict=True)})
-            parts.append(self.cnf(node.arg(0), inner, positive))
+            inner.update(zip(keys, values, strict=True))
+            parts.append(self.cnf(body, inner, positive))
         return _and(parts) if node.is_forall() == positive else _or(parts)
 
     @staticmethod
     def _term(node: FNode, binding: Mapping[str, str]) -> str:
-        if node.is_parameter_exp():
+        kind = node.node_type
+        if kind is _PARAM:
             return binding["?" + node.parameter().name]
-        if node.is_variable_exp():
+        if kind is _VARIABLE:
             return binding["?v:" + node.variable().name]
-        if node.is_object_exp():
+        if kind is _OBJECT:
             return node.object().name
         raise PlanningError(f"unsupported argument {node}")
 

@@ -96,7 +96,11 @@ def _split_effects(action: InstantaneousAction) -> tuple[list, list]:
 def _cost_exprs(problem: Problem) -> tuple[dict[str, FNode], FNode | None]:
     for metric in problem.quality_metrics:
         if isinstance(metric, MinimizeActionCosts):
-            costs = {a.name: metric.get_action_cost(a) for a in problem.actions}
+            # `get_action_cost` hashes the action (a walk over all its conditions and
+            # effects); the metric normally holds the problem's own action objects.
+            own = {id(a): c for a, c in metric.costs.items()}
+            costs = {a.name: own[id(a)] if id(a) in own else metric.get_action_cost(a)
+                     for a in problem.actions}
             return costs, metric.default
     return {}, None
 

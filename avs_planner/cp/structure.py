@@ -8,11 +8,11 @@ fact-id arrays that the per-call stage (`grounding.ground`) runs its fixpoints o
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from unified_planning.model import Problem
+from unified_planning.model import FNode, Problem
 
 from avs_planner.cp.encoding import AtomSpace, Columns
 from avs_planner.cp.formulas import FormulaGrounder
@@ -24,6 +24,7 @@ MAX_GROUND_ACTIONS = 2_000_000
 MAX_BINDINGS = 20_000_000  # partial bindings of one schema while joining its static atoms
 _PAD_TRUE = -1  # padding code of precondition arrays (an always-true fact)
 _PAD_NONE = -2  # padding code of the other arrays (a fact nothing reads or makes true)
+_DENSE_CODES = 1 << 16  # atom code spaces up to this size are renumbered through a table
 
 
 @dataclass(frozen=True)
@@ -136,6 +137,17 @@ def bitset(ids) -> int:
     return bits
 
 
+def _code_set(codes: np.ndarray, space_size: int) -> Callable[[np.ndarray], np.ndarray]:
+    """Membership test for a set of atom codes: a lookup table over a small code space (one
+    numpy call per test; joins test many times), else a binary search over sorted codes."""
+    if space_size <= _DENSE_CODES:
+        table = np.zeros(space_size, dtype=bool)
+        table[codes] = True
+        return table.__getitem__
+    sorted_codes = np.unique(codes)
+    return lambda queries: _member(queries, sorted_codes)
+
+
 def _member(codes: np.ndarray, sorted_codes: np.ndarray) -> np.ndarray:
     if len(sorted_codes) == 0:
         return np.zeros(len(codes), dtype=bool)
@@ -148,7 +160,7 @@ def _term_params(terms: Sequence[str]) -> frozenset[str]:
 
 
 def _bindings(
-    schema: LiftedSchema, space: AtomSpace, static_codes: np.ndarray
+    schema: LiftedSchema, space: AtomSpace, is_static: Callable[[np.ndarray], np.ndarray]
 ) -> tuple[dict[str, np.ndarray], int]:
     """Every parameter binding consistent with types, static atoms and (in)equalities, as
     columns of object ids in lexicographic order of the schema's parameters. A join: one
@@ -172,41 +184,45 @@ def _bindings(
 
     def apply(ready: list) -> None:
         nonlocal columns, rows
-        mask = np.ones(rows, dtype=bool)
+        mask = None
         for kind, item, _ in ready:
             if kind in ("in", "out"):
-                hit = _member(space.encode_rows(item, columns, rows), static_codes)
-                mask &= hit if kind == "in" else ~hit
+                hit = is_static(space.encode_rows(item, columns, rows))
+                ok = hit if kind == "in" else ~hit
             else:
                 same = value(item[0], rows) == value(item[1], rows)
-                mask &= same if kind == "eq" else ~same
-        if not mask.all():
-            columns = {p: c[mask] for p, c in columns.items()}
-            rows = int(mask.sum())
+                ok = same if kind == "eq" else ~same
+            mask = ok if mask is None else np.logical_and(mask, ok, out=mask)
+        if mask is not None and not mask.all():
+            at = np.flatnonzero(mask)
+            columns = {p: c[at] for p, c in columns.items()}
+            rows = len(at)
 
     bound: set[str] = set()
     apply([c for c in pending if not c[2]])
     pending = [c for c in pending if c[2]]
     remaining = list(params)
+    chosen: list[str] = []
     while remaining and rows:
         param = min(remaining, key=lambda p, pending=pending: (
             -sum(1 for c in pending if c[2] <= bound | {p}), len(domain[p]), params.index(p)
         ))
         remaining.remove(param)
+        chosen.append(param)
         objects = domain[param]
         if rows * len(objects) > MAX_BINDINGS:
             raise PlanningError(
                 f"action {schema.name}: more than {MAX_BINDINGS} partial bindings to ground"
             )
         columns = {p: np.repeat(c, len(objects)) for p, c in columns.items()}
-        columns[param] = np.tile(objects, rows)
+        columns[param] = np.repeat(objects[None, :], rows, axis=0).ravel()  # np.tile, faster
         rows *= len(objects)
         bound.add(param)
         apply([c for c in pending if c[2] <= bound])
         pending = [c for c in pending if not c[2] <= bound]
     if not rows or remaining:
         return {p: np.zeros(0, dtype=np.int64) for p in params}, 0
-    if params:
+    if chosen != list(params):  # joined in another order: sort the rows lexicographically
         order = np.lexsort([columns[p] for p in reversed(params)])
         columns = {p: columns[p][order] for p in params}
     return columns, rows
@@ -227,14 +243,52 @@ def _pad(lists: list[list[int]], pad: int) -> np.ndarray:
     return out
 
 
-def _complex_rows(schema, space, columns, rows, formulas):
+def _read_params(nodes: Sequence[FNode]) -> frozenset[str]:
+    """The schema parameters the conditions mention: their CNF depends on nothing else."""
+    stack, read = list(nodes), set()
+    while stack:
+        node = stack.pop()
+        if node.is_parameter_exp():
+            read.add("?" + node.parameter().name)
+        stack.extend(node.args)
+    return frozenset(read)
+
+
+def _complex_rows(
+    schema: LiftedSchema, space: AtomSpace, columns: Columns, rows: int,
+    formulas: FormulaGrounder,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[tuple]]:
     """Per binding: CNF of the quantified/disjunctive conditions. Unit clauses become extra
-    pre/pre_neg codes; longer ones are kept per row. Rows with an empty clause are dropped."""
-    keep = np.ones(rows, dtype=bool)
-    extra_pos: list[list[int]] = []
-    extra_neg: list[list[int]] = []
-    clauses: list[tuple] = []
+    pre/pre_neg codes; longer ones are kept per row. Rows with an empty clause are dropped.
+    The CNF is grounded once per distinct binding of the parameters the conditions read
+    (e.g. `?r` of createviewcones-in, not `?l`): grounding a quantifier walks the formula
+    once per object; copying its result to the rows that share it is one array gather."""
+    mentioned = _read_params(schema.complex)
+    read = [p for p in schema.params if p in mentioned]
+    if read:
+        keys = np.stack([columns[p] for p in read], axis=1)
+        distinct, inverse = np.unique(keys, axis=0, return_inverse=True)
+        inverse = inverse.reshape(-1)
+    else:
+        distinct, inverse = np.zeros((1, 0), dtype=np.int64), np.zeros(rows, dtype=np.int64)
     names = space.names
+    grounded = [
+        _ground_cnf(schema, space, formulas, {p: names[i] for p, i in zip(read, ids, strict=True)})
+        for ids in distinct.tolist()
+    ]
+    keep = np.array([g[0] for g in grounded], dtype=bool)[inverse]
+    pos = _pad([g[1] for g in grounded], _PAD_TRUE)[inverse]
+    neg = _pad([g[2] for g in grounded], _PAD_NONE)[inverse]
+    longer = [g[3] for g in grounded]
+    return keep, pos, neg, [longer[g] for g in inverse.tolist()]
+
+
+def _ground_cnf(
+    schema: LiftedSchema, space: AtomSpace, formulas: FormulaGrounder,
+    binding: Mapping[str, str],
+) -> tuple[bool, list[int], list[int], tuple]:
+    """(satisfiable, unit positive codes, unit negative codes, longer clauses as code pairs)
+    of the schema's complex conditions under one binding of the parameters they read."""
 
     def code(atom: Atom) -> int:
         c = space.encode(atom)
@@ -242,36 +296,22 @@ def _complex_rows(schema, space, columns, rows, formulas):
             raise PlanningError(f"action {schema.name}: cannot ground condition atom {atom}")
         return c
 
-    for i in range(rows):
-        binding = {p: names[int(columns[p][i])] for p in schema.params}
-        cnf = [c for node in schema.complex for c in formulas.cnf(node, binding)]
-        pos: list[int] = []
-        neg: list[int] = []
-        longer = []
-        for clause in sorted(cnf, key=lambda c: sorted(c)):
-            if not clause:
-                keep[i] = False
-                break
-            if len(clause) == 1:
-                ((atom, positive),) = clause
-                (pos if positive else neg).append(code(atom))
-            else:
-                longer.append((
-                    tuple(code(a) for a, positive in sorted(clause) if positive),
-                    tuple(code(a) for a, positive in sorted(clause) if not positive),
-                ))
-        extra_pos.append(pos)
-        extra_neg.append(neg)
-        clauses.append(tuple(longer))
-    return keep, _pad(extra_pos, _PAD_TRUE), _pad(extra_neg, _PAD_NONE), clauses
-
-
-def _widen(array: np.ndarray, width: int, pad: int) -> np.ndarray:
-    if array.shape[1] == width:
-        return array
-    out = np.full((array.shape[0], width), pad, dtype=np.int64)
-    out[:, : array.shape[1]] = array
-    return out
+    cnf = [c for node in schema.complex for c in formulas.cnf(node, binding)]
+    pos: list[int] = []
+    neg: list[int] = []
+    longer = []
+    for clause in sorted(cnf, key=lambda c: sorted(c)):
+        if not clause:
+            return False, pos, neg, tuple(longer)
+        if len(clause) == 1:
+            ((atom, positive),) = clause
+            (pos if positive else neg).append(code(atom))
+        else:
+            longer.append((
+                tuple(code(a) for a, positive in sorted(clause) if positive),
+                tuple(code(a) for a, positive in sorted(clause) if not positive),
+            ))
+    return True, pos, neg, tuple(longer)
 
 
 def build_structure(
@@ -280,23 +320,23 @@ def build_structure(
 ) -> GroundStructure:
     """Ground every action over the objects, filtered by types and static atoms."""
     space = AtomSpace(problem)
-    static_codes = np.unique(np.array(
+    is_static = _code_set(np.array(
         [c for c in (space.encode(a) for a in static) if c is not None], dtype=np.int64
-    ))
+    ), space.size)
     if static_names is None:
         static_names = frozenset(f.name for f in problem.get_static_fluents())
     formulas = FormulaGrounder(static, static_names, space.names_of)
-    parts = []  # (schema, columns, rows, pre, neg, add, delete, clauses per row)
+    parts = []  # (schema, columns, rows, pre, neg, add, delete, {row: its longer clauses})
     total = 0
     for schema in schemas:
         if schema.never:
             continue
-        columns, rows = _bindings(schema, space, static_codes)
+        columns, rows = _bindings(schema, space, is_static)
         if not rows:
             continue
         pre = _codes(schema.pre_pos, space, columns, rows)
         neg = _codes(schema.pre_neg, space, columns, rows)
-        clauses: list[tuple] = [()] * rows
+        clauses: list[tuple] | None = None  # per row, only for schemas with complex conditions
         if schema.complex:
             keep, more_pos, more_neg, clauses = _complex_rows(
                 schema, space, columns, rows, formulas
@@ -305,68 +345,60 @@ def build_structure(
             neg = np.concatenate([neg, more_neg], axis=1)
         else:
             keep = np.ones(rows, dtype=bool)
-        for i in range(pre.shape[1]):  # a condition and its negation: never applicable
-            for j in range(neg.shape[1]):
-                keep &= pre[:, i] != neg[:, j]
+        if pre.shape[1] and neg.shape[1]:  # a condition and its negation: never applicable
+            keep &= ~(pre[:, :, None] == neg[:, None, :]).any(axis=(1, 2))
         add = _codes(schema.add, space, columns, rows)
         delete = _codes(schema.delete, space, columns, rows)
-        for j in range(delete.shape[1]):  # add wins over delete (PDDL: deletes first)
-            for i in range(add.shape[1]):
-                delete[:, j] = np.where(delete[:, j] == add[:, i], _PAD_NONE, delete[:, j])
+        if add.shape[1] and delete.shape[1]:  # add wins over delete (PDDL: deletes first)
+            delete[(delete[:, :, None] == add[:, None, :]).any(axis=2)] = _PAD_NONE
         if not keep.all():
             columns = {p: c[keep] for p, c in columns.items()}
             pre, neg, add, delete = pre[keep], neg[keep], add[keep], delete[keep]
-            clauses = [c for c, k in zip(clauses, keep.tolist(), strict=True) if k]
+            if clauses is not None:
+                clauses = [c for c, k in zip(clauses, keep.tolist(), strict=True) if k]
             rows = int(keep.sum())
         total += rows
         if total > MAX_GROUND_ACTIONS:
             raise PlanningError(f"grounding exceeds {MAX_GROUND_ACTIONS} actions")
         if rows:
-            parts.append((schema, columns, rows, pre, neg, add, delete, clauses))
+            sparse = {i: c for i, c in enumerate(clauses) if c} if clauses else {}
+            parts.append((schema, columns, rows, pre, neg, add, delete, sparse))
     return _assemble(space, parts, assumptive)
 
 
 def _assemble(space: AtomSpace, parts: list, assumptive: Mapping[str, bool]) -> GroundStructure:
     """Concatenate the schemas' rows and renumber the atom codes they use as fact ids."""
-    arrays = {k: [] for k in ("pre", "neg", "add", "delete")}
-    clause_codes: list = []
-    for _, _, _, pre, neg, add, delete, clauses in parts:
-        for key, array in zip(arrays, (pre, neg, add, delete), strict=True):
-            arrays[key].append(array)
-        clause_codes.extend(c for row in clauses for clause in row for side in clause
-                            for c in side)
-    used = [a[a >= 0] for key in arrays for a in arrays[key]]
-    codes = np.unique(np.concatenate(used + [np.array(clause_codes, dtype=np.int64)]))
-    n = len(codes)
-    facts = tuple(space.decode_many(codes))
-
-    def renumber(array: np.ndarray, pad: int) -> np.ndarray:
-        out = np.searchsorted(codes, array)
-        out[array == _PAD_TRUE] = n
-        out[array == _PAD_NONE] = n + 1
-        return out
-
+    starts = np.cumsum([0] + [part[2] for part in parts]).tolist()
     stacked = {}
-    for key, pad in (("pre", _PAD_TRUE), ("neg", _PAD_NONE), ("add", _PAD_NONE),
-                     ("delete", _PAD_NONE)):
-        width = max((a.shape[1] for a in arrays[key]), default=0)
-        joined = (np.concatenate([_widen(a, width, pad) for a in arrays[key]])
-                  if arrays[key] else np.empty((0, 0), dtype=np.int64))
-        stacked[key] = renumber(joined, pad)
-    blocks, clauses, start = [], {}, 0
+    for k, (key, pad) in enumerate((("pre", _PAD_TRUE), ("neg", _PAD_NONE), ("add", _PAD_NONE),
+                                    ("delete", _PAD_NONE))):
+        arrays = [part[3 + k] for part in parts]
+        width = max((a.shape[1] for a in arrays), default=0)
+        out = stacked[key] = np.full((starts[-1], width), pad, dtype=np.int64)
+        for array, start in zip(arrays, starts, strict=False):
+            out[start:start + len(array), : array.shape[1]] = array
+    row_clauses = {start + i: c for part, start in zip(parts, starts, strict=False)
+                   for i, c in part[7].items()}
+    distinct_clauses = list(dict.fromkeys(row_clauses.values()))
+    clause_codes = np.array([c for row in distinct_clauses for clause in row for side in clause
+                             for c in side], dtype=np.int64)
+    codes, renumber = _fact_numbering(space.size, list(stacked.values()), clause_codes)
+    facts = tuple(space.decode_many(codes))
+    stacked = {key: renumber(array) for key, array in stacked.items()}
     index_of = {c: i for i, c in enumerate(codes.tolist())}
+    renumbered = {
+        row: tuple((tuple(index_of[c] for c in pos), tuple(index_of[c] for c in neg))
+                   for pos, neg in row)
+        for row in distinct_clauses
+    }
+    clauses = {i: renumbered[row] for i, row in row_clauses.items()}
+    blocks, start = [], 0
     arity = max((len(part[0].params) for part in parts), default=0)
-    arg_ids = np.full((sum(part[2] for part in parts), arity), -1, dtype=np.int64)
-    for schema, columns, rows, *_, row_clauses in parts:
+    arg_ids = np.full((starts[-1], arity), -1, dtype=np.int64)
+    for schema, columns, rows, *_ in parts:
         blocks.append(_Block(schema, start, start + rows, columns, assumptive[schema.name]))
         for j, param in enumerate(schema.params):
             arg_ids[start:start + rows, j] = columns[param]
-        for i, row in enumerate(row_clauses):
-            if row:
-                clauses[start + i] = tuple(
-                    (tuple(index_of[c] for c in pos), tuple(index_of[c] for c in neg))
-                    for pos, neg in row
-                )
         start += rows
     return GroundStructure(
         facts=facts, fact_index={a: i for i, a in enumerate(facts)},
@@ -374,6 +406,37 @@ def _assemble(space: AtomSpace, parts: list, assumptive: Mapping[str, bool]) -> 
         pre_neg=stacked["neg"], add=stacked["add"], delete=stacked["delete"], clauses=clauses,
         arg_ids=arg_ids,
     )
+
+
+def _fact_numbering(
+    space_size: int, arrays: list[np.ndarray], extra: np.ndarray
+) -> tuple[np.ndarray, Callable[[np.ndarray], np.ndarray]]:
+    """The atom codes used (sorted) and a map from code arrays to fact ids, padding codes
+    `_PAD_TRUE` -> n and `_PAD_NONE` -> n + 1. When the code space is small next to the
+    arrays (the usual case), a dense table replaces sort-based unique and searchsorted,
+    several times faster; huge code spaces (up to `MAX_CODE`) take the sorted path."""
+    entries = sum(a.size for a in arrays) + extra.size
+    if space_size <= max(_DENSE_CODES, 2 * entries):
+        used = np.zeros(space_size + 2, dtype=bool)  # the pads index the last two slots
+        for array in (*arrays, extra):
+            used[array.reshape(-1)] = True
+        used[-2:] = False
+        codes = np.flatnonzero(used)
+        n = len(codes)
+        table = np.empty(space_size + 2, dtype=np.int64)
+        table[codes] = np.arange(n)
+        table[_PAD_TRUE], table[_PAD_NONE] = n, n + 1
+        return codes, table.__getitem__
+    codes = np.unique(np.concatenate([a[a >= 0] for a in arrays] + [extra]))
+    n = len(codes)
+
+    def renumber(array: np.ndarray) -> np.ndarray:
+        out = np.searchsorted(codes, array)
+        out[array == _PAD_TRUE] = n
+        out[array == _PAD_NONE] = n + 1
+        return out
+
+    return codes, renumber
 
 
 def fact_matrix(ids: np.ndarray, n: int, read: np.ndarray | None) -> np.ndarray:
