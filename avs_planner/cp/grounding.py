@@ -17,6 +17,7 @@ import gc
 from collections import OrderedDict
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
+from fractions import Fraction
 
 import numpy as np
 from unified_planning.model import FNode, InstantaneousAction, Problem
@@ -34,13 +35,21 @@ def world_state(problem: Problem) -> WorldState:
     """The problem's initial state as atoms and numeric values (explicit :init entries)."""
     atoms: set[Atom] = set()
     values: dict[Atom, float] = {}
+    names: dict[FNode, str] = {}  # UP shares one node per object: name each once
     for fluent_exp, value in problem.explicit_initial_values.items():
-        key = (fluent_exp.fluent().name, *[a.object().name for a in fluent_exp.args])
-        if value.is_bool_constant():
-            if value.bool_constant_value():
-                atoms.add(key)
-        elif value.is_int_constant() or value.is_real_constant():
-            values[key] = float(value.constant_value())
+        key = [fluent_exp.fluent().name]
+        for arg in fluent_exp.args:
+            name = names.get(arg)
+            if name is None:
+                name = names[arg] = arg.object().name
+            key.append(name)
+        if not value.is_constant():
+            continue
+        constant = value.constant_value()
+        if constant is True:
+            atoms.add(tuple(key))
+        elif isinstance(constant, (int, Fraction)) and not isinstance(constant, bool):
+            values[tuple(key)] = float(constant)
     return WorldState(frozenset(atoms), values)
 
 
