@@ -14,13 +14,12 @@ from collections import OrderedDict
 
 import numpy as np
 
-from avs_planner.cp.structure import GroundStructure, fact_matrix
+from avs_planner.cp.structure import GroundStructure, bitset, fact_matrix
 
 try:  # the compiled fixpoints; the numpy versions below compute the same when not built
     from avs_planner.cp import _fixpoint
 except ImportError:
     _fixpoint = None
-
 _BIG = np.iinfo(np.int64).max
 
 
@@ -47,7 +46,9 @@ def bit_words(matrix: np.ndarray, n_facts: int) -> np.ndarray:
 class Derived:
     """Per structure row, filled on first use (a call only needs its kept rows): sorted
     unique fact ids (-1 padded at the end) and bitset words of pre, pre_neg, add, delete.
-    Also the rows' clause facts as (interleaved offsets, positives, negatives)."""
+    Also, computed at once: the rows' clause facts as (interleaved offsets, positives,
+    negatives) plus the row of each clause fact and each clause row's clauses as bitsets,
+    and (when the compiled fixpoints are built) the rows-by-fact indexes they take."""
 
     def __init__(self, st: GroundStructure):
         self._st = st
@@ -57,6 +58,19 @@ class Derived:
                               for m in (st.pre, st.pre_neg, st.add, st.delete))
         self.bits = tuple(np.empty((st.size, n_words), dtype="<u8") for _ in range(4))
         self.clauses = _clause_csr(st)
+        clause_rows = sorted(st.clauses)
+        self.clause_rows = np.array(clause_rows, dtype=np.int64)
+        self.clause_bits = {row: tuple((bitset(pos), bitset(neg)) for pos, neg in st.clauses[row])
+                            for row in clause_rows}
+        offsets = self.clauses[0]
+        self.clause_pos_rows = np.repeat(np.arange(st.size), np.diff(offsets[0::2]))
+        self.clause_neg_rows = np.repeat(np.arange(st.size), np.diff(offsets[1::2]))
+        self.pre_index = self.add_index = self.delete_index = b""
+        if _fixpoint is not None:
+            n = len(st.facts)
+            self.pre_index = _fixpoint.index(st.size, st.pre, st.pre.shape[1], n + 2)
+            self.add_index = _fixpoint.index(st.size, st.add, st.add.shape[1], n)
+            self.delete_index = _fixpoint.index(st.size, st.delete, st.delete.shape[1], n)
 
     def rows(self, rows: np.ndarray) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
         """The four matrices and bitset words of these rows (computing the missing ones)."""
@@ -65,11 +79,13 @@ class Derived:
             st, n = self._st, len(self._st.facts)
             for source, matrix, bits in zip((st.pre, st.pre_neg, st.add, st.delete),
                                             self.matrices, self.bits, strict=True):
-                sorted_rows = fact_matrix(source[missing], n, None)
+                sorted_rows = fact_matrix(np.take(source, missing, axis=0), n, None)
                 matrix[missing] = sorted_rows
                 bits[missing] = bit_words(sorted_rows, n)
             self._done[missing] = True
-        return (tuple(m[rows] for m in self.matrices), tuple(b[rows] for b in self.bits))
+        # np.take: ~3x faster than m[rows] for a row gather
+        return (tuple(np.take(m, rows, axis=0) for m in self.matrices),
+                tuple(np.take(b, rows, axis=0) for b in self.bits))
 
 
 _DERIVED: OrderedDict[int, tuple[GroundStructure, Derived]] = OrderedDict()
@@ -116,9 +132,9 @@ def task_rows(st: GroundStructure, kept_rows: np.ndarray, read: np.ndarray
     read_words = bit_words(np.flatnonzero(read[:n])[None, :], n)[0]
     matrices = [pre, pre_neg]
     for m in (add, delete):
-        drop = (m >= 0) & ~read[m]
-        if drop.any():
-            m = np.where(drop | (m < 0), _BIG, m)
+        keep = (m >= 0) & read[m]
+        if not np.array_equal(keep, m >= 0):  # drop unread facts, keep each row sorted
+            m = np.where(keep, m, _BIG)
             m.sort(axis=1)
             m[m == _BIG] = -1
         matrices.append(m)
@@ -134,6 +150,7 @@ def reachable(st: GroundStructure, init: np.ndarray, allowed: np.ndarray) -> np.
     flags = _fixpoint.reachable(
         st.size, st.pre, st.pre.shape[1], st.add, st.add.shape[1], n + 2, n + 1,
         np.ascontiguousarray(init, dtype=bool), np.ascontiguousarray(allowed, dtype=bool),
+        derived(st).pre_index,
     )
     return np.frombuffer(flags, dtype=bool)
 
@@ -164,15 +181,15 @@ def relevant(st: GroundStructure, allowed: np.ndarray, goal: int, goal_neg: int)
     (they can be cut from any plan, which only lowers its cost and raises its probability)."""
     if _fixpoint is None:
         return relevant_numpy(st, allowed, goal, goal_neg)
-    offsets, positives, negatives = derived(st).clauses
+    d = derived(st)
+    offsets, positives, negatives = d.clauses
     goal_ids = ids_of(goal)
     goal_neg_ids = ids_of(goal_neg)
     flags = _fixpoint.relevant(
-        st.size, len(st.facts), len(st.facts) + 2, st.add, st.add.shape[1],
-        st.delete, st.delete.shape[1], st.pre, st.pre.shape[1], st.pre_neg,
+        st.size, len(st.facts), len(st.facts) + 2, st.pre, st.pre.shape[1], st.pre_neg,
         st.pre_neg.shape[1], offsets, positives, len(positives), negatives, len(negatives),
         np.ascontiguousarray(allowed, dtype=bool), goal_ids, len(goal_ids), goal_neg_ids,
-        len(goal_neg_ids),
+        len(goal_neg_ids), d.add_index, d.delete_index,
     )
     return np.frombuffer(flags, dtype=bool)
 

@@ -165,6 +165,18 @@ class AtomSpace:
             out[j] = decoded.setdefault(code, atom)
         return out
 
+    def atoms(self, codes: list[int]) -> list[Atom]:
+        """`decode_many` through the memo first: a replan asks for the atoms it asked for
+        last time, and a dict lookup per code beats the array split."""
+        get = self._decoded.get
+        out = [get(c) for c in codes]
+        missing = [k for k, atom in enumerate(out) if atom is None]
+        if missing:
+            for k, atom in zip(missing, self.decode_many([codes[k] for k in missing]),
+                               strict=True):
+                out[k] = atom
+        return out  # type: ignore[return-value]
+
     def _name_array(self, type_: Type) -> np.ndarray:
         """Object names of `type_` as a numpy object array, for decoding on arrays."""
         key = str(type_)
@@ -196,13 +208,24 @@ _ARITH: dict[str, Callable[[float, float], float]] = {
 }
 
 
+class ConstantExpr:
+    """A `VectorExpr` that reads nothing; callers may use `value` without building columns."""
+
+    __slots__ = ("value",)
+
+    def __init__(self, value: float):
+        self.value = value
+
+    def __call__(self, space, cols, rows, values) -> np.ndarray:
+        return np.full(rows, self.value)
+
+
 def compile_vector(node: FNode | None, where: str, default: float) -> VectorExpr:
     """A numeric UP expression (constants, fluent terms, + - * /) over arrays of bindings."""
     if node is None:
-        return lambda space, cols, rows, values: np.full(rows, default)
+        return ConstantExpr(default)
     if node.is_constant():
-        value = float(Fraction(str(node.constant_value())))
-        return lambda space, cols, rows, values: np.full(rows, value)
+        return ConstantExpr(float(Fraction(str(node.constant_value()))))
     if node.is_fluent_exp():
         template = (node.fluent().name, *(term(a) for a in node.args))
         return lambda space, cols, rows, values: _lookup(
@@ -238,10 +261,9 @@ def _lookup(space: AtomSpace, template, cols, rows, values, where) -> np.ndarray
         return np.zeros(0)
     codes = space.encode_rows(template, cols, rows)
     unique, inverse = np.unique(codes, return_inverse=True)
-    found = np.empty(len(unique))
-    for i, atom in enumerate(space.decode_many(unique)):
-        value = values.get(atom)
-        if value is None:
-            raise PlanningError(f"{where}: no value for ({' '.join(atom)}) in :init")
-        found[i] = value
-    return found[inverse]
+    atoms = space.atoms(unique.tolist())
+    found = list(map(values.get, atoms))
+    if None in found:
+        atom = atoms[found.index(None)]
+        raise PlanningError(f"{where}: no value for ({' '.join(atom)}) in :init")
+    return np.array(found, dtype=float)[inverse]

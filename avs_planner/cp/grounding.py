@@ -23,7 +23,8 @@ import numpy as np
 from unified_planning.model import FNode, InstantaneousAction, Problem
 
 from avs_planner.cp.action_table import ActionTable
-from avs_planner.cp.derived import ids_of, reachable, relevant, task_rows
+from avs_planner.cp.derived import derived, ids_of, reachable, relevant, task_rows
+from avs_planner.cp.encoding import ConstantExpr
 from avs_planner.cp.schema import LiftedSchema, compile_schemas
 from avs_planner.cp.structure import GroundStructure, bitset, build_structure
 from avs_planner.cp.task import Atom, GroundTask, TaskArrays, WorldState
@@ -106,8 +107,11 @@ def _evaluate(st: GroundStructure, rows: np.ndarray, values: Mapping[Atom, float
         sel = rows[block.start:block.stop]
         if not sel.any():
             continue
-        columns, count = block.select(sel)
         expr = block.schema.probability if what == "prob" else block.schema.cost
+        if isinstance(expr, ConstantExpr):
+            out[block.start:block.stop][sel] = expr.value
+            continue
+        columns, count = block.select(sel)
         out[block.start:block.stop][sel] = expr(st.space, columns, count, values)
     return out
 
@@ -280,22 +284,21 @@ def _ground(
     read[st.pre[kept]] = True
     read[st.pre_neg[kept]] = True
     kept_rows = np.flatnonzero(kept)
+    d = derived(st)
     clauses = {}  # action index -> clauses as bitsets (few rows have any)
-    for row, row_clauses in st.clauses.items():
-        if kept[row]:
-            for pos, neg in row_clauses:
-                read[list(pos)] = True
-                read[list(neg)] = True
-            clauses[int(np.searchsorted(kept_rows, row))] = tuple(
-                (bitset(pos), bitset(neg)) for pos, neg in row_clauses
-            )
+    if len(d.clause_rows):
+        read[d.clauses[1][kept[d.clause_pos_rows]]] = True
+        read[d.clauses[2][kept[d.clause_neg_rows]]] = True
+        with_clauses = d.clause_rows[kept[d.clause_rows]]
+        clauses = dict(zip(np.searchsorted(kept_rows, with_clauses).tolist(),
+                           map(d.clause_bits.__getitem__, with_clauses.tolist()), strict=True))
     read_mask = _bits(read[:n])
-    cost, probability = cost[kept_rows], probability[kept_rows]
+    cost, probability = np.take(cost, kept_rows), np.take(probability, kept_rows)
     (pre, pre_neg, add, delete), bits = task_rows(st, kept_rows, read)
     arrays = TaskArrays(
         pre=pre, pre_neg=pre_neg, add=add, delete=delete, bits=bits,
         cost=cost, probability=probability, clauses=clauses,
-        arg_ids=st.arg_ids[kept_rows], objects=st.space.names,
+        arg_ids=np.take(st.arg_ids, kept_rows, axis=0), objects=st.space.names,
     )
     return GroundTask(
         facts=structure.facts, fact_index=structure.fact_index,

@@ -39,7 +39,7 @@ class _Block:
 
     def select(self, mask: np.ndarray) -> tuple[Columns, int]:
         """Columns of the rows where `mask` (over this block's rows) is true."""
-        return {p: c[mask] for p, c in self.columns.items()}, int(mask.sum())
+        return {p: np.compress(mask, c) for p, c in self.columns.items()}, int(mask.sum())
 
 
 @dataclass(frozen=True)

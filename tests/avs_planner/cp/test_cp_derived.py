@@ -94,15 +94,33 @@ def test_compiled_fixpoints_match_numpy(corridor):
 
 
 @needs_fixpoint
-def test_compiled_fixpoints_reject_facts_out_of_range():
+def test_compiled_fixpoints_reject_bad_input():
     from avs_planner.cp import _fixpoint
 
     pre = np.array([[0, 5]], dtype=np.int64)  # fact 5 outside 3 slots
     add = np.array([[1]], dtype=np.int64)
+    ok_pre = np.array([[0, 1]], dtype=np.int64)
+    index = _fixpoint.index(1, ok_pre, 2, 3)
+    assert np.frombuffer(index, np.int64).tolist() == [0, 1, 2, 2, 0, 0]
     with pytest.raises(ValueError, match="outside"):
-        _fixpoint.reachable(1, pre, 2, add, 1, 3, 2, np.ones(3, bool), np.ones(1, bool))
+        _fixpoint.reachable(1, pre, 2, add, 1, 3, 2, np.ones(3, bool), np.ones(1, bool), index)
     with pytest.raises(ValueError, match="bytes"):
-        _fixpoint.reachable(2, pre, 2, add, 1, 3, 2, np.ones(3, bool), np.ones(1, bool))
+        _fixpoint.reachable(2, ok_pre, 2, add, 1, 3, 2, np.ones(3, bool), np.ones(1, bool),
+                            index)
+    with pytest.raises(ValueError, match="not an index"):
+        _fixpoint.reachable(1, ok_pre, 2, add, 1, 3, 2, np.ones(3, bool), np.ones(1, bool),
+                            index[:-8])
+    broken = np.frombuffer(index, np.int64).copy()
+    broken[-1] = 7  # a row id outside the 1 row
+    with pytest.raises(ValueError, match="outside"):
+        _fixpoint.reachable(1, ok_pre, 2, add, 1, 3, 2, np.ones(3, bool), np.ones(1, bool),
+                            broken.tobytes())
+    reached = _fixpoint.reachable(1, ok_pre, 2, add, 1, 3, 2,
+                                  np.array([1, 0, 1], bool), np.ones(1, bool), index)
+    assert list(reached) == [0]  # fact 1 is not reached
+    reached = _fixpoint.reachable(1, ok_pre, 2, add, 1, 3, 2,
+                                  np.array([1, 1, 0], bool), np.ones(1, bool), index)
+    assert list(reached) == [1]
 
 
 def test_derived_rows_filled_in_any_order_match_a_fresh_sort(corridor):
