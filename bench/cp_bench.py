@@ -6,9 +6,10 @@ Instances: the AVS problems in domains/avs/problems, generated AVS problems of g
 times, their ratio (FD / ours, > 1 means we are faster), both plans' cost and, for AVS, both
 plans' true objective c + R(1 - p). FD cannot read probabilities, so for it each ground
 action's cost becomes round(100 (c + R (-ln p))) through a per-action cost fluent. Our time is
-`planning_time_s` (grounding + search, cold grounding cache) and, for AVS, also a warm replan
-(cache hit). FD's time is the wall time of `OneshotPlanner.solve` (writing PDDL, translate,
-search). Our plans are checked with UP's sequential plan validator.
+`planning_time_s` (grounding + search), the median of 5 cold calls (new problem object, new
+grounding cache) and, for AVS, also of 5 warm replans (cache hit). FD's time is the wall time
+of `OneshotPlanner.solve`, one run (writing PDDL, translate, search). Our plans are checked
+with UP's sequential plan validator.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import math
 import statistics
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from unified_planning.engines.plan_validator import SequentialPlanValidator
@@ -42,6 +44,7 @@ TIMEOUT_S = 10.0
 PROHIBITIVE = 10**7
 OPTIONS = SearchOptions(reward=REWARD, weight=2.0, heuristic="ff", timeout_s=TIMEOUT_S)
 SIZES = (AvsSize(8, 2, 2, 4), AvsSize(12, 3, 3, 6), AvsSize(20, 5, 4, 8))
+RUNS = 5  # our timings per instance (median); FD runs once (0.3-9 s each)
 
 
 def avs_cases(quick: bool, full: bool = False) -> list[tuple[str, ProbabilisticProblem]]:
@@ -127,16 +130,28 @@ def valid(problem: Problem, up_plan) -> bool:
     return validator.validate(problem, up_plan).status.name == "VALID"
 
 
-def bench_case(label: str, pproblem: ProbabilisticProblem, probabilistic: bool) -> dict:
+def bench_case(label: str, pproblem: ProbabilisticProblem, probabilistic: bool,
+               runs: int = RUNS) -> dict:
+    """Our time is the median of `runs` cold calls (each on a new problem object with a new
+    GroundingCache, the heap collected first) and, for AVS, of `runs` warm replans; single
+    timings on this shared machine vary up to 1.5x from run to run."""
+    colds = []
+    for _ in range(runs):
+        fresh = replace(pproblem)  # a new problem object: nothing is cached for it
+        gc.collect()  # each timing starts from a collected heap (the planner pauses the GC)
+        colds.append(plan(fresh, OPTIONS, cache=GroundingCache()))
+    ours: PlanResult = colds[0]
     cache = GroundingCache()
-    gc.collect()  # each timing starts from a collected heap (the planner pauses the GC)
-    ours: PlanResult = plan(pproblem, OPTIONS, cache=cache)
-    gc.collect()
-    warm = plan(pproblem, OPTIONS, cache=cache).planning_time_s if probabilistic else math.nan
+    plan(pproblem, OPTIONS, cache=cache)
+    warms = []
+    for _ in range(runs if probabilistic else 0):
+        gc.collect()
+        warms.append(plan(pproblem, OPTIONS, cache=cache).planning_time_s)
     task = ground(pproblem, cache=cache)
     fd_input = fd_problem(pproblem, task) if probabilistic else pproblem.problem
     fd_time, fd_plan = run_fd(fd_input)
-    row = {"label": label, "ours_s": ours.planning_time_s, "warm_s": warm, "fd_s": fd_time,
+    row = {"label": label, "ours_s": statistics.median(r.planning_time_s for r in colds),
+           "warm_s": statistics.median(warms) if warms else math.nan, "fd_s": fd_time,
            "status": ours.status.value, "expanded": ours.expanded}
     if ours.solved:
         row["ours_valid"] = valid(pproblem.problem, to_up_plan(pproblem.problem, ours.plan))
@@ -173,6 +188,11 @@ def report(rows: list[dict], title: str, probabilistic: bool) -> list[float]:
     print(f"-- median ours {statistics.median([r['ours_s'] for r in rows]) * 1e3:.1f} ms "
           f"(solved {len(solved)}/{len(rows)}), median FD/ours ratio "
           f"{_fmt(statistics.median(ratios) if ratios else math.nan, '.2f')}")
+    office = [r for r in rows if r["label"].startswith("avs/") or "-p20-" in r["label"]]
+    if probabilistic and office:  # issue 3's target set: the seed's situations + ~20 places
+        print(f"-- office scale (seed problems + 20-place ones, {len(office)}): median ours "
+              f"{statistics.median(r['ours_s'] for r in office) * 1e3:.1f} ms cold, "
+              f"{statistics.median(r['warm_s'] for r in office) * 1e3:.1f} ms warm")
     warm = [r["warm_s"] for r in rows if not math.isnan(r["warm_s"])]
     if warm:
         warm_ratios = [r["fd_s"] / r["warm_s"] for r in rows
