@@ -5,6 +5,8 @@
  * compute the same least fixpoints as the numpy versions in avs_planner/cp/derived.py, which
  * stay as the fallback when this module is not built; tests compare the two.
  *
+ * fill_rows: a structure row's fact ids sorted and unique, and its bitset words, for the rows
+ *   a call needs (derived.py keeps them per structure).
  * index: rows by fact (CSR) of a matrix, built once per structure and passed to the others
  *   (one int64 buffer: n_facts + 1 offsets, then the row ids; every occurrence once).
  * reachable: relaxed reachability. A row is active when every fact of its `pre` row is
@@ -74,6 +76,104 @@ bad:
     PyErr_Format(PyExc_ValueError, "%s: not an index over %zd facts", what, n_facts);
     PyBuffer_Release(view);
     return -1;
+}
+
+/* A writable C-contiguous buffer of exactly `count` items of `itemsize` bytes. */
+static int get_writable(PyObject *obj, Py_buffer *view, Py_ssize_t count, Py_ssize_t itemsize,
+                        const char *what)
+{
+    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0)
+        return -1;
+    if (view->len != count * itemsize) {
+        PyErr_Format(PyExc_ValueError, "%s: %zd bytes, expected %zd", what, view->len,
+                     count * itemsize);
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
+static PyObject *fill_rows(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *src_o, *idx_o, *out_o, *bits_o, *done_o;
+    Py_ssize_t rows, width, n_facts, n_words, k;
+    if (!PyArg_ParseTuple(args, "nOnnnOnOOO", &rows, &src_o, &width, &n_facts, &n_words,
+                          &idx_o, &k, &out_o, &bits_o, &done_o))
+        return NULL;
+    if (rows < 0 || width < 0 || n_facts < 0 || n_words < n_facts / 64 + 1 || k < 0) {
+        PyErr_SetString(PyExc_ValueError, "fill_rows: bad sizes");
+        return NULL;
+    }
+    Py_buffer b[5];
+    int got = 0;
+    PyObject *result = NULL;
+    int64_t *tmp = NULL;
+    if (get_buffer(src_o, &b[got], rows * width, 8, "fill_rows: matrix") < 0)
+        goto done;
+    got++;
+    if (get_buffer(idx_o, &b[got], k, 8, "fill_rows: rows") < 0)
+        goto done;
+    got++;
+    if (get_writable(out_o, &b[got], rows * width, 8, "fill_rows: out") < 0)
+        goto done;
+    got++;
+    if (get_writable(bits_o, &b[got], rows * n_words, 8, "fill_rows: bits") < 0)
+        goto done;
+    got++;
+    if (get_writable(done_o, &b[got], rows, 1, "fill_rows: done") < 0)
+        goto done;
+    got++;
+    const int64_t *src = b[0].buf, *idx = b[1].buf;
+    int64_t *out = b[2].buf;
+    uint64_t *bits = b[3].buf;
+    uint8_t *flag = b[4].buf;
+    if (check_range(idx, k, rows, "fill_rows: rows") < 0)
+        goto done;
+    tmp = malloc(((size_t)width + 1) * sizeof(int64_t));
+    if (!tmp) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (Py_ssize_t i = 0; i < k; i++) {
+        int64_t r = idx[i];
+        if (flag[r])
+            continue;
+        /* the valid ids (0 <= id < n_facts) sorted (insertion sort: rows are short), then
+         * unique, then -1 padding: what structure.fact_matrix(row, n_facts, None) gives */
+        Py_ssize_t m = 0;
+        for (Py_ssize_t j = 0; j < width; j++) {
+            int64_t f = src[r * width + j];
+            if (f < 0 || f >= n_facts)
+                continue;
+            Py_ssize_t at = m++;
+            while (at > 0 && tmp[at - 1] > f) {
+                tmp[at] = tmp[at - 1];
+                at--;
+            }
+            tmp[at] = f;
+        }
+        int64_t *row = out + r * width;
+        uint64_t *words = bits + r * n_words;
+        memset(words, 0, (size_t)n_words * sizeof(uint64_t));
+        Py_ssize_t u = 0;
+        for (Py_ssize_t j = 0; j < m; j++) {
+            if (u && row[u - 1] == tmp[j])
+                continue;
+            row[u++] = tmp[j];
+            words[tmp[j] >> 6] |= (uint64_t)1 << (tmp[j] & 63);
+        }
+        for (; u < width; u++)
+            row[u] = -1;
+        flag[r] = 1;
+    }
+    result = Py_None;
+    Py_INCREF(result);
+done:
+    free(tmp);
+    for (int j = 0; j < got; j++)
+        PyBuffer_Release(&b[j]);
+    return result;
 }
 
 static PyObject *build_index(PyObject *self, PyObject *args)
@@ -336,6 +436,10 @@ done:
 }
 
 static PyMethodDef methods[] = {
+    {"fill_rows", fill_rows, METH_VARARGS,
+     "fill_rows(rows, matrix, width, n_facts, n_words, row_ids, k, out, out_bits, done): "
+     "for each listed row not yet done, its valid fact ids sorted and unique (-1 padded) "
+     "into out and as little-endian uint64 bitset words into out_bits; marks it done"},
     {"index", build_index, METH_VARARGS,
      "index(rows, matrix, width, n_facts) -> bytes: int64 offsets (n_facts + 1) then the "
      "row ids, per fact the rows whose matrix row names it (entries outside [0, n_facts) "

@@ -52,7 +52,7 @@ class Derived:
 
     def __init__(self, st: GroundStructure):
         self._st = st
-        self._done = np.zeros(st.size, dtype=bool)
+        self._done = np.zeros((4, st.size), dtype=bool)  # per matrix: row filled in
         n_words = len(st.facts) // 64 + 1
         self.matrices = tuple(np.empty(m.shape, dtype=np.int64)
                               for m in (st.pre, st.pre_neg, st.add, st.delete))
@@ -74,15 +74,22 @@ class Derived:
 
     def rows(self, rows: np.ndarray) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
         """The four matrices and bitset words of these rows (computing the missing ones)."""
-        missing = rows[~self._done[rows]]
-        if len(missing):
-            st, n = self._st, len(self._st.facts)
-            for source, matrix, bits in zip((st.pre, st.pre_neg, st.add, st.delete),
-                                            self.matrices, self.bits, strict=True):
+        st, n = self._st, len(self._st.facts)
+        sources = (st.pre, st.pre_neg, st.add, st.delete)
+        if _fixpoint is not None:
+            rows = np.ascontiguousarray(rows, dtype=np.int64)
+            for k, (source, matrix, bits) in enumerate(zip(sources, self.matrices, self.bits,
+                                                           strict=True)):
+                _fixpoint.fill_rows(st.size, source, source.shape[1], n, bits.shape[1], rows,
+                                    len(rows), matrix, bits, self._done[k])
+        else:
+            missing = rows[~self._done[0][rows]]
+            for k, (source, matrix, bits) in enumerate(zip(sources, self.matrices, self.bits,
+                                                           strict=True)):
                 sorted_rows = fact_matrix(np.take(source, missing, axis=0), n, None)
                 matrix[missing] = sorted_rows
                 bits[missing] = bit_words(sorted_rows, n)
-            self._done[missing] = True
+                self._done[k][missing] = True
         # np.take: ~3x faster than m[rows] for a row gather
         return (tuple(np.take(m, rows, axis=0) for m in self.matrices),
                 tuple(np.take(b, rows, axis=0) for b in self.bits))

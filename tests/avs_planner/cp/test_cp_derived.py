@@ -115,6 +115,11 @@ def test_compiled_fixpoints_reject_bad_input():
     with pytest.raises(ValueError, match="outside"):
         _fixpoint.reachable(1, ok_pre, 2, add, 1, 3, 2, np.ones(3, bool), np.ones(1, bool),
                             broken.tobytes())
+    out, bits, done = np.zeros((1, 2), np.int64), np.zeros((1, 1), "<u8"), np.zeros(1, bool)
+    with pytest.raises(ValueError, match="outside"):
+        _fixpoint.fill_rows(1, ok_pre, 2, 3, 1, np.array([1]), 1, out, bits, done)
+    _fixpoint.fill_rows(1, np.array([[2, 0]]), 2, 3, 1, np.array([0]), 1, out, bits, done)
+    assert out.tolist() == [[0, 2]] and bits.tolist() == [[0b101]] and done.all()
     reached = _fixpoint.reachable(1, ok_pre, 2, add, 1, 3, 2,
                                   np.array([1, 0, 1], bool), np.ones(1, bool), index)
     assert list(reached) == [0]  # fact 1 is not reached
@@ -123,9 +128,15 @@ def test_compiled_fixpoints_reject_bad_input():
     assert list(reached) == [1]
 
 
-def test_derived_rows_filled_in_any_order_match_a_fresh_sort(corridor):
+@pytest.mark.parametrize("compiled", [True, False])
+def test_derived_rows_filled_in_any_order_match_a_fresh_sort(corridor, monkeypatch, compiled):
     from avs_planner.cp.derived import Derived, bit_words
     from avs_planner.cp.structure import fact_matrix
+
+    if compiled and derived._fixpoint is None:
+        pytest.skip("compiled fixpoints not built")
+    if not compiled:
+        monkeypatch.setattr(derived, "_fixpoint", None)
 
     st = GroundingCache().structure(corridor, world_state(corridor.problem))
     n = len(st.facts)
