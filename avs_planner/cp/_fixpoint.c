@@ -23,11 +23,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A C-contiguous buffer of `count` items of `itemsize` bytes, or an error naming `what`. */
+/* A C-contiguous (and, if asked, writable) buffer of `count` items of `itemsize` bytes, or
+ * an error naming `what`. */
 static int get_buffer(PyObject *obj, Py_buffer *view, Py_ssize_t count, Py_ssize_t itemsize,
-                      const char *what)
+                      const char *what, int writable)
 {
-    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS) < 0)
+    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS | (writable ? PyBUF_WRITABLE : 0)) < 0)
         return -1;
     if (view->len != count * itemsize) {
         PyErr_Format(PyExc_ValueError, "%s: %zd bytes, expected %zd", what, view->len,
@@ -78,17 +79,20 @@ bad:
     return -1;
 }
 
-/* A writable C-contiguous buffer of exactly `count` items of `itemsize` bytes. */
-static int get_writable(PyObject *obj, Py_buffer *view, Py_ssize_t count, Py_ssize_t itemsize,
-                        const char *what)
+/* Buffers acquired in order; *got counts those held (release them whatever happens). */
+typedef struct {
+    PyObject *obj;
+    Py_ssize_t count, itemsize;
+    int writable;
+    const char *what;
+} Spec;
+
+static int get_all(const Spec *specs, int n, Py_buffer *b, int *got)
 {
-    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) < 0)
-        return -1;
-    if (view->len != count * itemsize) {
-        PyErr_Format(PyExc_ValueError, "%s: %zd bytes, expected %zd", what, view->len,
-                     count * itemsize);
-        PyBuffer_Release(view);
-        return -1;
+    for (; *got < n; (*got)++) {
+        const Spec *sp = &specs[*got];
+        if (get_buffer(sp->obj, &b[*got], sp->count, sp->itemsize, sp->what, sp->writable) < 0)
+            return -1;
     }
     return 0;
 }
@@ -109,21 +113,15 @@ static PyObject *fill_rows(PyObject *self, PyObject *args)
     int got = 0;
     PyObject *result = NULL;
     int64_t *tmp = NULL;
-    if (get_buffer(src_o, &b[got], rows * width, 8, "fill_rows: matrix") < 0)
+    const Spec specs[5] = {
+        {src_o, rows * width, 8, 0, "fill_rows: matrix"},
+        {idx_o, k, 8, 0, "fill_rows: rows"},
+        {out_o, rows * width, 8, 1, "fill_rows: out"},
+        {bits_o, rows * n_words, 8, 1, "fill_rows: bits"},
+        {done_o, rows, 1, 1, "fill_rows: done"},
+    };
+    if (get_all(specs, 5, b, &got) < 0)
         goto done;
-    got++;
-    if (get_buffer(idx_o, &b[got], k, 8, "fill_rows: rows") < 0)
-        goto done;
-    got++;
-    if (get_writable(out_o, &b[got], rows * width, 8, "fill_rows: out") < 0)
-        goto done;
-    got++;
-    if (get_writable(bits_o, &b[got], rows * n_words, 8, "fill_rows: bits") < 0)
-        goto done;
-    got++;
-    if (get_writable(done_o, &b[got], rows, 1, "fill_rows: done") < 0)
-        goto done;
-    got++;
     const int64_t *src = b[0].buf, *idx = b[1].buf;
     int64_t *out = b[2].buf;
     uint64_t *bits = b[3].buf;
@@ -188,7 +186,7 @@ static PyObject *build_index(PyObject *self, PyObject *args)
         return NULL;
     }
     Py_buffer b;
-    if (get_buffer(m_o, &b, rows * width, 8, "index: matrix") < 0)
+    if (get_buffer(m_o, &b, rows * width, 8, "index: matrix", 0) < 0)
         return NULL;
     const int64_t *m = b.buf;
     PyObject *out = NULL;
@@ -224,6 +222,21 @@ done:
     return out;
 }
 
+/* Row r applies: mark it and queue the facts it adds that were not reached yet. */
+static inline Py_ssize_t fire(int64_t r, const int64_t *add, Py_ssize_t aw, Py_ssize_t never,
+                              uint8_t *active, uint8_t *reached, int64_t *queue, Py_ssize_t tail)
+{
+    active[r] = 1;
+    for (Py_ssize_t j = 0; j < aw; j++) {
+        int64_t g = add[r * aw + j];
+        if (g != never && !reached[g]) {
+            reached[g] = 1;
+            queue[tail++] = g;
+        }
+    }
+    return tail;
+}
+
 static PyObject *reachable(PyObject *self, PyObject *args)
 {
     (void)self;
@@ -242,18 +255,14 @@ static PyObject *reachable(PyObject *self, PyObject *args)
     int64_t *count = NULL, *queue = NULL;
     uint8_t *reached = NULL;
     const int64_t *off, *val;
-    if (get_buffer(pre_o, &b[got], rows * pw, 8, "reachable: pre") < 0)
+    const Spec specs[4] = {
+        {pre_o, rows * pw, 8, 0, "reachable: pre"},
+        {add_o, rows * aw, 8, 0, "reachable: add"},
+        {init_o, n_slots, 1, 0, "reachable: init"},
+        {allowed_o, rows, 1, 0, "reachable: allowed"},
+    };
+    if (get_all(specs, 4, b, &got) < 0)
         goto done;
-    got++;
-    if (get_buffer(add_o, &b[got], rows * aw, 8, "reachable: add") < 0)
-        goto done;
-    got++;
-    if (get_buffer(init_o, &b[got], n_slots, 1, "reachable: init") < 0)
-        goto done;
-    got++;
-    if (get_buffer(allowed_o, &b[got], rows, 1, "reachable: allowed") < 0)
-        goto done;
-    got++;
     if (get_index(index_o, &b[got], n_slots, rows, "reachable: index", &off, &val) < 0)
         goto done;
     got++;
@@ -282,32 +291,15 @@ static PyObject *reachable(PyObject *self, PyObject *args)
             queue[tail++] = f;
         }
     }
-    for (Py_ssize_t r = 0; pw == 0 && r < rows; r++) { /* no preconditions: fire at once */
-        if (!allowed[r])
-            continue;
-        active[r] = 1;
-        for (Py_ssize_t j = 0; j < aw; j++) {
-            int64_t g = add[r * aw + j];
-            if (g != never && !reached[g]) {
-                reached[g] = 1;
-                queue[tail++] = g;
-            }
-        }
-    }
+    for (Py_ssize_t r = 0; pw == 0 && r < rows; r++) /* no preconditions: fire at once */
+        if (allowed[r])
+            tail = fire(r, add, aw, never, active, reached, queue, tail);
     while (head < tail) {
         int64_t f = queue[head++];
         for (int64_t k = off[f]; k < off[f + 1]; k++) {
             int64_t r = val[k];
-            if (!allowed[r] || --count[r] != 0)
-                continue;
-            active[r] = 1;
-            for (Py_ssize_t j = 0; j < aw; j++) {
-                int64_t g = add[r * aw + j];
-                if (g != never && !reached[g]) {
-                    reached[g] = 1;
-                    queue[tail++] = g;
-                }
-            }
+            if (allowed[r] && --count[r] == 0)
+                tail = fire(r, add, aw, never, active, reached, queue, tail);
         }
     }
 done:
@@ -358,17 +350,18 @@ static PyObject *relevant(PyObject *self, PyObject *args)
     s.n = n;
     /* clause facts per row, interleaved offsets (2 * (rows + 1) entries): row r's positives
      * are cpos[coff[2r] .. coff[2r + 2]), its negatives cneg[coff[2r + 1] .. coff[2r + 3]) */
-    const Py_ssize_t sizes[8] = {rows * pw, rows * nw, 2 * (rows + 1), cpos_n, cneg_n, rows,
-                                 gt_n, gf_n};
-    const Py_ssize_t items[8] = {8, 8, 8, 8, 8, 1, 8, 8};
-    PyObject *objs[8] = {pre_o, neg_o, coff_o, cpos_o, cneg_o, allowed_o, gt_o, gf_o};
-    static const char *names[8] = {"relevant: pre", "relevant: pre_neg",
-                                   "relevant: clause offsets", "relevant: clause positives",
-                                   "relevant: clause negatives", "relevant: allowed",
-                                   "relevant: goal", "relevant: goal_neg"};
-    for (; got < 8; got++)
-        if (get_buffer(objs[got], &b[got], sizes[got], items[got], names[got]) < 0)
-            goto done;
+    const Spec specs[8] = {
+        {pre_o, rows * pw, 8, 0, "relevant: pre"},
+        {neg_o, rows * nw, 8, 0, "relevant: pre_neg"},
+        {coff_o, 2 * (rows + 1), 8, 0, "relevant: clause offsets"},
+        {cpos_o, cpos_n, 8, 0, "relevant: clause positives"},
+        {cneg_o, cneg_n, 8, 0, "relevant: clause negatives"},
+        {allowed_o, rows, 1, 0, "relevant: allowed"},
+        {gt_o, gt_n, 8, 0, "relevant: goal"},
+        {gf_o, gf_n, 8, 0, "relevant: goal_neg"},
+    };
+    if (get_all(specs, 8, b, &got) < 0)
+        goto done;
     const int64_t *aoff, *aval, *doff, *dval;
     if (get_index(ai_o, &b[got], n, rows, "relevant: add index", &aoff, &aval) < 0)
         goto done;
@@ -380,8 +373,8 @@ static PyObject *relevant(PyObject *self, PyObject *args)
     const int64_t *coff = b[2].buf, *cpos = b[3].buf, *cneg = b[4].buf;
     const uint8_t *allowed = b[5].buf;
     const int64_t *gt = b[6].buf, *gf = b[7].buf;
-    if (check_range(pre, sizes[0], n_slots, names[0]) < 0 ||
-        check_range(neg, sizes[1], n_slots, names[1]) < 0)
+    if (check_range(pre, rows * pw, n_slots, "relevant: pre") < 0 ||
+        check_range(neg, rows * nw, n_slots, "relevant: pre_neg") < 0)
         goto done;
     for (Py_ssize_t r = 0; r < rows; r++) {
         if (coff[2 * r] > coff[2 * r + 2] || coff[2 * r + 1] > coff[2 * r + 3] ||
