@@ -188,11 +188,13 @@ def report(rows: list[dict], title: str, probabilistic: bool) -> list[float]:
     print(f"-- median ours {statistics.median([r['ours_s'] for r in rows]) * 1e3:.1f} ms "
           f"(solved {len(solved)}/{len(rows)}), median FD/ours ratio "
           f"{_fmt(statistics.median(ratios) if ratios else math.nan, '.2f')}")
-    office = [r for r in rows if r["label"].startswith("avs/") or "-p20-" in r["label"]]
-    if probabilistic and office:  # issue 3's target set: the seed's situations + ~20 places
-        print(f"-- office scale (seed problems + 20-place ones, {len(office)}): median ours "
-              f"{statistics.median(r['ours_s'] for r in office) * 1e3:.1f} ms cold, "
-              f"{statistics.median(r['warm_s'] for r in office) * 1e3:.1f} ms warm")
+    if probabilistic:  # issue 3's office scale: the seed's situations and ~20-place ones
+        for name, group in (("seed problems", [r for r in rows if r["label"].startswith("avs/")]),
+                            ("20-place problems", [r for r in rows if "-p20-" in r["label"]])):
+            if group:
+                print(f"-- {name} ({len(group)}): median ours "
+                      f"{statistics.median(r['ours_s'] for r in group) * 1e3:.1f} ms cold, "
+                      f"{statistics.median(r['warm_s'] for r in group) * 1e3:.1f} ms warm")
     warm = [r["warm_s"] for r in rows if not math.isnan(r["warm_s"])]
     if warm:
         warm_ratios = [r["fd_s"] / r["warm_s"] for r in rows

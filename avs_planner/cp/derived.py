@@ -1,6 +1,6 @@
 """Arrays derived from a grounding structure, and the per-call fixpoints that run on them.
 
-`derived(st)` is kept per cached `GroundStructure` (for the last few). It fills in, as calls
+`derived(st)` is kept with its `GroundStructure` (`GroundStructure.memo`). It fills in, as calls
 need rows, each row's facts sorted and unique, as fact-id matrices and as uint64 bitset words;
 it also holds the rows' clause facts as CSR. A planning call takes its kept rows from these
 (`task_rows`) instead of sorting and packing them again. `reachable` and `relevant` are the
@@ -9,8 +9,6 @@ same result; tests compare them).
 """
 
 from __future__ import annotations
-
-from collections import OrderedDict
 
 import numpy as np
 
@@ -95,20 +93,12 @@ class Derived:
                 tuple(np.take(b, rows, axis=0) for b in self.bits))
 
 
-_DERIVED: OrderedDict[int, tuple[GroundStructure, Derived]] = OrderedDict()
-
-
 def derived(st: GroundStructure) -> Derived:
-    """The structure's derived arrays, kept for the last few structures."""
-    hit = _DERIVED.get(id(st))
-    if hit is not None and hit[0] is st:
-        _DERIVED.move_to_end(id(st))
-        return hit[1]
-    value = Derived(st)
-    _DERIVED[id(st)] = (st, value)  # a strong ref keeps the id unique
-    while len(_DERIVED) > 16:
-        _DERIVED.popitem(last=False)
-    return value
+    """The structure's derived arrays, made on first use and kept with the structure."""
+    value = st.memo.get("derived")
+    if value is None:
+        value = st.memo["derived"] = Derived(st)
+    return value  # type: ignore[return-value]
 
 
 def _clause_csr(st: GroundStructure) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

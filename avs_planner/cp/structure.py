@@ -60,6 +60,9 @@ class GroundStructure:
     clauses: Mapping[int, tuple[tuple[tuple[int, ...], tuple[int, ...]], ...]]
     arg_ids: np.ndarray  # (rows, max arity) object ids of the arguments, padded with -1
     _rows: dict[int, tuple] = field(default_factory=dict, compare=False, repr=False)
+    memo: dict[str, object] = field(default_factory=dict, compare=False, repr=False)
+    """Arrays other modules derive from the structure (`derived.derived`), kept with it so
+    they are freed when the grounding cache drops the structure."""
 
     @property
     def size(self) -> int:
