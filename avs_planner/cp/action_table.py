@@ -109,9 +109,9 @@ class ActionTable(Sequence[GroundAction]):
         The structure's rows of one schema are sorted by their argument ids, parameter by
         parameter, so the row is found by narrowing a range per argument."""
         st = self._st
-        if self._blocks is None:
-            self._blocks = {b.schema.name.lower(): k for k, b in enumerate(st.blocks)}
+        if self._blocks is None:  # objects first: `_blocks` set means both are
             self._objects = {n.lower(): i for i, n in enumerate(st.space.names)}
+            self._blocks = {b.schema.name.lower(): k for k, b in enumerate(st.blocks)}
         k = self._blocks.get(name.lower())
         if k is None:
             return None

@@ -81,9 +81,9 @@ class Derived:
                 _fixpoint.fill_rows(st.size, source, source.shape[1], n, bits.shape[1], rows,
                                     len(rows), matrix, bits, self._done[k])
         else:
-            missing = rows[~self._done[0][rows]]
             for k, (source, matrix, bits) in enumerate(zip(sources, self.matrices, self.bits,
                                                            strict=True)):
+                missing = rows[~self._done[k][rows]]  # per matrix: safe if calls interleave
                 sorted_rows = fact_matrix(np.take(source, missing, axis=0), n, None)
                 matrix[missing] = sorted_rows
                 bits[missing] = bit_words(sorted_rows, n)
