@@ -287,8 +287,9 @@ def _ground(
     d = derived(st)
     clauses = {}  # action index -> clauses as bitsets (few rows have any)
     if len(d.clause_rows):
-        read[d.clauses[1][kept[d.clause_pos_rows]]] = True
-        read[d.clauses[2][kept[d.clause_neg_rows]]] = True
+        _, positives, negatives = d.clauses
+        read[positives[kept[d.clause_pos_rows]]] = True
+        read[negatives[kept[d.clause_neg_rows]]] = True
         with_clauses = d.clause_rows[kept[d.clause_rows]]
         clauses = dict(zip(np.searchsorted(kept_rows, with_clauses).tolist(),
                            map(d.clause_bits.__getitem__, with_clauses.tolist()), strict=True))
