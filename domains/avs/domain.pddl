@@ -11,7 +11,7 @@
 ;;    functions are static costs. Only total-cost changes.
 (define (domain avs)
   (:requirements :strips :typing :negative-preconditions :disjunctive-preconditions
-                 :universal-preconditions :action-costs :probabilistic-effects)
+                 :universal-preconditions :equality :action-costs :probabilistic-effects)
 
   (:types
     place location label category relation - object
@@ -70,11 +70,15 @@
               (and (not (virtual ?o)) (label-of ?o ?l) (related ?o in ?r)
                    (defined-exists ?l in ?r))))
 
+  ;; (not (= ?o ?s)): an object is not assumed on itself. A virtual support that an assumption
+  ;; gave a label is no longer virtual, so no plan uses these groundings; ruling them out in
+  ;; the domain keeps them out of the relaxed heuristics too (15% of the ground actions of a
+  ;; 20-place problem, planning 15-30% faster, same plans).
   (:action assume-obj-exists-on
     :parameters (?l - label ?s - visualobject ?sl - label ?c - category ?r - room
                  ?o - visualobject)
     :precondition (and (label-of ?s ?sl) (related ?s in ?r) (has-category ?r ?c) (virtual ?o)
-                       (not (defined-exists ?l on ?s)))
+                       (not (= ?o ?s)) (not (defined-exists ?l on ?s)))
     :effect (probabilistic (p-obj-on ?l ?sl ?c)
               (and (not (virtual ?o)) (label-of ?o ?l) (related ?o on ?s)
                    (defined-exists ?l on ?s))))
