@@ -24,7 +24,7 @@ class ActionTable(Sequence[GroundAction]):
     nothing reads dropped (`read_mask`) and the cost and probability of this call."""
 
     __slots__ = ("_st", "_rows", "_cost", "_probability", "_read", "_built", "_all",
-                 "_blocks", "_objects")
+                 "_blocks", "_objects", "memo")
 
     def __init__(self, structure: GroundStructure, rows: np.ndarray, cost: np.ndarray,
                  probability: np.ndarray, read_mask: int):
@@ -37,6 +37,9 @@ class ActionTable(Sequence[GroundAction]):
         self._all: tuple[GroundAction, ...] | None = None
         self._blocks: dict[str, int] | None = None
         self._objects: dict[str, int] | None = None
+        self.memo: dict[str, object] = {}
+        """What consumers derive from these actions (the native packer's task), kept with
+        them so it goes when the task goes."""
 
     def __len__(self) -> int:
         return len(self._rows)

@@ -50,20 +50,30 @@ def _bits(mask: int, n_bytes: int, n_facts: int, where) -> bytes:
 
 
 def pack_task(task: GroundTask):
-    """The `_native.Task` for this task's actions (cached per action table and fact table)."""
+    """The `_native.Task` for this task's actions (kept with a grounder's action table; for
+    plain tuples, in a small LRU per action table and fact table)."""
     if _native is None:
         raise PlanningError("native search core is not built (pip install -e . builds it)")
+    memo = getattr(task.actions, "memo", None)
+    if memo is not None:  # an ActionTable: the packed task lives (and dies) with it
+        hit = memo.get("native")
+        if hit is None or hit[0] is not task.facts:
+            hit = memo["native"] = (task.facts, _pack(task))
+        return hit[1]
     key = id(task.actions)
     hit = _packed.get(key)
     if hit is not None and hit[0] is task.actions and hit[1] is task.facts:
         _packed.move_to_end(key)
         return hit[2]
-    args = task_arrays(task) if task.arrays is not None else task_args(task)
-    packed = _native.Task(*args)
+    packed = _pack(task)
     _packed[key] = (task.actions, task.facts, packed)  # strong refs: ids stay unique
     while len(_packed) > _CACHE_SIZE:
         _packed.popitem(last=False)
     return packed
+
+
+def _pack(task: GroundTask):
+    return _native.Task(*(task_arrays(task) if task.arrays is not None else task_args(task)))
 
 
 def _check_actions(task: GroundTask) -> tuple[bytes, bytes, bytes]:
