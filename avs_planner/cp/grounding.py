@@ -36,7 +36,8 @@ def world_state(problem: Problem) -> WorldState:
     """The problem's initial state as atoms and numeric values (explicit :init entries)."""
     atoms: set[Atom] = set()
     values: dict[Atom, float] = {}
-    names: dict[FNode, str] = {}  # UP shares one node per object: name each once
+    names: dict[FNode, str] = {}  # UP shares one node per object and per constant:
+    constants: dict[FNode, bool | float | None] = {}  # read each once
     for fluent_exp, value in problem.explicit_initial_values.items():
         key = [fluent_exp.fluent().name]
         for arg in fluent_exp.args:
@@ -44,14 +45,27 @@ def world_state(problem: Problem) -> WorldState:
             if name is None:
                 name = names[arg] = arg.object().name
             key.append(name)
-        if not value.is_constant():
-            continue
-        constant = value.constant_value()
+        if value in constants:
+            constant = constants[value]
+        else:
+            constant = constants[value] = _constant(value)
         if constant is True:
             atoms.add(tuple(key))
-        elif isinstance(constant, (int, Fraction)) and not isinstance(constant, bool):
-            values[tuple(key)] = float(constant)
+        elif constant is not None and constant is not False:
+            values[tuple(key)] = constant
     return WorldState(frozenset(atoms), values)
+
+
+def _constant(value: FNode) -> bool | float | None:
+    """True/False for a boolean constant, a float for a number, None for anything else."""
+    if not value.is_constant():
+        return None
+    constant = value.constant_value()
+    if isinstance(constant, bool):
+        return constant
+    if isinstance(constant, (int, Fraction)):
+        return float(constant)
+    return None
 
 
 def static_fluent_names(problem: Problem) -> frozenset[str]:
