@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avs_planner.cp.structure import GroundStructure, bitset, fact_matrix
+from avs_planner.cp.structure import GroundStructure, bit_words, bitset, fact_matrix
 
 try:  # the compiled fixpoints; the numpy versions below compute the same when not built
     from avs_planner.cp import _fixpoint
@@ -27,18 +27,6 @@ def ids_of(mask: int) -> np.ndarray:
         return np.zeros(0, dtype=np.int64)
     data = np.frombuffer(mask.to_bytes((mask.bit_length() + 7) // 8, "little"), np.uint8)
     return np.flatnonzero(np.unpackbits(data, bitorder="little")).astype(np.int64)
-
-
-def bit_words(matrix: np.ndarray, n_facts: int) -> np.ndarray:
-    """Each row's fact ids (>= 0; -1 is padding) as little-endian uint64 words, one spare bit
-    so that n_facts = 0 still has a word (the native core's layout)."""
-    words = n_facts // 64 + 1
-    out = np.zeros((matrix.shape[0], words), dtype="<u8")
-    rows, cols = np.nonzero(matrix >= 0)
-    facts = matrix[rows, cols]
-    np.bitwise_or.at(out, (rows, facts >> 6),
-                     np.left_shift(np.uint64(1), (facts & 63).astype(np.uint64)))
-    return out
 
 
 class Derived:

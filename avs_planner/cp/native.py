@@ -16,6 +16,7 @@ from array import array
 from collections import OrderedDict
 from itertools import chain
 
+from avs_planner.cp.structure import bit_words
 from avs_planner.cp.symmetry import Symmetries
 from avs_planner.cp.task import GroundTask
 from avs_planner.errors import PlanningError
@@ -170,14 +171,6 @@ def task_arrays(task: GroundTask) -> tuple:
             raise PlanningError("native search: the task's arrays name a fact outside it")
         return m
 
-    def bitsets(m: np.ndarray) -> bytes:
-        out = np.zeros((n_actions, n_words), dtype="<u8")
-        rows, cols = np.nonzero(m >= 0)
-        facts = m[rows, cols]
-        np.bitwise_or.at(out, (rows, facts >> 6),
-                         np.left_shift(np.uint64(1), (facts & 63).astype(np.uint64)))
-        return out.tobytes()
-
     def csr(m: np.ndarray) -> tuple[bytes, bytes]:
         valid = m >= 0
         offsets = np.zeros(n_actions + 1, dtype="<i8")
@@ -192,7 +185,7 @@ def task_arrays(task: GroundTask) -> tuple:
     ):
         masks = tuple(np.ascontiguousarray(b).tobytes() for b in given)
     else:
-        masks = (bitsets(pre), bitsets(neg), bitsets(add), bitsets(delete))
+        masks = tuple(bit_words(m, n_facts).tobytes() for m in (pre, neg, add, delete))
     return (n_facts, n_actions, *masks,
             *_check_actions(task), *csr(pre), *csr(add),
             *_clauses(task, 8 * n_words, n_facts))

@@ -212,8 +212,7 @@ def _native_search(
         options.timeout_s, options.node_limit, _lazy(task, options), _preferred(options),
         symmetries, start,
     )
-    take = getattr(task.actions, "take", None)  # an ActionTable builds only these
-    steps = take(path) if take is not None else [task.actions[i] for i in path]
+    steps = task.steps(path)
     return _finish(task, options, PlanStatus(status), steps, start, expanded, generated,
                    engine="native")
 
@@ -380,7 +379,7 @@ class _Search:
             path.append(self.via[node])
             node = self.parents[node]
         path.reverse()
-        steps = [self.task.actions[i] for i in path]
+        steps = self.task.steps(path)
         return _finish(
             self.task, self.options, status, steps, self.start, expanded, len(self.states),
             engine="python",

@@ -122,14 +122,21 @@ class GroundStructure:
 
 def _row_masks(matrix: np.ndarray, n: int) -> list[int]:
     """Each row's fact ids (>= 0; -1 is padding) as a Python int bitset."""
-    words = n // 64 + 1
-    out = np.zeros((matrix.shape[0], words), dtype=np.uint64)
+    words = bit_words(matrix, n)
+    data, size = words.tobytes(), words.shape[1] * 8
+    return [int.from_bytes(data[i:i + size], "little") for i in range(0, len(data), size)]
+
+
+def bit_words(matrix: np.ndarray, n_facts: int) -> np.ndarray:
+    """Each row's fact ids (>= 0; -1 is padding) as little-endian uint64 words, one spare bit
+    so that n_facts = 0 still has a word (the native core's layout)."""
+    words = n_facts // 64 + 1
+    out = np.zeros((matrix.shape[0], words), dtype="<u8")
     rows, cols = np.nonzero(matrix >= 0)
     facts = matrix[rows, cols]
-    np.bitwise_or.at(out, (rows, facts // 64),
-                     np.left_shift(np.uint64(1), (facts % 64).astype(np.uint64)))
-    data, size = out.tobytes(), 8 * words
-    return [int.from_bytes(data[i:i + size], "little") for i in range(0, len(data), size)]
+    np.bitwise_or.at(out, (rows, facts >> 6),
+                     np.left_shift(np.uint64(1), (facts & 63).astype(np.uint64)))
+    return out
 
 
 def bitset(ids) -> int:

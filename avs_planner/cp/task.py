@@ -162,5 +162,10 @@ class GroundTask:
             return find(name, tuple(args))
         return self.by_signature.get((name.lower(), *(a.lower() for a in args)))
 
+    def steps(self, indices: Iterable[int]) -> list[GroundAction]:
+        """The actions at these indices (a plan); an `ActionTable` builds only these."""
+        take = getattr(self.actions, "take", None)
+        return take(indices) if take is not None else [self.actions[i] for i in indices]
+
     def with_init(self, init: int) -> GroundTask:
         return replace(self, init=init)

@@ -74,3 +74,24 @@ def test_symmetries_from_the_arrays_match_those_from_the_actions(generated, corr
                                             n_facts)
             assert [bytes(memoryview(x)) for x in grouped] == \
                 [bytes(memoryview(x)) for x in mapped]
+
+
+def test_no_object_is_assumed_on_itself(corridor, generated):
+    """The AVS domain rules out `assume-obj-exists-on` with the support as the new object:
+    no state allows it, but the relaxed heuristics would otherwise pay for those groundings."""
+    for pproblem in (corridor, generated):
+        task = ground(pproblem, cache=GroundingCache())
+        on = [a for a in task.actions if a.name == "assume-obj-exists-on"]
+        assert on  # the problems do assume objects on (virtual) supports
+        assert all(a.args[1] != a.args[5] for a in on)
+
+
+def test_initial_state_and_packed_task_are_kept_per_problem_and_task(corridor):
+    cache = GroundingCache()
+    state = cache.initial_state(corridor)
+    assert cache.initial_state(corridor) is state
+    assert state == world_state(corridor.problem)
+    task = ground(corridor, cache=cache)
+    if native.AVAILABLE:  # a replan from another state reuses the packed actions
+        assert native.pack_task(task) is native.pack_task(task.with_init(0))
+        assert native.pack_task(ground(corridor, cache=cache)) is not native.pack_task(task)

@@ -130,8 +130,8 @@ def test_compiled_fixpoints_reject_bad_input():
 
 @pytest.mark.parametrize("compiled", [True, False])
 def test_derived_rows_filled_in_any_order_match_a_fresh_sort(corridor, monkeypatch, compiled):
-    from avs_planner.cp.derived import Derived, bit_words
-    from avs_planner.cp.structure import fact_matrix
+    from avs_planner.cp.derived import Derived
+    from avs_planner.cp.structure import bit_words, fact_matrix
 
     if compiled and derived._fixpoint is None:
         pytest.skip("compiled fixpoints not built")
