@@ -84,6 +84,10 @@ class PlanCreate(BaseModel):
     reward: float | None = Field(None, gt=0, description="R in c(pi) + R(1 - p(pi))")
     weight: float | None = Field(None, ge=1, le=100)
     timeout_s: float | None = Field(None, gt=0, le=3600)
+    patience: int | None = Field(
+        None, ge=0, le=10_000_000,
+        description="once a plan is found, expansions without a better one before the best "
+        "is returned (default 2500 with the default heuristic)")
 
 
 class PlanPublic(BaseModel):
@@ -97,6 +101,9 @@ class PlanPublic(BaseModel):
     reward: float | None = None
     planning_time_s: float | None = None
     expanded: int | None = None
+    stopped_by: str | None = Field(
+        None, description="patience, timeout or node_limit: the search was stopped with a "
+        "plan in hand, which is the best found so far")
 
 
 class DomainCheckCreate(BaseModel):

@@ -135,7 +135,8 @@ class AvsPlanner(Engine, OneshotPlannerMixin):
         }
         if not result.solved:
             return PlanGenerationResult(_STATUS[result.status], None, self.name, metrics)
-        optimal = get_heuristic(options.heuristic).admissible and options.weight == 1.0
+        optimal = (get_heuristic(options.heuristic).admissible and options.weight == 1.0
+                   and result.stopped_by is None)
         status = (
             PlanGenerationResultStatus.SOLVED_OPTIMALLY if optimal
             else PlanGenerationResultStatus.SOLVED_SATISFICING

@@ -26,7 +26,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="plan a (probabilistic) PDDL problem",
         description="Find a plan minimising c(pi) + R(1 - p(pi)) (seed 003). Exit codes: "
         "0 solved, 1 bad input, 2 unsolvable / no plan with p > 0 (or above --min-success), "
-        "3 timeout or node limit.",
+        "3 timeout or node limit with no plan found yet (with one found, the best so far is "
+        "printed, exit 0, and `stopped_by` says which limit ended the search).",
     )
     parser.add_argument("domain", help="domain PDDL file")
     parser.add_argument("problem", help="problem PDDL file")
@@ -37,6 +38,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="weight w >= 1 on the remaining cost estimate (1: A*; default 2)")
     parser.add_argument("--timeout", type=float, default=None, help="seconds (default: none)")
     parser.add_argument("--node-limit", type=int, default=None, help="max expanded states")
+    parser.add_argument("--patience", type=_patience, default=None,
+                        help="once a plan is found, expansions without a better one before "
+                        "the best is returned ('inf': no limit; default 2500 with an "
+                        "inadmissible heuristic, no limit with hmax)")
     parser.add_argument("--heuristic", default="ff",
                         help="hmax (admissible), hadd, ff (default) or blind")
     parser.add_argument("--min-success", type=float, default=0.0,
@@ -55,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
     given = {"reward": args.reward, "weight": args.weight}
     options = SearchOptions(
         heuristic=args.heuristic, timeout_s=args.timeout, node_limit=args.node_limit,
-        min_success=args.min_success, engine=args.engine,
+        min_success=args.min_success, engine=args.engine, patience=args.patience,
         **{k: v for k, v in given.items() if v is not None},
     ).check()
     pproblem = read_files(args.domain, args.problem)
@@ -64,10 +69,23 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_CODES[result.status.value]
 
 
+def _patience(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not value >= 0 or (math.isfinite(value) and value != int(value)):
+        raise argparse.ArgumentTypeError(f"expected a whole number of expansions >= 0 or "
+                                         f"'inf', got {text!r}")
+    return value
+
+
 def _text(result: PlanResult) -> str:
     lines = [step.label for step in result.plan]
     if not result.solved:
         lines.append(f"; status: {result.status.value}")
+    if result.stopped_by:
+        lines.append(f"; stopped by: {result.stopped_by} (the best plan found so far)")
     lines += [
         f"; cost: {result.cost:g}",
         f"; probability: {result.probability:.6g}",

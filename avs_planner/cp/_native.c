@@ -28,6 +28,8 @@ typedef uint64_t word;
 enum { H_BLIND = 0, H_MAX = 1, H_ADD = 2, H_FF = 3 };
 enum { ST_SOLVED = 0, ST_UNSOLVABLE = 1, ST_THRESHOLD = 2, ST_TIMEOUT = 3, ST_NODE_LIMIT = 4 };
 enum { ST_INTERRUPTED = -2 };
+/* why a search returned its best plan so far instead of a proven one (search.py STOPS) */
+enum { STOP_NONE = 0, STOP_TIMEOUT = 1, STOP_NODE_LIMIT = 2, STOP_PATIENCE = 3 };
 
 #define BIT(s, f) (((s)[(f) >> 6] >> ((f) & 63)) & 1u)
 
@@ -537,7 +539,8 @@ typedef struct {
     /* options */
     int heuristic, lazy, preferred;
     double reward, weight, min_success, timeout;
-    int64_t node_limit;
+    int64_t node_limit, patience; /* patience < 0: unlimited */
+    int stopped;                  /* STOP_*: why the best plan so far was returned */
     /* goal */
     word *goal, *goal_neg;
     int32_t *goal_facts;
@@ -1290,12 +1293,24 @@ static double now_s(void)
 }
 
 /* returns status; *goal_node set when solved; -1 on allocation failure */
+/* A limit was hit: the best plan found so far (the incumbent) if any, else the limit's status. */
+static int stop_at(Search *s, int32_t best, int32_t *goal_node, int why, int status)
+{
+    if (best < 0)
+        return status;
+    *goal_node = best;
+    s->stopped = why;
+    return ST_SOLVED;
+}
+
 static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *expanded_out)
 {
     const TaskObject *t = s->t;
     Py_ssize_t W = s->W, A = t->n_actions;
     double t0 = now_s();
-    int64_t expanded = 0;
+    int64_t expanded = 0, best_at = 0;
+    double best_obj = INFINITY;
+    int32_t best = -1; /* incumbent: the best goal node popped so far, expanded at best_at */
     *expanded_out = 0;
     if (push_node(s, init, 0.0, 1.0, -1, -1, 0) < 0)
         return -1;
@@ -1316,6 +1331,11 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
         const word *state = s->succ + W;
         if (is_goal_state(s, state)) {
             double obj = objective(c, p, s->reward);
+            if (obj < best_obj) {
+                best_obj = obj;
+                best = node;
+                best_at = expanded;
+            }
             if (s->from_pref && s->heap.n && s->heap.v[0].f < obj) {
                 s->n_alive[node] = 1;
                 if (qpush(s, &s->heap, obj, 0.0, node))
@@ -1328,10 +1348,12 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
         }
         expanded += 1;
         *expanded_out = expanded;
+        if (best >= 0 && s->patience >= 0 && expanded - best_at > s->patience)
+            return stop_at(s, best, goal_node, STOP_PATIENCE, ST_SOLVED);
         if (s->node_limit >= 0 && expanded > s->node_limit)
-            return ST_NODE_LIMIT;
+            return stop_at(s, best, goal_node, STOP_NODE_LIMIT, ST_NODE_LIMIT);
         if (s->timeout >= 0 && now_s() - t0 > s->timeout)
-            return ST_TIMEOUT;
+            return stop_at(s, best, goal_node, STOP_TIMEOUT, ST_TIMEOUT);
         if (s->thread && (expanded & 1023) == 0) { /* let Ctrl-C through now and then */
             PyEval_RestoreThread(s->thread);
             int interrupted = PyErr_CheckSignals();
@@ -1494,15 +1516,17 @@ static PyObject *native_search(PyObject *self, PyObject *args)
     memset(b, 0, sizeof(b));
     Search s;
     memset(&s, 0, sizeof(s));
-    long long node_limit;
-    if (!PyArg_ParseTuple(args, "O!y*y*y*iddddLppy*y*y*y*:search", &TaskType, &t, &b[0], &b[1],
-                          &b[2], &s.heuristic, &s.reward, &s.weight, &s.min_success, &s.timeout,
-                          &node_limit, &s.lazy, &s.preferred, &b[3], &b[4], &b[5], &b[6]))
+    long long node_limit, patience;
+    if (!PyArg_ParseTuple(args, "O!y*y*y*iddddLLppy*y*y*y*:search", &TaskType, &t, &b[0],
+                          &b[1], &b[2], &s.heuristic, &s.reward, &s.weight, &s.min_success,
+                          &s.timeout, &node_limit, &patience, &s.lazy, &s.preferred, &b[3],
+                          &b[4], &b[5], &b[6]))
         return NULL;
     PyObject *result = NULL;
     s.t = t;
     s.W = t->W;
     s.node_limit = node_limit;
+    s.patience = patience;
     s.best_h = INFINITY;
     Py_ssize_t W = t->W, F = t->n_facts, A = t->n_actions;
     if (s.heuristic < H_BLIND || s.heuristic > H_FF) {
@@ -1553,7 +1577,8 @@ static PyObject *native_search(PyObject *self, PyObject *args)
         }
         PyTuple_SET_ITEM(path, --i, v);
     }
-    result = Py_BuildValue("(iNLi)", status, path, (long long)expanded, (int)s.n_nodes);
+    result = Py_BuildValue("(iNLii)", status, path, (long long)expanded, (int)s.n_nodes,
+                           s.stopped);
 done:
     search_free(&s);
     for (int i = 0; i < 7; i++)

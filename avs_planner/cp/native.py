@@ -28,6 +28,7 @@ except ImportError:  # not built (no compiler): the Python search is used
 
 HEURISTIC_CODES = {"blind": 0, "hmax": 1, "hadd": 2, "ff": 3}
 STATUS_NAMES = ("solved", "unsolvable", "no_plan_above_threshold", "timeout", "node_limit")
+STOP_NAMES = (None, "timeout", "node_limit", "patience")  # _native.c STOP_*
 _CACHE_SIZE = 8
 if sys.byteorder != "little":  # the packed words are little-endian uint64
     _native = None
@@ -281,12 +282,14 @@ def run(
     min_success: float,
     timeout_s: float | None,
     node_limit: int | None,
+    patience: float,
     lazy: bool,
     preferred: bool,
     symmetries: Symmetries,
     start: float,
-) -> tuple[str, tuple[int, ...], int, int]:
-    """Run the C search: (status name, action indices of the plan, expanded, generated)."""
+) -> tuple[str, tuple[int, ...], int, int, str | None]:
+    """Run the C search: (status name, action indices of the plan, expanded, generated, why
+    the best plan so far was returned: None or one of search.STOPS)."""
     packed = pack_task(task)
     n_facts = len(task.facts)
     n_bytes = 8 * words(n_facts)
@@ -294,15 +297,16 @@ def run(
     remaining = -1.0
     if timeout_s is not None:  # the clock started with the search call, as in Python
         remaining = max(0.0, timeout_s - (time.perf_counter() - start))
-    status, path, expanded, generated = _native.search(
+    status, path, expanded, generated, stopped = _native.search(
         packed,
         _bits(task.init, n_bytes, n_facts, "the initial state"),
         _bits(task.goal, n_bytes, n_facts, "the goal"),
         _bits(task.goal_neg, n_bytes, n_facts, "the goal"),
         HEURISTIC_CODES[heuristic], float(reward), float(weight), float(min_success),
-        remaining, -1 if node_limit is None else int(node_limit), lazy, preferred, *sym,
+        remaining, -1 if node_limit is None else int(node_limit),
+        -1 if math.isinf(patience) else int(patience), lazy, preferred, *sym,
     )
-    return STATUS_NAMES[status], path, expanded, generated
+    return STATUS_NAMES[status], path, expanded, generated, STOP_NAMES[stopped]
 
 
 def estimates(

@@ -25,6 +25,7 @@ from avs_planner.cp.task import GroundAction, GroundTask, atom_str
 from avs_planner.errors import PlanningError
 
 DEFAULT_REWARD = 500.0  # as domains/README.md assumes for the AVS domain
+DEFAULT_PATIENCE = 2500  # expansions without a better plan (inadmissible heuristics only)
 ENGINES = ("auto", "native", "python")  # auto: the compiled core when it was built
 
 
@@ -50,6 +51,10 @@ class SearchOptions:
     lazy: bool | None = None  # deferred evaluation; None: only on deterministic tasks
     preferred: bool = True  # helpful actions first (dual queue) when h is inadmissible and has them
     engine: str = "auto"  # "native" (C core, same results), "python", or auto: native if built
+    patience: float | None = None
+    """Once a plan is found, expansions allowed without finding a better one before the best
+    is returned. None: DEFAULT_PATIENCE with an inadmissible heuristic, unlimited
+    (math.inf) with an admissible one, so w = 1 stays optimal."""
 
     def check(self) -> SearchOptions:
         if self.reward < 0 or not math.isfinite(self.reward):
@@ -63,6 +68,8 @@ class SearchOptions:
         if not 0.0 <= self.min_success <= 1.0:
             raise PlanningError(f"success threshold must be in [0, 1], got {self.min_success}")
         get_heuristic(self.heuristic)
+        if self.patience is not None and not self.patience >= 0:
+            raise PlanningError(f"patience must be >= 0 expansions (or inf), got {self.patience}")
         if self.engine not in ENGINES:
             raise PlanningError(
                 f"unknown engine {self.engine!r} (choose one of: {', '.join(ENGINES)})")
@@ -72,6 +79,13 @@ class SearchOptions:
         if self.engine == "native" and self.heuristic not in native.HEURISTIC_CODES:
             raise PlanningError(f"engine 'native' has no heuristic {self.heuristic!r}")
         return self
+
+    @property
+    def patience_used(self) -> float:
+        """Expansions without improvement after a plan is found (math.inf: no limit)."""
+        if self.patience is not None:
+            return self.patience
+        return math.inf if get_heuristic(self.heuristic).admissible else DEFAULT_PATIENCE
 
     @property
     def engine_used(self) -> str:
@@ -118,6 +132,9 @@ class PlanResult:
     weight: float = 1.0
     grounding_time_s: float = 0.0
     extra: dict = field(default_factory=dict)
+    stopped_by: str | None = None
+    """Set when a limit ("timeout", "node_limit") or the patience ran out after a plan was
+    found: the plan is the best found so far, not one the search showed nothing beats."""
 
     @property
     def solved(self) -> bool:
@@ -138,6 +155,7 @@ class PlanResult:
             "reward": self.reward,
             "heuristic": self.heuristic,
             "weight": self.weight,
+            "stopped_by": self.stopped_by,
         }
 
 
@@ -207,14 +225,14 @@ def _preferred(options: SearchOptions) -> bool:
 def _native_search(
     task: GroundTask, options: SearchOptions, start: float, symmetries: Symmetries
 ) -> PlanResult:
-    status, path, expanded, generated = native.run(
+    status, path, expanded, generated, stopped = native.run(
         task, options.heuristic, options.reward, options.weight, options.min_success,
-        options.timeout_s, options.node_limit, _lazy(task, options), _preferred(options),
-        symmetries, start,
+        options.timeout_s, options.node_limit, options.patience_used, _lazy(task, options),
+        _preferred(options), symmetries, start,
     )
     steps = task.steps(path)
     return _finish(task, options, PlanStatus(status), steps, start, expanded, generated,
-                   engine="native")
+                   engine="native", stopped_by=stopped)
 
 
 class _Search:
@@ -248,6 +266,8 @@ class _Search:
         self.h_of_node: list[float] = []
         self.evaluated: list[bool] = []
         self.commutes: dict[tuple[int, int], bool] = {}
+        self.patience = options.patience_used
+        self.best: tuple[float, int, int] | None = None  # incumbent: (objective, node, expanded)
 
     def f(self, state: int, c: float, p: float) -> float:
         """c + w*hc + R(1 - p exp(-hl)): the weight inflates the remaining cost only; weighting
@@ -342,6 +362,9 @@ class _Search:
             self.alive[node] = False
             state, c, p = self.states[node], self.costs[node], self.probs[node]
             if task.is_goal(state):
+                obj = objective(c, p, self.reward)
+                if self.best is None or obj < self.best[0]:
+                    self.best = (obj, node, expanded)
                 if self.from_pref and self.heap and self.heap[0][0] < objective(c, p, self.reward):
                     # a helpful-action goal is only taken if no open node promises better
                     self.alive[node] = True
@@ -349,11 +372,13 @@ class _Search:
                     continue
                 return self.finish(PlanStatus.SOLVED, node, expanded)
             expanded += 1
+            if self.best is not None and expanded - self.best[2] > self.patience:
+                return self.stop("patience", PlanStatus.SOLVED, expanded)
             if options.node_limit is not None and expanded > options.node_limit:
-                return self.finish(PlanStatus.NODE_LIMIT, None, expanded)
+                return self.stop("node_limit", PlanStatus.NODE_LIMIT, expanded)
             if options.timeout_s is not None:
                 if time.perf_counter() - self.start > options.timeout_s:
-                    return self.finish(PlanStatus.TIMEOUT, None, expanded)
+                    return self.stop("timeout", PlanStatus.TIMEOUT, expanded)
             last = self.via[node]
             helpful = self.helpful.get(state, frozenset()) if self.helpful is not None else ()
             for a in actions:
@@ -373,7 +398,15 @@ class _Search:
         )
         return self.finish(status, None, expanded)
 
-    def finish(self, status: PlanStatus, node: int | None, expanded: int) -> PlanResult:
+    def stop(self, why: str, status: PlanStatus, expanded: int) -> PlanResult:
+        """A limit was hit: the best plan found so far if there is one, else `status`."""
+        if self.best is None:
+            return self.finish(status, None, expanded)
+        return self.finish(PlanStatus.SOLVED, self.best[1], expanded, stopped_by=why)
+
+    def finish(
+        self, status: PlanStatus, node: int | None, expanded: int, stopped_by: str | None = None
+    ) -> PlanResult:
         path: list[int] = []
         while node is not None and node >= 0 and self.via[node] >= 0:
             path.append(self.via[node])
@@ -382,7 +415,7 @@ class _Search:
         steps = self.task.steps(path)
         return _finish(
             self.task, self.options, status, steps, self.start, expanded, len(self.states),
-            engine="python",
+            engine="python", stopped_by=stopped_by,
         )
 
 
@@ -395,6 +428,7 @@ def _finish(
     expanded: int,
     generated: int,
     engine: str | None = None,
+    stopped_by: str | None = None,
 ) -> PlanResult:
     elapsed = time.perf_counter() - start
     extra = {"engine": engine or options.engine_used}
@@ -411,5 +445,5 @@ def _finish(
         status, plan, cost, probability, objective(cost, probability, options.reward),
         planning_time_s=elapsed, expanded=expanded, generated=generated,
         reward=options.reward, heuristic=options.heuristic, weight=options.weight,
-        extra=extra,
+        extra=extra, stopped_by=stopped_by,
     )

@@ -76,6 +76,21 @@ def test_bad_options_are_422(client: TestClient) -> None:
     assert extra.status_code == 422
 
 
+def test_plan_patience_and_stopped_by(client: TestClient) -> None:
+    from bench.avs_generator import AvsSize, generate
+
+    domain = (Path(__file__).resolve().parents[2] / "domains/avs/domain.pddl").read_text()
+    problem = generate(AvsSize(8, 2, 2, 4), 5)  # a first plan after 18 expansions
+    body = client.post("/v1/plans", json={"domain": domain, "problem": problem,
+                                          "patience": 50}).json()
+    assert body["status"] == "solved" and body["stopped_by"] == "patience"
+    assert body["expanded"] == 18 + 50 + 1
+    plain = client.post("/v1/plans", json={"domain": DOMAIN, "problem": PROBLEM}).json()
+    assert plain["stopped_by"] is None
+    bad = client.post("/v1/plans", json={"domain": DOMAIN, "problem": PROBLEM, "patience": -1})
+    assert bad.status_code == 422 and bad.json()["detail"][0]["loc"][-1] == "patience"
+
+
 def test_domain_check_reports_diagnostics(client: TestClient) -> None:
     typo = PROBLEM.replace("(:goal (lit kitchen))", "(:goal (lt kitchen))")
     body = {"domain": DOMAIN, "problems": [PROBLEM, typo]}
