@@ -92,17 +92,15 @@
                  (increase (total-cost) (move-cost ?from ?to))))
 
   ;; View cones for a room need the room fully explored: every placeholder in it visited.
-  ;; Cones are made only for a label where an object of it is assumed or known
-  ;; (defined-exists): cones for labels nobody looks for only grow the search space.
   (:action createviewcones-in
     :parameters (?l - label ?r - room)
-    :precondition (and (not (virtual ?r)) (defined-exists ?l in ?r)
+    :precondition (and (not (virtual ?r))
                        (forall (?q - placeholder) (imply (in-room ?q ?r) (visited ?q))))
     :effect (and (viewcones ?l in ?r) (increase (total-cost) 1)))
 
   (:action createviewcones-on
     :parameters (?l - label ?s - visualobject)
-    :precondition (and (detected ?s) (defined-exists ?l on ?s))
+    :precondition (detected ?s)
     :effect (and (viewcones ?l on ?s) (increase (total-cost) 1)))
 
   ;; SEARCHFOROBJECT hands control to the DT planner, which starts from the robot's place ?p.

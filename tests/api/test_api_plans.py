@@ -80,11 +80,11 @@ def test_plan_patience_and_stopped_by(client: TestClient) -> None:
     from bench.avs_generator import AvsSize, generate
 
     domain = (Path(__file__).resolve().parents[2] / "domains/avs/domain.pddl").read_text()
-    problem = generate(AvsSize(8, 2, 2, 4), 5)  # a first plan after 17 expansions
+    problem = generate(AvsSize(8, 2, 2, 4), 5)  # a first plan after 18 expansions
     body = client.post("/v1/plans", json={"domain": domain, "problem": problem,
-                                          "patience": 3}).json()
+                                          "patience": 50}).json()
     assert body["status"] == "solved" and body["stopped_by"] == "patience"
-    assert body["expanded"] == 17 + 3 + 1
+    assert body["expanded"] == 18 + 50 + 1
     plain = client.post("/v1/plans", json={"domain": DOMAIN, "problem": PROBLEM}).json()
     assert plain["stopped_by"] is None
     bad = client.post("/v1/plans", json={"domain": DOMAIN, "problem": PROBLEM, "patience": -1})

@@ -294,15 +294,11 @@ def test_packing_from_the_grounder_arrays_equals_packing_from_actions(name):
 
 
 def _generated_p8():
-    return _generated(8, 2, 2, 4)
-
-
-def _generated(*size: int):
     from avs_planner.pddl import read_text
     from bench.avs_generator import AvsSize, generate
 
     domain = (ROOT / "domains/avs/domain.pddl").read_text()
-    return read_text(domain, generate(AvsSize(*size), 0), "domain.pddl", "generated")
+    return read_text(domain, generate(AvsSize(8, 2, 2, 4), 0), "domain.pddl", "p8")
 
 
 class _Alarm(Exception):
@@ -316,7 +312,7 @@ def test_a_long_native_search_lets_signals_through():
     import signal
     import time
 
-    task = ground(_generated(20, 5, 4, 8))  # blind search at w = 1 runs for many seconds
+    task = ground(_generated_p8())  # blind search at w = 1 runs for many seconds here
 
     def alarm(signum, frame):
         raise _Alarm
