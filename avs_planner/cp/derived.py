@@ -109,7 +109,28 @@ def task_rows(st: GroundStructure, kept_rows: np.ndarray, read: np.ndarray
               ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
     """The kept rows' (pre, pre_neg, add, delete) fact-id matrices and bitset words, with
     add and delete facts that `read` (bool over fact ids + pads) does not mark removed:
-    what `fact_matrix(rows, n, read)` gives, from the cached sorted rows."""
+    what `fact_matrix(rows, n, read)` gives. Compiled, the rows are sorted afresh into
+    k-row arrays (cheaper than filling, then gathering from, the structure-wide cache)."""
+    if _fixpoint is None:
+        return _task_rows_numpy(st, kept_rows, read)
+    n = len(st.facts)
+    n_words = n // 64 + 1
+    rows = np.ascontiguousarray(kept_rows, dtype=np.int64)
+    read_facts = np.ascontiguousarray(read[:n], dtype=bool)
+    matrices, bits = [], []
+    for source, mask in ((st.pre, None), (st.pre_neg, None), (st.add, read_facts),
+                         (st.delete, read_facts)):
+        out = np.empty((len(rows), source.shape[1]), dtype=np.int64)
+        words = np.empty((len(rows), n_words), dtype="<u8")
+        _fixpoint.gather_rows(st.size, source, source.shape[1], n, n_words, rows, len(rows),
+                              mask, out, words)
+        matrices.append(out)
+        bits.append(words)
+    return tuple(matrices), tuple(bits)
+
+
+def _task_rows_numpy(st: GroundStructure, kept_rows: np.ndarray, read: np.ndarray
+                     ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
     n = len(st.facts)
     (pre, pre_neg, add, delete), (pre_bits, neg_bits, add_bits, delete_bits) = (
         derived(st).rows(kept_rows)
