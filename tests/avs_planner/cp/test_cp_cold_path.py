@@ -10,6 +10,7 @@ import pytest
 from avs_planner.cp import derived
 from avs_planner.cp.encoding import NumericValues
 from avs_planner.cp.grounding import GroundingCache, world_state
+from avs_planner.cp.task import WorldState
 
 
 @pytest.fixture(scope="module")
@@ -57,3 +58,69 @@ def test_numeric_values_by_code_match_dict_lookups(corridor_structure):
         others = others[[space.decode(int(c))[0] == fluent for c in others]]
         assert not values.lookup(fluent, others)[1].any()
     assert not values.lookup("at", np.array([space.base["at"]]))[1].any()
+
+
+def _swap(atom, a, b):
+    return (atom[0], *(b if x == a else a if x == b else x for x in atom[1:]))
+
+
+def _pairwise_classes(names, state):
+    """The definition: a joins the first class whose first member it can swap with, the
+    swap mapping every true atom to a true atom and every value to an equal value."""
+    def interchangeable(a, b):
+        atoms = [x for x in (*state.true_atoms, *state.values) if a in x[1:] or b in x[1:]]
+        for atom in atoms:
+            other = _swap(atom, a, b)
+            if atom in state.true_atoms:
+                if other not in state.true_atoms:
+                    return False
+            elif state.values.get(atom) != state.values.get(other):
+                return False
+        return True
+
+    classes: list[list[str]] = []
+    for name in names:
+        for cls in classes:
+            if interchangeable(cls[0], name):
+                cls.append(name)
+                break
+        else:
+            classes.append([name])
+    return [tuple(c) for c in classes]
+
+
+def _random_state(rng, names):
+    """Atoms over a few objects, some of them made symmetric on purpose (copies of o0)."""
+    atoms, values = set(), {}
+    for _ in range(rng.integers(0, 12)):
+        args = tuple(rng.choice(names, size=rng.integers(1, 4)))
+        if rng.random() < 0.5:
+            atoms.add(("p", *args))
+        else:
+            values[("v", *args)] = float(rng.integers(0, 3))
+    for twin in names[1:3]:  # o1, o2 mirror o0 in unary atoms
+        atoms |= {(a[0], twin) for a in atoms if a[1:] == (names[0],)}
+        values |= {(a[0], twin): v for a, v in values.items() if a[1:] == (names[0],)}
+    return WorldState(frozenset(atoms), values)
+
+
+def test_symmetry_classes_match_the_pairwise_definition(corridor):
+    from avs_planner.cp.symmetry import _mentions, _partition
+
+    rng = np.random.default_rng(11)
+    names = [f"o{i}" for i in range(6)]
+    shapes = set()
+    for _ in range(300):
+        state = _random_state(rng, names)
+        order = list(rng.permutation(names))
+        got = _partition(order, state, _mentions(state, set(order)))
+        assert got == _pairwise_classes(order, state)
+        shapes.add(tuple(sorted(map(len, got))))
+    assert len(shapes) >= 5  # the states gave many different partitions
+    state = world_state(corridor.problem)
+    by_type: dict[str, list[str]] = {}
+    for obj in corridor.problem.all_objects:
+        by_type.setdefault(str(obj.type), []).append(obj.name)
+    for group in by_type.values():
+        got = _partition(group, state, _mentions(state, set(group)))
+        assert got == _pairwise_classes(group, state)
