@@ -124,3 +124,16 @@ def test_symmetry_classes_match_the_pairwise_definition(corridor):
     for group in by_type.values():
         got = _partition(group, state, _mentions(state, set(group)))
         assert got == _pairwise_classes(group, state)
+
+
+def test_fact_numbering_writes_into_out_as_it_returns():
+    from avs_planner.cp.structure import _PAD_NONE, _PAD_TRUE, _fact_numbering
+
+    rng = np.random.default_rng(5)
+    array = rng.integers(0, 300, size=(30, 4))
+    array[::3, 1], array[::5, 3] = _PAD_TRUE, _PAD_NONE
+    for space_size in (300, 10**15):  # the dense table and the sorted path
+        _, renumber = _fact_numbering(space_size, [array], np.zeros(0, dtype=np.int64))
+        out = np.full((30, 4), -7, dtype=np.int64)
+        assert renumber(array, out) is out
+        assert out.tolist() == renumber(array).tolist()
