@@ -289,16 +289,18 @@ def _ground(
     probability = _evaluate(st, may_apply, values, "prob")
     _check(st, may_apply, probability, "prob")
     possible = may_apply & (probability > 0.0)
-    kept = relevant(st, reachable(st, reached, possible), goal, goal_neg)
+    if (may_apply != possible).any():  # else reachability over `possible` is `may_apply`
+        possible = reachable(st, reached, possible)
+    kept = relevant(st, possible, goal, goal_neg)
     cost = _evaluate(st, kept, values, "cost")
     _check(st, kept, cost, "cost")
     # effects on facts nothing reads are dropped (e.g. `visited` of ordinary places), so
     # states differing only there merge
     read = np.zeros(n + 2, dtype=bool)
     read[ids_of(goal | goal_neg)] = True
-    read[st.pre[kept]] = True
-    read[st.pre_neg[kept]] = True
     kept_rows = np.flatnonzero(kept)
+    read[np.take(st.pre, kept_rows, axis=0).ravel()] = True  # np.take: faster than a mask
+    read[np.take(st.pre_neg, kept_rows, axis=0).ravel()] = True
     d = derived(st)
     clauses = {}  # action index -> clauses as bitsets (few rows have any)
     if len(d.clause_rows):

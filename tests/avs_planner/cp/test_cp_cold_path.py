@@ -31,6 +31,7 @@ def test_compiled_task_rows_equal_the_numpy_path(corridor_structure, monkeypatch
         with monkeypatch.context() as m:
             m.setattr(derived, "_fixpoint", None)
             plain = derived.task_rows(st, rows, read)
+            st.memo.pop("derived")  # made without the compiled indexes: not for later tests
         for got, expected in zip(compiled[0] + compiled[1], plain[0] + plain[1], strict=True):
             assert got.dtype == expected.dtype and np.array_equal(got, expected)
     empty = derived.task_rows(st, np.zeros(0, dtype=np.int64), np.ones(n + 2, bool))
@@ -137,3 +138,19 @@ def test_fact_numbering_writes_into_out_as_it_returns():
         out = np.full((30, 4), -7, dtype=np.int64)
         assert renumber(array, out) is out
         assert out.tolist() == renumber(array).tolist()
+
+
+def test_reachability_over_its_own_result_is_that_result(corridor_structure):
+    """The grounder skips its second reachability pass when no row was dropped (p = 0):
+    reachable(init, allowed=reachable(init, all rows)) must then be the first result."""
+    st, state = corridor_structure
+    n = len(st.facts)
+    rng = np.random.default_rng(2)
+    for _ in range(5):
+        init = np.zeros(n + 2, dtype=bool)
+        init[rng.choice(n, size=n // 4, replace=False)] = True
+        init[n] = True
+        allowed = rng.random(st.size) < 0.8
+        first = derived.reachable(st, init, allowed)
+        assert first.any()
+        assert np.array_equal(derived.reachable(st, init, first), first)
