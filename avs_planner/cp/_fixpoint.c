@@ -5,11 +5,10 @@
  * compute the same least fixpoints as the numpy versions in avs_planner/cp/derived.py, which
  * stay as the fallback when this module is not built; tests compare the two.
  *
- * fill_rows: a structure row's fact ids sorted and unique, and its bitset words, for the rows
- *   a call needs (derived.py keeps them per structure).
- * gather_rows: the same for a list of rows, written to fresh k-row arrays, optionally keeping
- *   only the facts a `read` mask marks (a call's kept rows: sorting them again is cheaper than
- *   touching and then gathering from the structure-wide cache).
+ * gather_rows: the fact ids of a list of structure rows sorted and unique, and their bitset
+ *   words, written to fresh k-row arrays, optionally keeping only the facts a `read` mask
+ *   marks (a call's kept rows: sorting them afresh is cheaper than keeping a structure-wide
+ *   cache of sorted rows, which only the numpy fallback in derived.py does).
  * index: rows by fact (CSR) of a matrix, built once per structure and passed to the others
  *   (one int64 buffer: n_facts + 1 offsets, then the row ids; every occurrence once).
  * reachable: relaxed reachability. A row is active when every fact of its `pre` row is
@@ -128,59 +127,6 @@ static void sorted_row(const int64_t *src, Py_ssize_t width, Py_ssize_t n_facts,
     }
     for (; u < width; u++)
         row[u] = -1;
-}
-
-static PyObject *fill_rows(PyObject *self, PyObject *args)
-{
-    (void)self;
-    PyObject *src_o, *idx_o, *out_o, *bits_o, *done_o;
-    Py_ssize_t rows, width, n_facts, n_words, k;
-    if (!PyArg_ParseTuple(args, "nOnnnOnOOO", &rows, &src_o, &width, &n_facts, &n_words,
-                          &idx_o, &k, &out_o, &bits_o, &done_o))
-        return NULL;
-    if (rows < 0 || width < 0 || n_facts < 0 || n_words < n_facts / 64 + 1 || k < 0) {
-        PyErr_SetString(PyExc_ValueError, "fill_rows: bad sizes");
-        return NULL;
-    }
-    Py_buffer b[5];
-    int got = 0;
-    PyObject *result = NULL;
-    int64_t *tmp = NULL;
-    const Spec specs[5] = {
-        {src_o, rows * width, 8, 0, "fill_rows: matrix"},
-        {idx_o, k, 8, 0, "fill_rows: rows"},
-        {out_o, rows * width, 8, 1, "fill_rows: out"},
-        {bits_o, rows * n_words, 8, 1, "fill_rows: bits"},
-        {done_o, rows, 1, 1, "fill_rows: done"},
-    };
-    if (get_all(specs, 5, b, &got) < 0)
-        goto done;
-    const int64_t *src = b[0].buf, *idx = b[1].buf;
-    int64_t *out = b[2].buf;
-    uint64_t *bits = b[3].buf;
-    uint8_t *flag = b[4].buf;
-    if (check_range(idx, k, rows, "fill_rows: rows") < 0)
-        goto done;
-    tmp = malloc(((size_t)width + 1) * sizeof(int64_t));
-    if (!tmp) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    for (Py_ssize_t i = 0; i < k; i++) {
-        int64_t r = idx[i];
-        if (flag[r])
-            continue;
-        sorted_row(src + r * width, width, n_facts, NULL, tmp, out + r * width,
-                   bits + r * n_words, n_words);
-        flag[r] = 1;
-    }
-    result = Py_None;
-    Py_INCREF(result);
-done:
-    free(tmp);
-    for (int j = 0; j < got; j++)
-        PyBuffer_Release(&b[j]);
-    return result;
 }
 
 static PyObject *gather_rows(PyObject *self, PyObject *args)
@@ -484,10 +430,6 @@ done:
 }
 
 static PyMethodDef methods[] = {
-    {"fill_rows", fill_rows, METH_VARARGS,
-     "fill_rows(rows, matrix, width, n_facts, n_words, row_ids, k, out, out_bits, done): "
-     "for each listed row not yet done, its valid fact ids sorted and unique (-1 padded) "
-     "into out and as little-endian uint64 bitset words into out_bits; marks it done"},
     {"gather_rows", gather_rows, METH_VARARGS,
      "gather_rows(rows, matrix, width, n_facts, n_words, row_ids, k, read, out, out_bits): "
      "for each listed row, its valid fact ids (those read marks, unless read is None) sorted "

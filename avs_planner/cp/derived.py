@@ -69,24 +69,19 @@ class Derived:
         return cache
 
     def rows(self, rows: np.ndarray) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
-        """The four matrices and bitset words of these rows (computing the missing ones)."""
+        """The four matrices and bitset words of these rows (computing the missing ones,
+        kept per structure): the numpy fallback's path; compiled, `task_rows` sorts the
+        kept rows afresh instead."""
         st, n = self._st, len(self._st.facts)
         done, matrices, all_bits = self._row_cache()
         sources = (st.pre, st.pre_neg, st.add, st.delete)
-        if _fixpoint is not None:
-            rows = np.ascontiguousarray(rows, dtype=np.int64)
-            for k, (source, matrix, bits) in enumerate(zip(sources, matrices, all_bits,
-                                                           strict=True)):
-                _fixpoint.fill_rows(st.size, source, source.shape[1], n, bits.shape[1], rows,
-                                    len(rows), matrix, bits, done[k])
-        else:
-            for k, (source, matrix, bits) in enumerate(zip(sources, matrices, all_bits,
-                                                           strict=True)):
-                missing = rows[~done[k][rows]]  # per matrix: safe if calls interleave
-                sorted_rows = fact_matrix(np.take(source, missing, axis=0), n, None)
-                matrix[missing] = sorted_rows
-                bits[missing] = bit_words(sorted_rows, n)
-                done[k][missing] = True
+        for k, (source, matrix, bits) in enumerate(zip(sources, matrices, all_bits,
+                                                       strict=True)):
+            missing = rows[~done[k][rows]]  # per matrix: safe if calls interleave
+            sorted_rows = fact_matrix(np.take(source, missing, axis=0), n, None)
+            matrix[missing] = sorted_rows
+            bits[missing] = bit_words(sorted_rows, n)
+            done[k][missing] = True
         # np.take: ~3x faster than m[rows] for a row gather
         return (tuple(np.take(m, rows, axis=0) for m in matrices),
                 tuple(np.take(b, rows, axis=0) for b in all_bits))
