@@ -10,7 +10,7 @@ search only tries the lower one.
 from __future__ import annotations
 
 from collections import OrderedDict, defaultdict
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -20,6 +20,11 @@ from avs_planner.cp.task import Atom, GroundTask, WorldState
 from avs_planner.pddl.model import ProbabilisticProblem
 
 Pair = tuple[str, str]
+
+
+def _swapped(atom: Atom, swap: Callable[[str, str], str]) -> Atom:
+    """The atom with two objects exchanged; `swap` is `{a: b, b: a}.get`."""
+    return (atom[0], *map(swap, atom[1:], atom[1:]))
 
 
 _NAMED: OrderedDict[int, tuple[ProbabilisticProblem, frozenset[str]]] = OrderedDict()
@@ -73,16 +78,12 @@ def _mentions(state: WorldState, candidates: set[str]) -> dict[str, list[Atom]]:
 
 def _interchangeable(a: str, b: str, state: WorldState, mentions) -> bool:
     """True if swapping a and b maps the state's true atoms and values onto themselves.
-    a's atoms are tried first, without building the union, so that most pairs that are
-    not interchangeable fail after a few atoms."""
+    a's atoms are tried first, then b's (together, the atoms naming either), so that most
+    pairs that are not interchangeable fail after a few atoms."""
     true_atoms, values = state.true_atoms, state.values
     swap = {a: b, b: a}.get
-    for atom in mentions.get(a, ()):
-        if not _kept(atom, (atom[0], *map(swap, atom[1:], atom[1:])), true_atoms, values):
-            return False
-    atoms = set(mentions.get(a, ())) | set(mentions.get(b, ()))
-    return all(_kept(atom, (atom[0], *map(swap, atom[1:], atom[1:])), true_atoms, values)
-               for atom in atoms)
+    return all(_kept(atom, _swapped(atom, swap), true_atoms, values)
+               for x in (a, b) for atom in mentions.get(x, ()))
 
 
 def _kept(atom: Atom, other: Atom, true_atoms: frozenset[Atom], values) -> bool:
@@ -189,7 +190,7 @@ def _fact_pairs(task: GroundTask, groups: tuple[tuple[str, ...], ...]) -> tuple[
                 touched = sorted(set(facts_of[a]) | set(facts_of[b]))
                 swap, facts, index = {a: b, b: a}.get, task.facts, task.fact_index.get
                 fact_pairs[(a, b)] = tuple(
-                    (f, index((atom[0], *map(swap, atom[1:], atom[1:])), -1))
+                    (f, index(_swapped(atom, swap), -1))
                     for f, atom in zip(touched, map(facts.__getitem__, touched), strict=True)
                 )
     by_args: dict[tuple[str, ...], tuple[Pair, ...]] = {}
