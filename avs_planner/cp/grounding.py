@@ -312,14 +312,30 @@ def _ground(
                            map(d.clause_bits.__getitem__, with_clauses.tolist()), strict=True))
     read_mask = _bits(read[:n])
     cost, probability = np.take(cost, kept_rows), np.take(probability, kept_rows)
+    actions, arrays = _action_table(st, kept_rows, cost, probability, read, read_mask, clauses)
+    return GroundTask(
+        facts=structure.facts, fact_index=structure.fact_index, actions=actions,
+        init=init, goal=goal, goal_neg=goal_neg, goal_impossible=impossible, arrays=arrays,
+    )
+
+
+def _action_table(st: GroundStructure, kept_rows: np.ndarray, cost: np.ndarray,
+                  probability: np.ndarray, read: np.ndarray, read_mask: int,
+                  clauses: dict) -> tuple[ActionTable, TaskArrays]:
+    """The action table and arrays of these rows, costs and probabilities: the previous
+    call's on the same structure if they are the same (a replan whose new state reaches the
+    same actions), so what consumers keep with the table (the native packer's task) is
+    reused; else new ones."""
+    key = (kept_rows.tobytes(), cost.tobytes(), probability.tobytes(), read_mask)
+    last = st.memo.get("last_table")
+    if last is not None and last[0] == key:
+        return last[1], last[2]
     (pre, pre_neg, add, delete), bits = task_rows(st, kept_rows, read)
     arrays = TaskArrays(
         pre=pre, pre_neg=pre_neg, add=add, delete=delete, bits=bits,
         cost=cost, probability=probability, clauses=clauses,
         arg_ids=np.take(st.arg_ids, kept_rows, axis=0), objects=st.space.names,
     )
-    return GroundTask(
-        facts=structure.facts, fact_index=structure.fact_index,
-        actions=ActionTable(st, kept_rows, cost, probability, read_mask),
-        init=init, goal=goal, goal_neg=goal_neg, goal_impossible=impossible, arrays=arrays,
-    )
+    actions = ActionTable(st, kept_rows, cost, probability, read_mask)
+    st.memo["last_table"] = (key, actions, arrays)
+    return actions, arrays

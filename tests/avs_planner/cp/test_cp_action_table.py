@@ -11,6 +11,7 @@ from avs_planner.cp import native
 from avs_planner.cp.action_table import ActionTable
 from avs_planner.cp.grounding import GroundingCache, ground, world_state
 from avs_planner.cp.symmetry import find_symmetries
+from avs_planner.cp.task import WorldState
 from avs_planner.pddl import read_text
 from bench.avs_generator import AvsSize, generate
 
@@ -94,4 +95,30 @@ def test_initial_state_and_packed_task_are_kept_per_problem_and_task(corridor):
     task = ground(corridor, cache=cache)
     if native.AVAILABLE:  # a replan from another state reuses the packed actions
         assert native.pack_task(task) is native.pack_task(task.with_init(0))
-        assert native.pack_task(ground(corridor, cache=cache)) is not native.pack_task(task)
+        changed = _with_a_probability_halved(state)
+        assert native.pack_task(ground(corridor, changed, cache)) is not native.pack_task(task)
+
+
+def _with_a_probability_halved(state: WorldState) -> WorldState:
+    key = min(k for k, v in state.values.items() if 0.0 < v < 1.0)
+    return WorldState(state.true_atoms, {**state.values, key: state.values[key] / 2})
+
+
+def test_a_replan_reaching_the_same_actions_reuses_their_table(corridor):
+    cache = GroundingCache()
+    state = cache.initial_state(corridor)
+    task = ground(corridor, state, cache)
+    moved = WorldState((state.true_atoms - {("at", "place0")}) | {("at", "place1")},
+                       state.values)
+    replan = ground(corridor, moved, cache)
+    assert replan.init != task.init
+    assert replan.actions is task.actions and replan.arrays is task.arrays
+    # the reused table is what grounding afresh gives
+    fresh = ground(corridor, moved, GroundingCache())
+    assert list(replan.actions) == list(fresh.actions)
+    # another probability: a new table with the new value, and the old one is not changed
+    halved = ground(corridor, _with_a_probability_halved(state), cache)
+    assert halved.actions is not task.actions
+    assert sorted(a.probability for a in halved.actions) != sorted(
+        a.probability for a in task.actions)
+    assert list(task.actions) == list(ground(corridor, state, GroundingCache()).actions)
