@@ -219,6 +219,19 @@ def pack_symmetries(symmetries: Symmetries, n_actions: int, n_facts: int) -> tup
     return act_off.tobytes(), ids.astype("<i8").tobytes(), pair_off, fg
 
 
+def _packed_symmetries(task: GroundTask, symmetries: Symmetries) -> tuple:
+    """`pack_symmetries`, kept with a grounder's action table for the last symmetries
+    packed (the symmetry finder hands a replan with the same groups the same object)."""
+    memo = getattr(task.actions, "memo", None)
+    hit = memo.get("native_symmetries") if memo is not None else None
+    if hit is not None and hit[0] is symmetries and hit[1] is task.facts:
+        return hit[2]
+    packed = pack_symmetries(symmetries, len(task.actions), len(task.facts))
+    if memo is not None:
+        memo["native_symmetries"] = (symmetries, task.facts, packed)
+    return packed
+
+
 def _pack_grouped(grouped: tuple, pair_index: dict, n_actions: int) -> tuple[bytes, bytes]:
     """(act_off, pair ids) from `Symmetries.grouped`: the pair ids are looked up once per
     distinct pair list and gathered per action with array arithmetic."""
@@ -293,7 +306,7 @@ def run(
     packed = pack_task(task)
     n_facts = len(task.facts)
     n_bytes = 8 * words(n_facts)
-    sym = pack_symmetries(symmetries, len(task.actions), n_facts)
+    sym = _packed_symmetries(task, symmetries)
     remaining = -1.0
     if timeout_s is not None:  # the clock started with the search call, as in Python
         remaining = max(0.0, timeout_s - (time.perf_counter() - start))

@@ -201,7 +201,21 @@ def _fact_pairs(task: GroundTask, groups: tuple[tuple[str, ...], ...]) -> tuple[
 
 
 def _build(task: GroundTask, groups: Iterable[tuple[str, ...]]) -> Symmetries:
+    """The symmetries of these groups; the last ones are kept with a grounder's action
+    table (its `memo`): a replan that reuses the table often has the same groups."""
     groups = tuple(groups)
+    memo = getattr(task.actions, "memo", None)
+    if memo is not None:
+        hit = memo.get("symmetries")
+        if hit is not None and hit[0] is task.facts and hit[1] == groups:
+            return hit[2]
+    symmetries = _build_new(task, groups)
+    if memo is not None:
+        memo["symmetries"] = (task.facts, groups, symmetries)
+    return symmetries
+
+
+def _build_new(task: GroundTask, groups: tuple[tuple[str, ...], ...]) -> Symmetries:
     fact_pairs, by_args = _fact_pairs(task, groups)
     lower = {b: [(a, b) for a in group[:j]] for group in groups for j, b in enumerate(group)}
     higher = frozenset(b for b, pairs in lower.items() if pairs)

@@ -122,3 +122,24 @@ def test_a_replan_reaching_the_same_actions_reuses_their_table(corridor):
     assert sorted(a.probability for a in halved.actions) != sorted(
         a.probability for a in task.actions)
     assert list(task.actions) == list(ground(corridor, state, GroundingCache()).actions)
+
+
+def test_a_replan_with_the_same_groups_reuses_the_symmetries(generated):
+    cache = GroundingCache()
+    state = cache.initial_state(generated)
+    task = ground(generated, state, cache)
+    first = find_symmetries(generated, state, task)
+    assert first.groups  # the generated problem has interchangeable virtual objects
+    replan = ground(generated, state, cache)
+    again = find_symmetries(generated, state, replan)
+    assert again is first
+    if native.AVAILABLE:
+        assert native._packed_symmetries(replan, again) is native._packed_symmetries(task, first)
+    fresh_task = ground(generated, state, GroundingCache())
+    assert find_symmetries(generated, state, fresh_task) == first
+    # a state that splits a group: other symmetries for the same table
+    virtual = first.groups[-1][0]
+    assert virtual.startswith("new-object")
+    split = WorldState(state.true_atoms | {("detected", virtual)}, state.values)
+    other = find_symmetries(generated, split, task)
+    assert other.groups != first.groups
