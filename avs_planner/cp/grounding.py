@@ -239,6 +239,13 @@ class GroundingCache:
             lambda: build_structure(problem, schemas, static, assumptive, static_names),
         )
 
+    def forget_action_tables(self) -> None:
+        """Drop the action tables kept for reuse (see `_action_table`), so the next call
+        grounds its actions afresh as a replan reaching other actions would (benchmarks
+        measure that case with it)."""
+        for structure in self._structures.values():
+            structure.memo.pop("last_table", None)
+
 
 DEFAULT_CACHE = GroundingCache()
 
