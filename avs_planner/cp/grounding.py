@@ -115,7 +115,22 @@ def _flatten(node: FNode) -> list[FNode]:
 
 def _evaluate(st: GroundStructure, rows: np.ndarray, values: NumericValues,
               what: str) -> np.ndarray:
-    """Success probability (`what` = "prob") or cost of the rows in the boolean mask."""
+    """Success probability (`what` = "prob") or cost of the rows in the boolean mask. The
+    last result per `what` is kept with the structure: a replan from a state with the same
+    numeric values and the same rows (most replans) gets it without evaluating again."""
+    memo = st.memo.setdefault("evaluated", {})
+    key = rows.tobytes()
+    hit = memo.get(what)
+    if hit is not None and hit[1] == key and hit[0] == values.values:
+        return hit[2]
+    out = _evaluate_rows(st, rows, values, what)
+    out.flags.writeable = False  # shared by the calls that hit
+    memo[what] = (dict(values.values), key, out)
+    return out
+
+
+def _evaluate_rows(st: GroundStructure, rows: np.ndarray, values: NumericValues,
+                   what: str) -> np.ndarray:
     out = np.zeros(st.size)
     for block in st.blocks:
         sel = rows[block.start:block.stop]

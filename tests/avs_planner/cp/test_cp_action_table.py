@@ -12,6 +12,7 @@ from avs_planner.cp.action_table import ActionTable
 from avs_planner.cp.grounding import GroundingCache, ground, world_state
 from avs_planner.cp.symmetry import find_symmetries
 from avs_planner.cp.task import WorldState
+from avs_planner.errors import PlanningError
 from avs_planner.pddl import read_text
 from bench.avs_generator import AvsSize, generate
 
@@ -148,3 +149,18 @@ def test_a_replan_with_the_same_groups_reuses_the_symmetries(generated):
     split = WorldState(state.true_atoms | {("detected", virtual)}, state.values)
     other = find_symmetries(generated, split, task)
     assert other.groups != first.groups
+
+
+def test_kept_evaluations_follow_the_numeric_values(corridor):
+    cache = GroundingCache()
+    state = cache.initial_state(corridor)
+    ground(corridor, state, cache)
+    # a value that a reachable action reads goes missing: the error, not the kept numbers
+    key = min(k for k, v in state.values.items() if 0.0 < v < 1.0)
+    missing = WorldState(state.true_atoms, {k: v for k, v in state.values.items() if k != key})
+    with pytest.raises(PlanningError, match=r"no value for \(" + key[0]):
+        ground(corridor, missing, cache)
+    # and a changed value is read again, also after the error
+    halved = ground(corridor, _with_a_probability_halved(state), cache)
+    fresh = ground(corridor, _with_a_probability_halved(state), GroundingCache())
+    assert list(halved.actions) == list(fresh.actions)
