@@ -9,8 +9,9 @@ action's cost becomes round(100 (c + R (-ln p))) through a per-action cost fluen
 `planning_time_s` (grounding + search), the median of 5 cold calls (new problem object, new
 grounding cache) and, for AVS, also of 5 warm replans from the same state (grounding structure,
 action table and packed task reused; in episodes about 60% of replans reuse their table) and
-of 5 replans with the action tables dropped first (as a replan whose new state reaches other
-actions: "warm with new actions" in the summary). FD's time is the wall time
+of 5 replans with what the last call left for reuse dropped first (action table and
+evaluations, as a replan whose new state reaches other actions and values: "warm, new
+actions" in the summary). FD's time is the wall time
 of `OneshotPlanner.solve`, one run (writing PDDL, translate, search). Our plans are checked
 with UP's sequential plan validator.
 """
@@ -150,7 +151,7 @@ def bench_case(label: str, pproblem: ProbabilisticProblem, probabilistic: bool,
     for _ in range(runs if probabilistic else 0):
         gc.collect()
         warms.append(plan(pproblem, OPTIONS, cache=cache).planning_time_s)
-        cache.forget_action_tables()  # as a replan whose state reaches other actions
+        cache.forget_last_calls()  # as a replan reaching other actions and values
         gc.collect()
         fresh_tables.append(plan(pproblem, OPTIONS, cache=cache).planning_time_s)
     task = ground(pproblem, cache=cache)
@@ -204,7 +205,7 @@ def report(rows: list[dict], title: str, probabilistic: bool) -> list[float]:
                       f"{statistics.median(r['ours_s'] for r in group) * 1e3:.1f} ms cold, "
                       f"{statistics.median(r['warm_s'] for r in group) * 1e3:.1f} ms warm, "
                       f"{statistics.median(r['new_table_s'] for r in group) * 1e3:.1f} ms "
-                      f"warm with new actions")
+                      f"warm, new actions")
     warm = [r["warm_s"] for r in rows if not math.isnan(r["warm_s"])]
     if warm:
         warm_ratios = [r["fd_s"] / r["warm_s"] for r in rows

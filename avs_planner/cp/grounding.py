@@ -254,12 +254,14 @@ class GroundingCache:
             lambda: build_structure(problem, schemas, static, assumptive, static_names),
         )
 
-    def forget_action_tables(self) -> None:
-        """Drop the action tables kept for reuse (see `_action_table`), so the next call
-        grounds its actions afresh as a replan reaching other actions would (benchmarks
-        measure that case with it)."""
+    def forget_last_calls(self) -> None:
+        """Drop what the last calls left for reuse (action tables, see `_action_table`, and
+        evaluations, see `_evaluate`), so the next call grounds as a replan from a state
+        with other actions and values would (benchmarks measure that case with it); the
+        structures stay."""
         for structure in self._structures.values():
             structure.memo.pop("last_table", None)
+            structure.memo.pop("evaluated", None)
 
 
 DEFAULT_CACHE = GroundingCache()

@@ -126,7 +126,10 @@ def test_a_replan_reaching_the_same_actions_reuses_their_table(corridor):
     # dropped on request (the benchmark times replans that reach other actions with it)
     kept = ground(corridor, state, cache)
     assert ground(corridor, state, cache).actions is kept.actions
-    cache.forget_action_tables()
+    structure = cache.structure(corridor, state)
+    assert "evaluated" in structure.memo
+    cache.forget_last_calls()
+    assert "evaluated" not in structure.memo
     assert ground(corridor, state, cache).actions is not kept.actions
 
 
