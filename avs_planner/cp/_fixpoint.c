@@ -5,8 +5,10 @@
  * compute the same least fixpoints as the numpy versions in avs_planner/cp/derived.py, which
  * stay as the fallback when this module is not built; tests compare the two.
  *
- * fill_rows: a structure row's fact ids sorted and unique, and its bitset words, for the rows
- *   a call needs (derived.py keeps them per structure).
+ * gather_rows: the fact ids of a list of structure rows sorted and unique, and their bitset
+ *   words, written to fresh k-row arrays, optionally keeping only the facts a `read` mask
+ *   marks (a call's kept rows: sorting them afresh is cheaper than keeping a structure-wide
+ *   cache of sorted rows, which only the numpy fallback in derived.py does).
  * index: rows by fact (CSR) of a matrix, built once per structure and passed to the others
  *   (one int64 buffer: n_facts + 1 offsets, then the row ids; every occurrence once).
  * reachable: relaxed reachability. A row is active when every fact of its `pre` row is
@@ -97,74 +99,73 @@ static int get_all(const Spec *specs, int n, Py_buffer *b, int *got)
     return 0;
 }
 
-static PyObject *fill_rows(PyObject *self, PyObject *args)
+/* Sort row r's valid ids (0 <= id < n_facts, and read[id] if read is given) into row, unique
+ * and -1 padded to width, and set their bits in words. tmp holds width + 1 ids. */
+static void sorted_row(const int64_t *src, Py_ssize_t width, Py_ssize_t n_facts,
+                       const uint8_t *read, int64_t *tmp, int64_t *row, uint64_t *words,
+                       Py_ssize_t n_words)
+{
+    Py_ssize_t m = 0;
+    for (Py_ssize_t j = 0; j < width; j++) {
+        int64_t f = src[j];
+        if (f < 0 || f >= n_facts || (read && !read[f]))
+            continue;
+        Py_ssize_t at = m++;
+        while (at > 0 && tmp[at - 1] > f) { /* insertion sort: rows are short */
+            tmp[at] = tmp[at - 1];
+            at--;
+        }
+        tmp[at] = f;
+    }
+    memset(words, 0, (size_t)n_words * sizeof(uint64_t));
+    Py_ssize_t u = 0;
+    for (Py_ssize_t j = 0; j < m; j++) {
+        if (u && row[u - 1] == tmp[j])
+            continue;
+        row[u++] = tmp[j];
+        words[tmp[j] >> 6] |= (uint64_t)1 << (tmp[j] & 63);
+    }
+    for (; u < width; u++)
+        row[u] = -1;
+}
+
+static PyObject *gather_rows(PyObject *self, PyObject *args)
 {
     (void)self;
-    PyObject *src_o, *idx_o, *out_o, *bits_o, *done_o;
+    PyObject *src_o, *idx_o, *read_o, *out_o, *bits_o;
     Py_ssize_t rows, width, n_facts, n_words, k;
     if (!PyArg_ParseTuple(args, "nOnnnOnOOO", &rows, &src_o, &width, &n_facts, &n_words,
-                          &idx_o, &k, &out_o, &bits_o, &done_o))
+                          &idx_o, &k, &read_o, &out_o, &bits_o))
         return NULL;
     if (rows < 0 || width < 0 || n_facts < 0 || n_words < n_facts / 64 + 1 || k < 0) {
-        PyErr_SetString(PyExc_ValueError, "fill_rows: bad sizes");
+        PyErr_SetString(PyExc_ValueError, "gather_rows: bad sizes");
         return NULL;
     }
     Py_buffer b[5];
-    int got = 0;
+    int got = 0, n_specs = read_o == Py_None ? 4 : 5;
     PyObject *result = NULL;
     int64_t *tmp = NULL;
     const Spec specs[5] = {
-        {src_o, rows * width, 8, 0, "fill_rows: matrix"},
-        {idx_o, k, 8, 0, "fill_rows: rows"},
-        {out_o, rows * width, 8, 1, "fill_rows: out"},
-        {bits_o, rows * n_words, 8, 1, "fill_rows: bits"},
-        {done_o, rows, 1, 1, "fill_rows: done"},
+        {src_o, rows * width, 8, 0, "gather_rows: matrix"},
+        {idx_o, k, 8, 0, "gather_rows: rows"},
+        {out_o, k * width, 8, 1, "gather_rows: out"},
+        {bits_o, k * n_words, 8, 1, "gather_rows: bits"},
+        {read_o, n_facts, 1, 0, "gather_rows: read"},
     };
-    if (get_all(specs, 5, b, &got) < 0)
+    if (get_all(specs, n_specs, b, &got) < 0)
         goto done;
     const int64_t *src = b[0].buf, *idx = b[1].buf;
-    int64_t *out = b[2].buf;
-    uint64_t *bits = b[3].buf;
-    uint8_t *flag = b[4].buf;
-    if (check_range(idx, k, rows, "fill_rows: rows") < 0)
+    const uint8_t *read = n_specs == 5 ? b[4].buf : NULL;
+    if (check_range(idx, k, rows, "gather_rows: rows") < 0)
         goto done;
     tmp = malloc(((size_t)width + 1) * sizeof(int64_t));
     if (!tmp) {
         PyErr_NoMemory();
         goto done;
     }
-    for (Py_ssize_t i = 0; i < k; i++) {
-        int64_t r = idx[i];
-        if (flag[r])
-            continue;
-        /* the valid ids (0 <= id < n_facts) sorted (insertion sort: rows are short), then
-         * unique, then -1 padding: what structure.fact_matrix(row, n_facts, None) gives */
-        Py_ssize_t m = 0;
-        for (Py_ssize_t j = 0; j < width; j++) {
-            int64_t f = src[r * width + j];
-            if (f < 0 || f >= n_facts)
-                continue;
-            Py_ssize_t at = m++;
-            while (at > 0 && tmp[at - 1] > f) {
-                tmp[at] = tmp[at - 1];
-                at--;
-            }
-            tmp[at] = f;
-        }
-        int64_t *row = out + r * width;
-        uint64_t *words = bits + r * n_words;
-        memset(words, 0, (size_t)n_words * sizeof(uint64_t));
-        Py_ssize_t u = 0;
-        for (Py_ssize_t j = 0; j < m; j++) {
-            if (u && row[u - 1] == tmp[j])
-                continue;
-            row[u++] = tmp[j];
-            words[tmp[j] >> 6] |= (uint64_t)1 << (tmp[j] & 63);
-        }
-        for (; u < width; u++)
-            row[u] = -1;
-        flag[r] = 1;
-    }
+    for (Py_ssize_t i = 0; i < k; i++)
+        sorted_row(src + idx[i] * width, width, n_facts, read, tmp,
+                   (int64_t *)b[2].buf + i * width, (uint64_t *)b[3].buf + i * n_words, n_words);
     result = Py_None;
     Py_INCREF(result);
 done:
@@ -429,10 +430,11 @@ done:
 }
 
 static PyMethodDef methods[] = {
-    {"fill_rows", fill_rows, METH_VARARGS,
-     "fill_rows(rows, matrix, width, n_facts, n_words, row_ids, k, out, out_bits, done): "
-     "for each listed row not yet done, its valid fact ids sorted and unique (-1 padded) "
-     "into out and as little-endian uint64 bitset words into out_bits; marks it done"},
+    {"gather_rows", gather_rows, METH_VARARGS,
+     "gather_rows(rows, matrix, width, n_facts, n_words, row_ids, k, read, out, out_bits): "
+     "for each listed row, its valid fact ids (those read marks, unless read is None) sorted "
+     "and unique (-1 padded) into the next row of out (k x width) and as little-endian uint64 "
+     "bitset words into out_bits (k x n_words)"},
     {"index", build_index, METH_VARARGS,
      "index(rows, matrix, width, n_facts) -> bytes: int64 offsets (n_facts + 1) then the "
      "row ids, per fact the rows whose matrix row names it (entries outside [0, n_facts) "

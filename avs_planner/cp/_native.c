@@ -28,7 +28,7 @@ typedef uint64_t word;
 enum { H_BLIND = 0, H_MAX = 1, H_ADD = 2, H_FF = 3 };
 enum { ST_SOLVED = 0, ST_UNSOLVABLE = 1, ST_THRESHOLD = 2, ST_TIMEOUT = 3, ST_NODE_LIMIT = 4 };
 enum { ST_INTERRUPTED = -2 };
-/* why a search returned its best plan so far instead of a proven one (search.py STOPS) */
+/* why a search returned its best plan so far instead of a proven one (native.py STOP_NAMES) */
 enum { STOP_NONE = 0, STOP_TIMEOUT = 1, STOP_NODE_LIMIT = 2, STOP_PATIENCE = 3 };
 
 #define BIT(s, f) (((s)[(f) >> 6] >> ((f) & 63)) & 1u)
@@ -1416,7 +1416,6 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* returns status; *goal_node set when solved; -1 on allocation failure */
 /* A limit was hit: the best plan found so far (the incumbent) if any, else the limit's status. */
 static int stop_at(Search *s, int32_t best, int32_t *goal_node, int why, int status)
 {
@@ -1427,6 +1426,7 @@ static int stop_at(Search *s, int32_t best, int32_t *goal_node, int why, int sta
     return ST_SOLVED;
 }
 
+/* returns status; *goal_node set when solved; -1 on allocation failure */
 static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *expanded_out)
 {
     const TaskObject *t = s->t;

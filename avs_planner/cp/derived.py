@@ -30,27 +30,24 @@ def ids_of(mask: int) -> np.ndarray:
 
 
 class Derived:
-    """Per structure row, filled on first use (a call only needs its kept rows): sorted
-    unique fact ids (-1 padded at the end) and bitset words of pre, pre_neg, add, delete.
-    Also, computed at once: the rows' clause facts as (interleaved offsets, positives,
+    """Per structure row, filled on first use by `rows` (the numpy path of `task_rows`):
+    sorted unique fact ids (-1 padded at the end) and bitset words of pre, pre_neg, add,
+    delete. Computed at once: the rows' clause facts as (interleaved offsets, positives,
     negatives) plus the row of each clause fact and each clause row's clauses as bitsets,
     and (when the compiled fixpoints are built) the rows-by-fact indexes they take."""
 
     def __init__(self, st: GroundStructure):
         self._st = st
-        self._done = np.zeros((4, st.size), dtype=bool)  # per matrix: row filled in
-        n_words = len(st.facts) // 64 + 1
-        self.matrices = tuple(np.empty(m.shape, dtype=np.int64)
-                              for m in (st.pre, st.pre_neg, st.add, st.delete))
-        self.bits = tuple(np.empty((st.size, n_words), dtype="<u8") for _ in range(4))
+        self._cache: tuple | None = None  # (done flags, matrices, bits), made by `rows`
         self.clauses = _clause_csr(st)
         clause_rows = sorted(st.clauses)
         self.clause_rows = np.array(clause_rows, dtype=np.int64)
         self.clause_bits = {row: tuple((bitset(pos), bitset(neg)) for pos, neg in st.clauses[row])
                             for row in clause_rows}
-        offsets = self.clauses[0]
-        self.clause_pos_rows = np.repeat(np.arange(st.size), np.diff(offsets[0::2]))
-        self.clause_neg_rows = np.repeat(np.arange(st.size), np.diff(offsets[1::2]))
+        offsets = self.clauses[0]  # rows without clauses have no clause facts to repeat
+        at = self.clause_rows * 2
+        self.clause_pos_rows = np.repeat(self.clause_rows, offsets[at + 2] - offsets[at])
+        self.clause_neg_rows = np.repeat(self.clause_rows, offsets[at + 3] - offsets[at + 1])
         self.pre_index = self.add_index = self.delete_index = b""
         if _fixpoint is not None:
             n = len(st.facts)
@@ -58,27 +55,36 @@ class Derived:
             self.add_index = _fixpoint.index(st.size, st.add, st.add.shape[1], n)
             self.delete_index = _fixpoint.index(st.size, st.delete, st.delete.shape[1], n)
 
+    def _row_cache(self) -> tuple:
+        cache = self._cache
+        if cache is None:  # one tuple, set at once: safe if calls interleave
+            st = self._st
+            n_words = len(st.facts) // 64 + 1
+            cache = self._cache = (
+                np.zeros((4, st.size), dtype=bool),  # per matrix: row filled in
+                tuple(np.empty(m.shape, dtype=np.int64)
+                      for m in (st.pre, st.pre_neg, st.add, st.delete)),
+                tuple(np.empty((st.size, n_words), dtype="<u8") for _ in range(4)),
+            )
+        return cache
+
     def rows(self, rows: np.ndarray) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
-        """The four matrices and bitset words of these rows (computing the missing ones)."""
+        """The four matrices and bitset words of these rows (computing the missing ones,
+        kept per structure): the numpy fallback's path; compiled, `task_rows` sorts the
+        kept rows afresh instead."""
         st, n = self._st, len(self._st.facts)
+        done, matrices, all_bits = self._row_cache()
         sources = (st.pre, st.pre_neg, st.add, st.delete)
-        if _fixpoint is not None:
-            rows = np.ascontiguousarray(rows, dtype=np.int64)
-            for k, (source, matrix, bits) in enumerate(zip(sources, self.matrices, self.bits,
-                                                           strict=True)):
-                _fixpoint.fill_rows(st.size, source, source.shape[1], n, bits.shape[1], rows,
-                                    len(rows), matrix, bits, self._done[k])
-        else:
-            for k, (source, matrix, bits) in enumerate(zip(sources, self.matrices, self.bits,
-                                                           strict=True)):
-                missing = rows[~self._done[k][rows]]  # per matrix: safe if calls interleave
-                sorted_rows = fact_matrix(np.take(source, missing, axis=0), n, None)
-                matrix[missing] = sorted_rows
-                bits[missing] = bit_words(sorted_rows, n)
-                self._done[k][missing] = True
+        for k, (source, matrix, bits) in enumerate(zip(sources, matrices, all_bits,
+                                                       strict=True)):
+            missing = rows[~done[k][rows]]  # per matrix: safe if calls interleave
+            sorted_rows = fact_matrix(np.take(source, missing, axis=0), n, None)
+            matrix[missing] = sorted_rows
+            bits[missing] = bit_words(sorted_rows, n)
+            done[k][missing] = True
         # np.take: ~3x faster than m[rows] for a row gather
-        return (tuple(np.take(m, rows, axis=0) for m in self.matrices),
-                tuple(np.take(b, rows, axis=0) for b in self.bits))
+        return (tuple(np.take(m, rows, axis=0) for m in matrices),
+                tuple(np.take(b, rows, axis=0) for b in all_bits))
 
 
 def derived(st: GroundStructure) -> Derived:
@@ -92,16 +98,20 @@ def derived(st: GroundStructure) -> Derived:
 def _clause_csr(st: GroundStructure) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Clause facts per row for `_fixpoint.relevant`: interleaved offsets (row r's
     positives start at [2r], its negatives at [2r + 1]) and the two fact lists."""
-    counts = np.zeros((st.size + 1, 2), dtype=np.int64)
+    counts = np.zeros((2, st.size + 1), dtype=np.int64)  # facts of row r at [:, r + 1]
     positives: list[int] = []
     negatives: list[int] = []
     for row in sorted(st.clauses):
+        before = len(positives), len(negatives)
         for pos, neg in st.clauses[row]:
             positives.extend(pos)
             negatives.extend(neg)
-        counts[row + 1] = (len(positives), len(negatives))
-    offsets = np.maximum.accumulate(counts, axis=0)  # rows without clauses repeat the last
-    return (offsets.ravel(), np.array(positives, dtype=np.int64),
+        counts[0, row + 1] = len(positives) - before[0]
+        counts[1, row + 1] = len(negatives) - before[1]
+    offsets = np.empty(2 * (st.size + 1), dtype=np.int64)
+    np.cumsum(counts[0], out=offsets[0::2])
+    np.cumsum(counts[1], out=offsets[1::2])
+    return (offsets, np.array(positives, dtype=np.int64),
             np.array(negatives, dtype=np.int64))
 
 
@@ -109,7 +119,28 @@ def task_rows(st: GroundStructure, kept_rows: np.ndarray, read: np.ndarray
               ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
     """The kept rows' (pre, pre_neg, add, delete) fact-id matrices and bitset words, with
     add and delete facts that `read` (bool over fact ids + pads) does not mark removed:
-    what `fact_matrix(rows, n, read)` gives, from the cached sorted rows."""
+    what `fact_matrix(rows, n, read)` gives. Compiled, the rows are sorted afresh into
+    k-row arrays (cheaper than filling, then gathering from, the structure-wide cache)."""
+    if _fixpoint is None:
+        return _task_rows_numpy(st, kept_rows, read)
+    n = len(st.facts)
+    n_words = n // 64 + 1
+    rows = np.ascontiguousarray(kept_rows, dtype=np.int64)
+    read_facts = np.ascontiguousarray(read[:n], dtype=bool)
+    matrices, bits = [], []
+    for source, mask in ((st.pre, None), (st.pre_neg, None), (st.add, read_facts),
+                         (st.delete, read_facts)):
+        out = np.empty((len(rows), source.shape[1]), dtype=np.int64)
+        words = np.empty((len(rows), n_words), dtype="<u8")
+        _fixpoint.gather_rows(st.size, source, source.shape[1], n, n_words, rows, len(rows),
+                              mask, out, words)
+        matrices.append(out)
+        bits.append(words)
+    return tuple(matrices), tuple(bits)
+
+
+def _task_rows_numpy(st: GroundStructure, kept_rows: np.ndarray, read: np.ndarray
+                     ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
     n = len(st.facts)
     (pre, pre_neg, add, delete), (pre_bits, neg_bits, add_bits, delete_bits) = (
         derived(st).rows(kept_rows)

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import gc
 from collections import OrderedDict
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator
 from contextlib import contextmanager
 from fractions import Fraction
 
@@ -24,7 +24,7 @@ from unified_planning.model import FNode, InstantaneousAction, Problem
 
 from avs_planner.cp.action_table import ActionTable
 from avs_planner.cp.derived import derived, ids_of, reachable, relevant, task_rows
-from avs_planner.cp.encoding import ConstantExpr
+from avs_planner.cp.encoding import ConstantExpr, NumericValues
 from avs_planner.cp.schema import LiftedSchema, compile_schemas
 from avs_planner.cp.structure import GroundStructure, bitset, build_structure
 from avs_planner.cp.task import Atom, GroundTask, TaskArrays, WorldState
@@ -113,7 +113,7 @@ def _flatten(node: FNode) -> list[FNode]:
     return [node]
 
 
-def _evaluate(st: GroundStructure, rows: np.ndarray, values: Mapping[Atom, float],
+def _evaluate(st: GroundStructure, rows: np.ndarray, values: NumericValues,
               what: str) -> np.ndarray:
     """Success probability (`what` = "prob") or cost of the rows in the boolean mask."""
     out = np.zeros(st.size)
@@ -285,19 +285,22 @@ def _ground(
     # drop actions that can never succeed (p = 0), then what only they made reachable;
     # only reachable actions are evaluated (others may read values :init does not give)
     may_apply = reachable(st, reached, np.ones(st.size, dtype=bool))
-    probability = _evaluate(st, may_apply, state.values, "prob")
+    values = NumericValues(st.space, state.values)
+    probability = _evaluate(st, may_apply, values, "prob")
     _check(st, may_apply, probability, "prob")
     possible = may_apply & (probability > 0.0)
-    kept = relevant(st, reachable(st, reached, possible), goal, goal_neg)
-    cost = _evaluate(st, kept, state.values, "cost")
+    if (may_apply != possible).any():  # else reachability over `possible` is `may_apply`
+        possible = reachable(st, reached, possible)
+    kept = relevant(st, possible, goal, goal_neg)
+    cost = _evaluate(st, kept, values, "cost")
     _check(st, kept, cost, "cost")
     # effects on facts nothing reads are dropped (e.g. `visited` of ordinary places), so
     # states differing only there merge
     read = np.zeros(n + 2, dtype=bool)
     read[ids_of(goal | goal_neg)] = True
-    read[st.pre[kept]] = True
-    read[st.pre_neg[kept]] = True
     kept_rows = np.flatnonzero(kept)
+    read[np.take(st.pre, kept_rows, axis=0).ravel()] = True  # np.take: faster than a mask
+    read[np.take(st.pre_neg, kept_rows, axis=0).ravel()] = True
     d = derived(st)
     clauses = {}  # action index -> clauses as bitsets (few rows have any)
     if len(d.clause_rows):

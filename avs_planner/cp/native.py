@@ -304,7 +304,7 @@ def run(
     start: float,
 ) -> tuple[str, tuple[int, ...], int, int, str | None]:
     """Run the C search: (status name, action indices of the plan, expanded, generated, why
-    the best plan so far was returned: None or one of search.STOPS)."""
+    the best plan so far was returned: one of STOP_NAMES)."""
     packed = pack_task(task)
     n_facts = len(task.facts)
     n_bytes = 8 * words(n_facts)
@@ -318,10 +318,17 @@ def run(
         _bits(task.goal, n_bytes, n_facts, "the goal"),
         _bits(task.goal_neg, n_bytes, n_facts, "the goal"),
         HEURISTIC_CODES[heuristic], float(reward), float(weight), float(min_success),
-        remaining, -1 if node_limit is None else int(node_limit),
-        -1 if math.isinf(patience) else int(patience), lazy, preferred, *sym,
+        remaining, _c_limit(node_limit), _c_limit(patience), lazy, preferred, *sym,
     )
     return STATUS_NAMES[status], path, expanded, generated, STOP_NAMES[stopped]
+
+
+def _c_limit(limit: float | None) -> int:
+    """An expansion limit for the C core: -1 for none (None, inf, or more expansions than an
+    int64 counter reaches, which C could not even take as an argument)."""
+    if limit is None or limit >= 2**62:
+        return -1
+    return int(limit)
 
 
 def estimates(

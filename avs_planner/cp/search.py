@@ -365,10 +365,10 @@ class _Search:
                 obj = objective(c, p, self.reward)
                 if self.best is None or obj < self.best[0]:
                     self.best = (obj, node, expanded)
-                if self.from_pref and self.heap and self.heap[0][0] < objective(c, p, self.reward):
+                if self.from_pref and self.heap and self.heap[0][0] < obj:
                     # a helpful-action goal is only taken if no open node promises better
                     self.alive[node] = True
-                    heapq.heappush(self.heap, (objective(c, p, self.reward), 0.0, node))
+                    heapq.heappush(self.heap, (obj, 0.0, node))
                     continue
                 return self.finish(PlanStatus.SOLVED, node, expanded)
             expanded += 1

@@ -379,22 +379,31 @@ def build_structure(
 def _assemble(space: AtomSpace, parts: list, assumptive: Mapping[str, bool]) -> GroundStructure:
     """Concatenate the schemas' rows and renumber the atom codes they use as fact ids."""
     starts = np.cumsum([0] + [part[2] for part in parts]).tolist()
-    stacked = {}
-    for k, (key, pad) in enumerate((("pre", _PAD_TRUE), ("neg", _PAD_NONE), ("add", _PAD_NONE),
-                                    ("delete", _PAD_NONE))):
-        arrays = [part[3 + k] for part in parts]
-        width = max((a.shape[1] for a in arrays), default=0)
-        out = stacked[key] = np.full((starts[-1], width), pad, dtype=np.int64)
-        for array, start in zip(arrays, starts, strict=False):
-            out[start:start + len(array), : array.shape[1]] = array
     row_clauses = {start + i: c for part, start in zip(parts, starts, strict=False)
                    for i, c in part[7].items()}
     distinct_clauses = list(dict.fromkeys(row_clauses.values()))
     clause_codes = np.array([c for row in distinct_clauses for clause in row for side in clause
                              for c in side], dtype=np.int64)
-    codes, renumber = _fact_numbering(space.size, list(stacked.values()), clause_codes)
+    codes, renumber = _fact_numbering(
+        space.size, [part[3 + k] for part in parts for k in range(4)], clause_codes
+    )
+    n = len(codes)
     facts = tuple(space.decode_many(codes))
-    stacked = {key: renumber(array) for key, array in stacked.items()}
+    # each schema's codes renumbered straight into the stacked arrays, whose padding is
+    # already the pads' fact ids (one pass over the big arrays instead of two)
+    stacked = {}
+    for k, (key, pad) in enumerate((("pre", n), ("neg", n + 1), ("add", n + 1),
+                                    ("delete", n + 1))):
+        arrays = [part[3 + k] for part in parts]
+        width = max((a.shape[1] for a in arrays), default=0)
+        out = stacked[key] = np.empty((starts[-1], width), dtype=np.int64)
+        for array, start in zip(arrays, starts, strict=False):
+            rows = out[start:start + len(array)]
+            if array.shape[1] == width:  # contiguous: written in place
+                renumber(array, rows)
+            else:
+                rows[:, : array.shape[1]] = renumber(array)
+                rows[:, array.shape[1]:] = pad
     index_of = {c: i for i, c in enumerate(codes.tolist())}
     renumbered = {
         row: tuple((tuple(index_of[c] for c in pos), tuple(index_of[c] for c in neg))
@@ -411,7 +420,7 @@ def _assemble(space: AtomSpace, parts: list, assumptive: Mapping[str, bool]) -> 
             arg_ids[start:start + rows, j] = columns[param]
         start += rows
     return GroundStructure(
-        facts=facts, fact_index={a: i for i, a in enumerate(facts)},
+        facts=facts, fact_index=dict(zip(facts, range(n), strict=True)),
         space=space, blocks=tuple(blocks), pre=stacked["pre"],
         pre_neg=stacked["neg"], add=stacked["add"], delete=stacked["delete"], clauses=clauses,
         arg_ids=arg_ids,
@@ -420,11 +429,13 @@ def _assemble(space: AtomSpace, parts: list, assumptive: Mapping[str, bool]) -> 
 
 def _fact_numbering(
     space_size: int, arrays: list[np.ndarray], extra: np.ndarray
-) -> tuple[np.ndarray, Callable[[np.ndarray], np.ndarray]]:
-    """The atom codes used (sorted) and a map from code arrays to fact ids, padding codes
-    `_PAD_TRUE` -> n and `_PAD_NONE` -> n + 1. When the code space is small next to the
-    arrays (the usual case), a dense table replaces sort-based unique and searchsorted,
-    several times faster; huge code spaces (up to `MAX_CODE`) take the sorted path."""
+) -> tuple[np.ndarray, Callable[..., np.ndarray]]:
+    """The atom codes used (sorted) and `renumber(codes, out=None)`, which gives the fact ids
+    of a code array (written into `out`, contiguous and of the same shape, if given),
+    padding codes `_PAD_TRUE` -> n and `_PAD_NONE` -> n + 1. When the code space is small
+    next to the arrays (the usual case), a dense table replaces sort-based unique and
+    searchsorted, several times faster; huge code spaces (up to `MAX_CODE`) take the sorted
+    path."""
     entries = sum(a.size for a in arrays) + extra.size
     if space_size <= max(_DENSE_CODES, 2 * entries):
         used = np.zeros(space_size + 2, dtype=bool)  # the pads index the last two slots
@@ -436,14 +447,23 @@ def _fact_numbering(
         table = np.empty(space_size + 2, dtype=np.int64)
         table[codes] = np.arange(n)
         table[_PAD_TRUE], table[_PAD_NONE] = n, n + 1
-        return codes, table.__getitem__
+
+        def lookup(array: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+            # "wrap" reads the pads (-1, -2) from the table's end, as indexing would (codes
+            # are in [-2, space_size)), and is faster than indexing or the default mode
+            return np.take(table, array, out=out, mode="wrap")
+
+        return codes, lookup
     codes = np.unique(np.concatenate([a[a >= 0] for a in arrays] + [extra]))
     n = len(codes)
 
-    def renumber(array: np.ndarray) -> np.ndarray:
-        out = np.searchsorted(codes, array)
-        out[array == _PAD_TRUE] = n
-        out[array == _PAD_NONE] = n + 1
+    def renumber(array: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        ids = np.searchsorted(codes, array)
+        ids[array == _PAD_TRUE] = n
+        ids[array == _PAD_NONE] = n + 1
+        if out is None:
+            return ids
+        out[...] = ids
         return out
 
     return codes, renumber

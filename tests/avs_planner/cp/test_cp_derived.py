@@ -115,11 +115,11 @@ def test_compiled_fixpoints_reject_bad_input():
     with pytest.raises(ValueError, match="outside"):
         _fixpoint.reachable(1, ok_pre, 2, add, 1, 3, 2, np.ones(3, bool), np.ones(1, bool),
                             broken.tobytes())
-    out, bits, done = np.zeros((1, 2), np.int64), np.zeros((1, 1), "<u8"), np.zeros(1, bool)
+    out, bits = np.zeros((1, 2), np.int64), np.zeros((1, 1), "<u8")
     with pytest.raises(ValueError, match="outside"):
-        _fixpoint.fill_rows(1, ok_pre, 2, 3, 1, np.array([1]), 1, out, bits, done)
-    _fixpoint.fill_rows(1, np.array([[2, 0]]), 2, 3, 1, np.array([0]), 1, out, bits, done)
-    assert out.tolist() == [[0, 2]] and bits.tolist() == [[0b101]] and done.all()
+        _fixpoint.gather_rows(1, ok_pre, 2, 3, 1, np.array([1]), 1, None, out, bits)
+    _fixpoint.gather_rows(1, np.array([[2, 0]]), 2, 3, 1, np.array([0]), 1, None, out, bits)
+    assert out.tolist() == [[0, 2]] and bits.tolist() == [[0b101]]
     reached = _fixpoint.reachable(1, ok_pre, 2, add, 1, 3, 2,
                                   np.array([1, 0, 1], bool), np.ones(1, bool), index)
     assert list(reached) == [0]  # fact 1 is not reached

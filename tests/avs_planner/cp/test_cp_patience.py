@@ -89,3 +89,11 @@ def test_cli_patience_option(tmp_path, capsys):
         main(["plan", str(domain), str(problem), "--patience", "soon"])
     assert exc.value.code != 0
     assert "--patience" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_limits_beyond_any_count_mean_no_limit(late_better, engine):
+    """A patience or node limit too large for the C core's int64 is no limit, not a crash."""
+    huge = _run(late_better, patience=1e30, node_limit=10**30, engine=engine)
+    assert huge.solved and huge.stopped_by is None
+    assert huge.objective == pytest.approx(368.893)
