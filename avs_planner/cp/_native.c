@@ -67,12 +67,21 @@ static inline double pysum_value(const PySum *s)
 /* ------------------------------------------------------------------------------------------ */
 /* The packed task (immutable; built once per GroundTask action table)                         */
 
+/* Relaxed actions (relaxed_merge.py): the task's actions 0..n_actions-1, of which the merged
+ * ones take no part in the relaxation, then merged and auxiliary ones up to n_rel; auxiliary
+ * facts n_facts..n_rfacts-1 are never in a state. */
+enum { K_REAL = 0, K_AWAY = 1, K_MERGED = 2, K_AUX = 3 };
+
 typedef struct {
     PyObject_HEAD
     Py_ssize_t n_facts, n_actions, W;
+    Py_ssize_t n_rfacts, n_rel; /* with the merge's auxiliary facts, extra actions */
     word *pre, *pre_neg, *add, *del, *reads; /* n_actions * W each */
-    double *cost, *prob, *neglog;
-    int32_t *pre_off, *pre_facts; /* relaxed preconditions (pre_facts), CSR per action */
+    double *cost, *prob, *neglog; /* per relaxed action (extra: a member's, aux: 0, 0, 1) */
+    int8_t *kind;                 /* K_* per relaxed action */
+    int32_t *link;                /* merged: its fact X; aux: its position among X's */
+    int32_t *member_off, *members; /* per merged action: the task action per X position */
+    int32_t *pre_off, *pre_facts; /* relaxed preconditions (pre_facts), CSR per rel. action */
     int32_t *add_off, *add_facts;
     int32_t *cl_off;              /* clauses (pos, neg) per action, CSR */
     word *cl_pos, *cl_neg;        /* n_clauses * W */
@@ -102,7 +111,7 @@ static void task_free_arrays(TaskObject *t)
                     t->cl_neg, t->unit_off, t->unit_fact, t->unit_clause, t->unit_pair,
                     t->pair_action, t->cls_of, t->cls_off, t->cls_members, t->cls_len,
                     t->cof_off, t->cof, t->xcof_off, t->xcof_cls, t->xcof_pair, t->no_pre,
-                    t->n_pairs_of, t->pre_len};
+                    t->n_pairs_of, t->pre_len, t->kind, t->link, t->member_off, t->members};
     for (size_t i = 0; i < sizeof(ptrs) / sizeof(ptrs[0]); i++)
         free(ptrs[i]);
 }
@@ -215,7 +224,7 @@ static int same_pre(const TaskObject *t, int32_t a, int32_t b)
  * the clause variants. Order within these lists does not matter (see relaxed_costs). */
 static int derive_classes(TaskObject *t, const int32_t *pair_fact)
 {
-    Py_ssize_t A = t->n_actions, F = t->n_facts, np = t->n_pairs;
+    Py_ssize_t A = t->n_rel, F = t->n_rfacts, np = t->n_pairs;
     size_t ns = 2;
     while (ns < 2 * (size_t)A + 2)
         ns <<= 1;
@@ -228,7 +237,11 @@ static int derive_classes(TaskObject *t, const int32_t *pair_fact)
     int32_t n = 0;
     for (Py_ssize_t a = 0; a < A; a++) {
         int32_t c = -1;
-        if (t->n_pairs_of[a] == 0) {
+        if (t->kind[a] == K_AWAY) {
+            t->cls_of[a] = -1;
+            continue;
+        }
+        if (a >= t->n_actions || t->n_pairs_of[a] == 0) {
             uint64_t h = 1469598103934665603ull;
             for (int32_t j = t->pre_off[a]; j < t->pre_off[a + 1]; j++)
                 h = (h ^ (uint64_t)t->pre_facts[j]) * 1099511628211ull;
@@ -253,7 +266,8 @@ static int derive_classes(TaskObject *t, const int32_t *pair_fact)
     if (!t->cls_off || !t->cls_members || !t->cls_len || !t->cof_off || !t->xcof_off)
         goto nomem;
     for (Py_ssize_t a = 0; a < A; a++)
-        t->cls_off[t->cls_of[a] + 1]++;
+        if (t->cls_of[a] >= 0)
+            t->cls_off[t->cls_of[a] + 1]++;
     for (int32_t c = 0; c < n; c++)
         t->cls_off[c + 1] += t->cls_off[c];
     int32_t *cfill = xcalloc((size_t)n, sizeof(int32_t));
@@ -261,7 +275,8 @@ static int derive_classes(TaskObject *t, const int32_t *pair_fact)
         goto nomem;
     for (Py_ssize_t a = 0; a < A; a++) {
         int32_t c = t->cls_of[a];
-        t->cls_members[t->cls_off[c] + cfill[c]++] = (int32_t)a;
+        if (c >= 0)
+            t->cls_members[t->cls_off[c] + cfill[c]++] = (int32_t)a;
     }
     free(cfill);
     Py_ssize_t n_entries = 0;
@@ -365,19 +380,20 @@ static int task_derive(TaskObject *t)
 
     if (derive_classes(t, pair_fact))
         goto nomem;
-    t->no_pre = xcalloc((size_t)A, sizeof(int32_t));
+    Py_ssize_t R = t->n_rel;
+    t->no_pre = xcalloc((size_t)R, sizeof(int32_t));
     if (!t->no_pre)
         goto nomem;
-    t->pre_len = xcalloc((size_t)A, sizeof(int32_t));
+    t->pre_len = xcalloc((size_t)R, sizeof(int32_t));
     if (!t->pre_len)
         goto nomem;
-    for (Py_ssize_t a = 0; a < A; a++)
+    for (Py_ssize_t a = 0; a < R; a++)
         t->pre_len[a] = t->pre_off[a + 1] - t->pre_off[a];
     t->n_no_pre = 0;
-    for (Py_ssize_t a = 0; a < A; a++)
-        if (t->pre_off[a] == t->pre_off[a + 1])
+    for (Py_ssize_t a = 0; a < R; a++)
+        if (t->pre_off[a] == t->pre_off[a + 1] && t->kind[a] != K_AWAY)
             t->no_pre[t->n_no_pre++] = (int32_t)a;
-    t->total_add = t->add_off[A];
+    t->total_add = t->add_off[R];
     free(pair_fact);
     return 0;
 nomem:
@@ -386,16 +402,112 @@ nomem:
     return -1;
 }
 
-#define NBUF 14
+#define NBUF 23
+
+/* Append two int32 CSRs (a: n_a rows, b: n_b rows) into a new one. */
+static int join_csr(int32_t **off, int32_t **val, Py_ssize_t n_a, const int32_t *b_off,
+                    const int32_t *b_val, Py_ssize_t n_b)
+{
+    int32_t m_a = (*off)[n_a], m_b = b_off[n_b];
+    int32_t *o = xcalloc((size_t)(n_a + n_b) + 1, sizeof(int32_t));
+    int32_t *v = xcalloc((size_t)m_a + (size_t)m_b, sizeof(int32_t));
+    if (!o || !v) {
+        free(o);
+        free(v);
+        PyErr_NoMemory();
+        return -1;
+    }
+    memcpy(o, *off, sizeof(int32_t) * ((size_t)n_a + 1));
+    for (Py_ssize_t i = 1; i <= n_b; i++)
+        o[n_a + i] = m_a + b_off[i];
+    memcpy(v, *val, sizeof(int32_t) * (size_t)m_a);
+    memcpy(v + m_a, b_val, sizeof(int32_t) * (size_t)m_b);
+    free(*off);
+    free(*val);
+    *off = o;
+    *val = v;
+    return 0;
+}
+
+/* The relaxed merge (b[0..8]: extra pre CSR, extra add CSR, away, weight_of, link, member CSR;
+ * int64 each): extends pre/add CSRs, weights and kinds to n_rel relaxed actions. */
+static int task_merge(TaskObject *t, Py_ssize_t n_rfacts, Py_ssize_t n_merged, Py_buffer *b)
+{
+    Py_ssize_t A = t->n_actions, F = t->n_facts;
+    if (n_rfacts < F || n_rfacts > INT32_MAX / 2 || n_merged < 0 || b[5].len % 8) {
+        PyErr_SetString(PyExc_ValueError, "native task: bad relaxed merge sizes");
+        return -1;
+    }
+    Py_ssize_t E = b[5].len / 8; /* extra actions */
+    if (n_merged > E || E > INT32_MAX / 4 || (size_t)b[4].len != (size_t)A * 8 ||
+        (size_t)b[6].len != (size_t)E * 8) {
+        PyErr_SetString(PyExc_ValueError, "native task: relaxed merge arrays disagree");
+        return -1;
+    }
+    int32_t *x_pre_off = NULL, *x_pre = NULL, *x_add_off = NULL, *x_add = NULL;
+    int ok = -1;
+    if (copy_csr(&b[0], &b[1], E, n_rfacts, &x_pre_off, &x_pre, "merged pre") ||
+        copy_csr(&b[2], &b[3], E, n_rfacts, &x_add_off, &x_add, "merged add") ||
+        copy_csr(&b[7], &b[8], n_merged, A, &t->member_off, &t->members, "merged members") ||
+        join_csr(&t->pre_off, &t->pre_facts, A, x_pre_off, x_pre, E) ||
+        join_csr(&t->add_off, &t->add_facts, A, x_add_off, x_add, E))
+        goto done;
+    Py_ssize_t R = A + E;
+    const int64_t *away = b[4].buf, *weight_of = b[5].buf, *link = b[6].buf;
+    double *cost = realloc(t->cost, sizeof(double) * (size_t)(R ? R : 1));
+    if (cost)
+        t->cost = cost;
+    double *prob = realloc(t->prob, sizeof(double) * (size_t)(R ? R : 1));
+    if (prob)
+        t->prob = prob;
+    double *neglog = realloc(t->neglog, sizeof(double) * (size_t)(R ? R : 1));
+    if (neglog)
+        t->neglog = neglog;
+    t->kind = xcalloc((size_t)R, 1);
+    t->link = xcalloc((size_t)R, sizeof(int32_t));
+    if (!cost || !prob || !neglog || !t->kind || !t->link) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (Py_ssize_t a = 0; a < A; a++) {
+        t->kind[a] = away[a] ? K_AWAY : K_REAL;
+        t->link[a] = -1;
+    }
+    for (Py_ssize_t e = 0; e < E; e++) {
+        int64_t w = weight_of[e];
+        int merged = e < n_merged;
+        if ((merged && (w < 0 || w >= A)) || (!merged && w != -1) || link[e] < 0 ||
+            (merged ? link[e] < F || link[e] >= n_rfacts : link[e] > INT32_MAX / 2)) {
+            PyErr_Format(PyExc_ValueError, "native task: relaxed action %zd is malformed", A + e);
+            goto done;
+        }
+        t->kind[A + e] = merged ? K_MERGED : K_AUX;
+        t->link[A + e] = (int32_t)link[e];
+        t->cost[A + e] = merged ? t->cost[w] : 0.0;
+        t->prob[A + e] = merged ? t->prob[w] : 1.0;
+        t->neglog[A + e] = merged ? t->neglog[w] : 0.0;
+    }
+    t->n_rel = R;
+    t->n_rfacts = n_rfacts;
+    ok = 0;
+done:
+    free(x_pre_off);
+    free(x_pre);
+    free(x_add_off);
+    free(x_add);
+    return ok;
+}
 
 static PyObject *task_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
 {
-    Py_ssize_t n_facts, n_actions;
+    Py_ssize_t n_facts, n_actions, n_rfacts, n_merged;
     Py_buffer b[NBUF];
     memset(b, 0, sizeof(b));
-    if (!PyArg_ParseTuple(args, "nny*y*y*y*y*y*y*y*y*y*y*y*y*y*:Task", &n_facts, &n_actions,
-                          &b[0], &b[1], &b[2], &b[3], &b[4], &b[5], &b[6], &b[7], &b[8], &b[9],
-                          &b[10], &b[11], &b[12], &b[13]))
+    if (!PyArg_ParseTuple(args, "nny*y*y*y*y*y*y*y*y*y*y*y*y*y*nny*y*y*y*y*y*y*y*y*:Task",
+                          &n_facts, &n_actions, &b[0], &b[1], &b[2], &b[3], &b[4], &b[5],
+                          &b[6], &b[7], &b[8], &b[9], &b[10], &b[11], &b[12], &b[13],
+                          &n_rfacts, &n_merged, &b[14], &b[15], &b[16], &b[17], &b[18],
+                          &b[19], &b[20], &b[21], &b[22]))
         return NULL;
     TaskObject *t = NULL;
     if (n_facts < 0 || n_actions < 0 || n_facts > INT32_MAX / 2 || n_actions > INT32_MAX / 2) {
@@ -456,7 +568,7 @@ static PyObject *task_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
                              n_facts);
                 goto fail;
             }
-    if (task_derive(t))
+    if (task_merge(t, n_rfacts, n_merged, b + 14) || task_derive(t))
         goto fail;
     for (int i = 0; i < NBUF; i++)
         PyBuffer_Release(&b[i]);
@@ -755,7 +867,7 @@ static inline void relax_fire(Search *s, int32_t a, double nd)
 static void next_pop(Search *s)
 {
     if (++s->pop_id == 0) {
-        memset(s->set_in, 0, sizeof(uint32_t) * (size_t)s->t->n_facts);
+        memset(s->set_in, 0, sizeof(uint32_t) * (size_t)s->t->n_rfacts);
         s->pop_id = 1;
     }
 }
@@ -766,14 +878,13 @@ static void next_pop(Search *s)
 static void relaxed_costs(Search *s, const word *state, const double *w, int use_max, int ext)
 {
     const TaskObject *t = s->t;
-    Py_ssize_t F = t->n_facts;
     double *dist = s->dist;
-    for (Py_ssize_t f = 0; f < F; f++) {
+    for (Py_ssize_t f = 0; f < t->n_rfacts; f++) {
         dist[f] = INFINITY;
         s->support[f] = -1;
     }
     dclear(s);
-    for (Py_ssize_t f = 0; f < F; f++)
+    for (Py_ssize_t f = 0; f < t->n_facts; f++)
         if (BIT(state, f)) {
             dist[f] = 0.0;
             dpush(s, 0.0, (int32_t)f);
@@ -891,8 +1002,8 @@ static int push_help(Search *s, int32_t a)
 static uint32_t next_stamp(Search *s)
 {
     if (++s->stamp == 0) { /* wrapped: clear every stamp array */
-        memset(s->seen_stamp, 0, sizeof(uint32_t) * (size_t)s->t->n_facts);
-        memset(s->chosen_stamp, 0, sizeof(uint32_t) * (size_t)s->t->n_actions);
+        memset(s->seen_stamp, 0, sizeof(uint32_t) * (size_t)s->t->n_rfacts);
+        memset(s->chosen_stamp, 0, sizeof(uint32_t) * (size_t)s->t->n_rel);
         memset(s->emit_stamp, 0, sizeof(uint32_t) * ((size_t)s->t->n_pairs + 1));
         s->stamp = 1;
     }
@@ -927,11 +1038,13 @@ static void ff(Search *s, const word *state, StateRec *rec, double *hc, double *
         /* the variant's pre[a]: base pre_facts, then active clause facts not yet there */
         for (int32_t j = t->pre_off[a]; j < t->pre_off[a + 1]; j++) {
             int32_t f = t->pre_facts[j];
-            if (s->seen_stamp[f] != st && !BIT(state, f)) {
+            if (s->seen_stamp[f] != st && !(f < t->n_facts && BIT(state, f))) {
                 s->seen_stamp[f] = st;
                 s->stack[top++] = f;
             }
         }
+        if (a >= t->n_actions)
+            continue; /* merged and auxiliary actions have no clauses */
         for (int32_t k = t->unit_off[a]; k < t->unit_off[a + 1]; k++) {
             int32_t q = t->unit_pair[k];
             if (!s->active[k] || q < 0 || s->emit_stamp[q] == st)
@@ -946,19 +1059,30 @@ static void ff(Search *s, const word *state, StateRec *rec, double *hc, double *
     }
     PySum sc = {0.0, 0.0}, sl = {0.0, 0.0};
     for (Py_ssize_t i = 0; i < n_chosen; i++)
-        pysum_add(&sc, t->cost[s->chosen[i]] + 1.0);
+        if (t->kind[s->chosen[i]] != K_AUX)
+            pysum_add(&sc, t->cost[s->chosen[i]] + 1.0);
     for (Py_ssize_t i = 0; i < n_chosen; i++)
-        pysum_add(&sl, t->neglog[s->chosen[i]]);
+        if (t->kind[s->chosen[i]] != K_AUX)
+            pysum_add(&sl, t->neglog[s->chosen[i]]);
     *hc = pysum_value(&sc);
     *hl = pysum_value(&sl);
     rec->help_off = s->n_help;
     rec->help_n = 0;
-    for (Py_ssize_t i = 0; i < n_chosen; i++)
-        if (applicable(t, s->W, s->chosen[i], state)) {
-            if (push_help(s, s->chosen[i]))
+    for (Py_ssize_t i = 0; i < n_chosen; i++) {
+        int32_t a = s->chosen[i];
+        if (t->kind[a] == K_AUX)
+            continue;
+        if (t->kind[a] == K_MERGED) { /* the member whose alternative reached X */
+            int32_t aux = s->support[t->link[a]];
+            int32_t m = a - (int32_t)t->n_actions;
+            a = t->members[t->member_off[m] + t->link[aux]];
+        }
+        if (applicable(t, s->W, a, state)) {
+            if (push_help(s, a))
                 return;
             rec->help_n++;
         }
+    }
 }
 
 static void estimate(Search *s, int32_t sid)
@@ -1419,7 +1543,8 @@ static void search_free(Search *s)
 static int search_alloc(Search *s)
 {
     const TaskObject *t = s->t;
-    size_t F = (size_t)t->n_facts, A = (size_t)t->n_actions, W = (size_t)s->W;
+    /* relaxed sizes: auxiliary facts and extra actions of the merge included */
+    size_t F = (size_t)t->n_rfacts, A = (size_t)t->n_rel, W = (size_t)s->W;
     s->goal = xcalloc(W, 8);
     s->goal_neg = xcalloc(W, 8);
     s->goal_facts = xcalloc(F, sizeof(int32_t));
@@ -1450,6 +1575,15 @@ static int search_alloc(Search *s)
         !s->active || !s->pair_eff || !s->dheap || !s->hpos || !s->succ)
         return -1;
     return grow_slots(s);
+}
+
+/* RelaxedTask.combined, same expression; auxiliary actions weigh nothing */
+static void fill_combined(Search *s)
+{
+    const TaskObject *t = s->t;
+    for (Py_ssize_t a = 0; a < t->n_rel; a++)
+        s->combined[a] =
+            t->kind[a] == K_AUX ? 0.0 : 1.0 + t->cost[a] + s->reward * (1.0 - t->prob[a]);
 }
 
 static int check_words(Py_buffer *b, Py_ssize_t W, Py_ssize_t n_facts, const char *what)
@@ -1548,8 +1682,7 @@ static PyObject *native_search(PyObject *self, PyObject *args)
             s.goal_facts[s.n_goal++] = (int32_t)f;
             s.is_goal[f] = 1;
         }
-    for (Py_ssize_t a = 0; a < A; a++) /* RelaxedTask.combined, same expression */
-        s.combined[a] = 1.0 + t->cost[a] + s.reward * (1.0 - t->prob[a]);
+    fill_combined(&s);
     int32_t goal_node = -1;
     int64_t expanded = 0;
     int status;
@@ -1601,7 +1734,7 @@ static PyObject *native_estimates(PyObject *self, PyObject *args)
     PyObject *out = NULL;
     s.t = t;
     s.W = t->W;
-    Py_ssize_t W = t->W, F = t->n_facts, A = t->n_actions;
+    Py_ssize_t W = t->W, F = t->n_facts;
     if (s.heuristic < H_BLIND || s.heuristic > H_FF) {
         PyErr_SetString(PyExc_ValueError, "native estimates: unknown heuristic code");
         goto done;
@@ -1622,8 +1755,7 @@ static PyObject *native_estimates(PyObject *self, PyObject *args)
             s.goal_facts[s.n_goal++] = (int32_t)f;
             s.is_goal[f] = 1;
         }
-    for (Py_ssize_t a = 0; a < A; a++)
-        s.combined[a] = 1.0 + t->cost[a] + s.reward * (1.0 - t->prob[a]);
+    fill_combined(&s);
     Py_ssize_t n = states.len / (8 * W);
     out = PyList_New(0);
     for (Py_ssize_t i = 0; out && i < n; i++) {

@@ -17,6 +17,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from avs_planner.cp.relaxed_merge import merge_task
 from avs_planner.cp.task import GroundTask
 from avs_planner.errors import PlanningError
 
@@ -26,21 +27,33 @@ Estimator = Callable[[int], Estimate]
 
 
 class RelaxedTask:
-    """Per-task arrays the relaxed heuristics iterate over (negative preconditions dropped)."""
+    """Per-task arrays the relaxed heuristics iterate over (negative preconditions dropped):
+    the task's actions, with groups that differ in one argument merged (relaxed_merge.py);
+    `n_facts` counts the auxiliary facts of the merge too."""
 
     def __init__(self, task: GroundTask, reward: float, clauses: bool = False):
-        self.n_facts = len(task.facts)
-        self.pre = [a.pre_facts for a in task.actions]
-        self.add = [a.add_facts for a in task.actions]
-        self.cost = [a.cost for a in task.actions]
-        self.neglog = [-math.log(a.probability) for a in task.actions]
+        merge = self.merge = merge_task(task)
+        self.n_facts = merge.n_rfacts
+        self.n_task_actions = n = len(task.actions)
+        extra_pre, extra_add = merge.extra_lists()
+        self.pre = [a.pre_facts for a in task.actions] + extra_pre
+        self.add = [a.add_facts for a in task.actions] + extra_add
+        base_cost = [a.cost for a in task.actions]
+        base_neglog = [-math.log(a.probability) for a in task.actions]
         # +1 per action (as LAMA's plusone costs): zero-cost actions otherwise form plateaus
-        self.combined = [1.0 + a.cost + reward * (1.0 - a.probability) for a in task.actions]
+        base_combined = [1.0 + a.cost + reward * (1.0 - a.probability) for a in task.actions]
+        behind = merge.weight_of.tolist()  # extra actions: a member's weights, or 0 (aux)
+        self.cost = base_cost + [base_cost[b] if b >= 0 else 0.0 for b in behind]
+        self.neglog = base_neglog + [base_neglog[b] if b >= 0 else 0.0 for b in behind]
+        self.combined = base_combined + [base_combined[b] if b >= 0 else 0.0 for b in behind]
+        self.aux = [False] * (n + merge.n_merged) + [True] * (merge.n_extra - merge.n_merged)
+        self.live = [not x for x in merge.away.tolist()] + [True] * merge.n_extra
         self.pre_of: list[list[int]] = [[] for _ in range(self.n_facts)]
         for i, pre in enumerate(self.pre):
-            for f in pre:
-                self.pre_of[f].append(i)
-        self.no_pre = [i for i, pre in enumerate(self.pre) if not pre]
+            if self.live[i]:
+                for f in pre:
+                    self.pre_of[f].append(i)
+        self.no_pre = [i for i, pre in enumerate(self.pre) if not pre and self.live[i]]
         self.goal = [i for i in range(self.n_facts) if task.goal >> i & 1]
         self.is_goal = [bool(task.goal >> i & 1) for i in range(self.n_facts)]
         self.pre_len = [len(p) for p in self.pre]
@@ -69,9 +82,10 @@ class RelaxedTask:
         variant.pre = [tuple(p) for p in pre]
         variant.pre_of = [[] for _ in range(self.n_facts)]
         for i, p in enumerate(variant.pre):
-            for f in p:
-                variant.pre_of[f].append(i)
-        variant.no_pre = [i for i, p in enumerate(variant.pre) if not p]
+            if self.live[i]:
+                for f in p:
+                    variant.pre_of[f].append(i)
+        variant.no_pre = [i for i, p in enumerate(variant.pre) if not p and self.live[i]]
         variant.pre_len = [len(p) for p in variant.pre]
         return variant
 
@@ -174,9 +188,10 @@ class _FF:
         dist, support = relaxed_costs(rt, state, rt.combined, False)
         if any(dist[g] == INF for g in rt.goal):
             return INF, INF
-        chosen = self._relaxed_plan(rt, state, support)
-        actions = self.actions
-        self.helpful[state] = frozenset(a for a in chosen if actions[a].applicable(state))
+        chosen = [a for a in self._relaxed_plan(rt, state, support) if not rt.aux[a]]
+        actions, n, merge = self.actions, rt.n_task_actions, rt.merge
+        real = (a if a < n else merge.member(a, support) for a in chosen)
+        self.helpful[state] = frozenset(a for a in real if actions[a].applicable(state))
         return sum(rt.cost[a] + 1.0 for a in chosen), sum(rt.neglog[a] for a in chosen)
 
     @staticmethod

@@ -75,7 +75,22 @@ def pack_task(task: GroundTask):
 
 
 def _pack(task: GroundTask):
-    return _native.Task(*(task_arrays(task) if task.arrays is not None else task_args(task)))
+    from avs_planner.cp.relaxed_merge import merge_task
+
+    base = task_arrays(task) if task.arrays is not None else task_args(task)
+    return _native.Task(*base, *merge_args(merge_task(task)))
+
+
+def merge_args(merge) -> tuple:
+    """The arguments of `_native.Task` for a `relaxed_merge.RelaxedMerge`."""
+    import numpy as np
+
+    def b(x) -> bytes:
+        return np.ascontiguousarray(x, dtype="<i8").tobytes()
+
+    return (merge.n_rfacts, merge.n_merged, b(merge.pre_off), b(merge.pre), b(merge.add_off),
+            b(merge.add), b(merge.away), b(merge.weight_of), b(merge.link), b(merge.member_off),
+            b(merge.members))
 
 
 def _check_actions(task: GroundTask) -> tuple[bytes, bytes, bytes]:

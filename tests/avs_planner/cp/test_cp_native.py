@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from avs_planner.cp import native
+from avs_planner.cp.relaxed_merge import merge_task
 from avs_planner.cp.grounding import ground, world_state
 from avs_planner.cp.search import PlanStatus, SearchOptions, search
 from avs_planner.cp.symmetry import NO_SYMMETRIES, find_symmetries
@@ -243,7 +244,11 @@ def test_bad_tasks_are_errors_not_crashes():
     with pytest.raises(PlanningError, match="outside"):
         search(task.with_init(1 << 500), SearchOptions(engine="native"))
     with pytest.raises(ValueError, match="native"):
-        native._native.Task(3, 1, *([b""] * 14))
+        native._native.Task(3, 1, *([b""] * 14), 3, 0, *([b""] * 9))
+    args = (*native.task_args(task), *native.merge_args(merge_task(task)))
+    native._native.Task(*args)  # well formed
+    with pytest.raises(ValueError, match="merge"):
+        native._native.Task(*args[:16], len(task.facts) - 1, *args[17:])
 
 
 @needs_native
