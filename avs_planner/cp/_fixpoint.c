@@ -429,6 +429,567 @@ done:
     return out;
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* relaxed_merge.py's grouping and merge construction (one_argument_groups + build_merge), the
+ * same arrays in the same order: hashes are the same wrapping sums of value * weight[c % 256]
+ * with the weights passed in, and every order the numpy code takes from a sort is reproduced
+ * by sorting on the same keys (ties by index). */
+
+#define MERGE_BIG ((int64_t)1 << 62)
+
+typedef struct {
+    uint64_t k1, k2;
+    int64_t i;
+} Key3;
+
+static int key3_cmp(const void *pa, const void *pb)
+{
+    const Key3 *a = pa, *b = pb;
+    if (a->k1 != b->k1)
+        return a->k1 < b->k1 ? -1 : 1;
+    if (a->k2 != b->k2)
+        return a->k2 < b->k2 ? -1 : 1;
+    return (a->i > b->i) - (a->i < b->i);
+}
+
+static int bit_length(int64_t v)
+{
+    int n = 0;
+    while (v > 0) {
+        n++;
+        v >>= 1;
+    }
+    return n;
+}
+
+/* Growable int64 list. */
+typedef struct {
+    int64_t *v;
+    Py_ssize_t n, cap;
+} I64List;
+
+static int i64_push(I64List *l, int64_t x)
+{
+    if (l->n == l->cap) {
+        Py_ssize_t cap = l->cap ? l->cap * 2 : 256;
+        int64_t *v = realloc(l->v, (size_t)cap * sizeof(int64_t));
+        if (!v)
+            return -1;
+        l->v = v;
+        l->cap = cap;
+    }
+    l->v[l->n++] = x;
+    return 0;
+}
+
+static PyObject *i64_bytes(const int64_t *v, Py_ssize_t n)
+{
+    return PyBytes_FromStringAndSize((const char *)v, n * (Py_ssize_t)sizeof(int64_t));
+}
+
+static PyObject *relaxed_merge(PyObject *self, PyObject *args)
+{
+    (void)self;
+    PyObject *args_o, *pre_o, *add_o, *cost_o, *prob_o, *elig_o, *w_o;
+    Py_ssize_t n, arity, wp, wa, n_facts;
+    if (!PyArg_ParseTuple(args, "nnnnnOOOOOOO", &n, &arity, &wp, &wa, &n_facts, &args_o, &pre_o,
+                          &add_o, &cost_o, &prob_o, &elig_o, &w_o))
+        return NULL;
+    if (n < 0 || arity < 0 || wp < 0 || wa < 0 || n_facts < 0 || n_facts > INT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "relaxed_merge: bad sizes");
+        return NULL;
+    }
+    Py_buffer b[7];
+    int got = 0;
+    const Spec specs[7] = {
+        {args_o, n * arity, 8, 0, "relaxed_merge: args"},
+        {pre_o, n * wp, 8, 0, "relaxed_merge: pre"},
+        {add_o, n * wa, 8, 0, "relaxed_merge: add"},
+        {cost_o, n, 8, 0, "relaxed_merge: cost"},
+        {prob_o, n, 8, 0, "relaxed_merge: probability"},
+        {elig_o, n, 1, 0, "relaxed_merge: eligible"},
+        {w_o, 256, 8, 0, "relaxed_merge: weights"},
+    };
+    PyObject *result = NULL;
+    Py_ssize_t K = arity + wa + 2;
+    uint64_t *key = NULL, *full = NULL;
+    int64_t *gid = NULL, *first = NULL, *rank = NULL, *members = NULL, *g = NULL, *alt = NULL;
+    int64_t *cnt = NULL, *start = NULL, *sizes = NULL, *x_of = NULL, *common_n = NULL;
+    uint8_t *free_ = NULL, *away = NULL, *okg = NULL;
+    Key3 *ks = NULL;
+    int64_t *slot = NULL, *slot_g = NULL;
+    I64List pre_off = {0}, pre_v = {0}, add_off = {0}, add_v = {0}, weight_of = {0},
+            link = {0}, member_off = {0}, mem_out = {0};
+    Py_ssize_t n_x = 0, n_m = 0;
+    if (get_all(specs, 7, b, &got) < 0)
+        goto done;
+    const int64_t *A = b[0].buf, *P = b[1].buf, *D = b[2].buf;
+    const uint64_t *C = b[3].buf, *Q = b[4].buf, *W = b[6].buf;
+    const uint8_t *E = b[5].buf;
+    gid = malloc(sizeof(int64_t) * (size_t)(n + 1));
+    away = calloc((size_t)n + 1, 1);
+    if (!gid || !away)
+        goto nomem;
+    for (Py_ssize_t i = 0; i < n; i++)
+        gid[i] = -1;
+    /* one_argument_groups */
+    if (n >= 2 && arity) {
+        key = malloc(sizeof(uint64_t) * (size_t)(n * K));
+        full = malloc(sizeof(uint64_t) * (size_t)n);
+        free_ = malloc((size_t)n);
+        ks = malloc(sizeof(Key3) * (size_t)n);
+        int64_t *gains = calloc((size_t)arity, sizeof(int64_t));
+        int64_t *korder = malloc(sizeof(int64_t) * (size_t)arity);
+        if (!key || !full || !free_ || !ks || !gains || !korder) {
+            free(gains);
+            free(korder);
+            goto nomem;
+        }
+        for (Py_ssize_t i = 0; i < n; i++) {
+            uint64_t *row = key + i * K, h = 0;
+            for (Py_ssize_t c = 0; c < arity; c++)
+                row[c] = (uint64_t)A[i * arity + c];
+            for (Py_ssize_t c = 0; c < wa; c++)
+                row[arity + c] = (uint64_t)D[i * wa + c];
+            row[arity + wa] = C[i];
+            row[arity + wa + 1] = Q[i];
+            for (Py_ssize_t c = 0; c < K; c++)
+                h += row[c] * W[c % 256];
+            full[i] = h;
+            free_[i] = E[i];
+        }
+        size_t cap = 16;
+        while (cap < 2 * (size_t)n)
+            cap <<= 1;
+        slot = malloc(sizeof(int64_t) * cap);
+        slot_g = malloc(sizeof(int64_t) * (size_t)n);
+        if (!slot || !slot_g) {
+            free(gains);
+            free(korder);
+            goto nomem;
+        }
+        for (Py_ssize_t k = 0; k < arity; k++) { /* gains: rows whose hash an earlier has */
+            memset(slot, 0xff, sizeof(int64_t) * cap);
+            uint64_t wk = W[k % 256];
+            for (Py_ssize_t i = 0; i < n; i++) {
+                if (!free_[i] || A[i * arity + k] < 0)
+                    continue;
+                uint64_t h = full[i] - key[i * K + k] * wk;
+                size_t s = (size_t)(h ^ (h >> 31)) & (cap - 1);
+                while (slot[s] >= 0 && full[slot[s]] - key[slot[s] * K + k] * wk != h)
+                    s = (s + 1) & (cap - 1);
+                if (slot[s] >= 0)
+                    gains[k]++;
+                else
+                    slot[s] = i;
+            }
+            korder[k] = k;
+        }
+        for (Py_ssize_t x = 1; x < arity; x++) { /* by (-gain, k): insertion sort */
+            int64_t k = korder[x];
+            Py_ssize_t y = x;
+            while (y > 0 && gains[korder[y - 1]] < gains[k]) {
+                korder[y] = korder[y - 1];
+                y--;
+            }
+            korder[y] = k;
+        }
+        int64_t n_groups = 0;
+        for (Py_ssize_t x = 0; x < arity; x++) {
+            int64_t k = korder[x];
+            if (!gains[k])
+                break;
+            /* rows with the same hash and the same key columns (k aside) form a group; a
+             * slot holds the first such row, slot_g its group (-1 while alone) */
+            memset(slot, 0xff, sizeof(int64_t) * cap);
+            uint64_t wk = W[k % 256];
+            Py_ssize_t n_seen = 0;
+            for (Py_ssize_t i = 0; i < n; i++) {
+                if (!free_[i] || A[i * arity + k] < 0)
+                    continue;
+                uint64_t h = full[i] - key[i * K + k] * wk;
+                size_t s = (size_t)(h ^ (h >> 31)) & (cap - 1);
+                while (slot[s] >= 0) {
+                    int64_t r = slot[s];
+                    if (full[r] - key[r * K + k] * wk == h) {
+                        const uint64_t *r0 = key + r * K, *r1 = key + i * K;
+                        int same = 1;
+                        for (Py_ssize_t c = 0; c < K && same; c++)
+                            if (c != k && r0[c] != r1[c])
+                                same = 0;
+                        if (same)
+                            break;
+                    }
+                    s = (s + 1) & (cap - 1);
+                }
+                if (slot[s] < 0) {
+                    slot[s] = i;
+                    slot_g[i] = -1;
+                    n_seen++;
+                    continue;
+                }
+                int64_t r = slot[s];
+                if (slot_g[r] < 0)
+                    slot_g[r] = n_groups++;
+                gid[r] = gid[i] = slot_g[r];
+            }
+            for (Py_ssize_t i = 0; i < n; i++) /* grouped rows leave the pool after this k */
+                if (gid[i] >= 0)
+                    free_[i] = 0;
+            (void)n_seen;
+        }
+        free(gains);
+        free(korder);
+        if (n_groups) { /* renumber by first member */
+            first = malloc(sizeof(int64_t) * (size_t)n_groups);
+            rank = malloc(sizeof(int64_t) * (size_t)n_groups);
+            if (!first || !rank)
+                goto nomem;
+            for (int64_t q = 0; q < n_groups; q++)
+                first[q] = -1;
+            int64_t next = 0;
+            for (Py_ssize_t i = 0; i < n; i++)
+                if (gid[i] >= 0 && first[gid[i]] < 0) {
+                    first[gid[i]] = i;
+                    rank[gid[i]] = next++;
+                }
+            for (Py_ssize_t i = 0; i < n; i++)
+                if (gid[i] >= 0)
+                    gid[i] = rank[gid[i]];
+        }
+    }
+    /* build_merge */
+    Py_ssize_t n_mem = 0;
+    for (Py_ssize_t i = 0; i < n; i++)
+        n_mem += gid[i] >= 0;
+    if (n_mem && wp) {
+        /* members by (group, index); a group's members are contiguous */
+        members = malloc(sizeof(int64_t) * (size_t)n_mem);
+        int64_t n_groups = 0;
+        for (Py_ssize_t i = 0; i < n; i++)
+            if (gid[i] + 1 > n_groups)
+                n_groups = gid[i] + 1;
+        int64_t *goff = calloc((size_t)n_groups + 1, sizeof(int64_t));
+        if (!members || !goff) {
+            free(goff);
+            goto nomem;
+        }
+        for (Py_ssize_t i = 0; i < n; i++)
+            if (gid[i] >= 0)
+                goff[gid[i] + 1]++;
+        for (int64_t q = 0; q < n_groups; q++)
+            goff[q + 1] += goff[q];
+        {
+            int64_t *fill = calloc((size_t)n_groups, sizeof(int64_t));
+            if (!fill) {
+                free(goff);
+                goto nomem;
+            }
+            for (Py_ssize_t i = 0; i < n; i++)
+                if (gid[i] >= 0)
+                    members[goff[gid[i]] + fill[gid[i]]++] = i;
+            free(fill);
+        }
+        /* per member: which preconditions all of its group have (common); the rest */
+        cnt = calloc((size_t)n_facts + 2, sizeof(int64_t));
+        okg = malloc((size_t)n_groups);
+        alt = malloc(sizeof(int64_t) * (size_t)(n_mem * wp));
+        common_n = calloc((size_t)n_groups, sizeof(int64_t));
+        int64_t *common = malloc(sizeof(int64_t) * (size_t)(n_groups * wp) + 8);
+        if (!cnt || !okg || !alt || !common_n || !common) {
+            free(goff);
+            free(common);
+            goto nomem;
+        }
+        for (int64_t q = 0; q < n_groups; q++) {
+            int64_t size = goff[q + 1] - goff[q];
+            for (int64_t t = goff[q]; t < goff[q + 1]; t++)
+                for (Py_ssize_t c = 0; c < wp; c++) {
+                    int64_t f = P[members[t] * wp + c];
+                    if (f >= 0 && f < n_facts + 2)
+                        cnt[f]++;
+                }
+            okg[q] = 1;
+            for (int64_t t = goff[q]; t < goff[q + 1]; t++) {
+                Py_ssize_t na = 0;
+                int64_t *row = alt + t * wp;
+                for (Py_ssize_t c = 0; c < wp; c++) {
+                    int64_t f = P[members[t] * wp + c];
+                    if (f < 0)
+                        continue;
+                    if (f < n_facts + 2 && cnt[f] == size) {
+                        if (t == goff[q])
+                            common[q * wp + common_n[q]++] = f;
+                    } else
+                        row[na++] = f;
+                }
+                if (!na)
+                    okg[q] = 0;
+                for (Py_ssize_t c = na; c < wp; c++)
+                    row[c] = MERGE_BIG;
+                /* pre rows are sorted, so the remainder is too */
+            }
+            for (int64_t t = goff[q]; t < goff[q + 1]; t++)
+                for (Py_ssize_t c = 0; c < wp; c++) {
+                    int64_t f = P[members[t] * wp + c];
+                    if (f >= 0 && f < n_facts + 2)
+                        cnt[f] = 0;
+                }
+        }
+        /* dense ids over the kept groups */
+        g = malloc(sizeof(int64_t) * (size_t)n_groups);
+        if (!g) {
+            free(goff);
+            free(common);
+            goto nomem;
+        }
+        for (int64_t q = 0; q < n_groups; q++)
+            g[q] = okg[q] ? n_m++ : -1;
+        if (n_m) {
+            /* members of kept groups ordered by (group, hash bits of remainder, index) */
+            ks = ks ? ks : malloc(sizeof(Key3) * (size_t)n_mem);
+            if (!ks) {
+                free(goff);
+                free(common);
+                goto nomem;
+            }
+            int gb = bit_length(n_m) > 1 ? bit_length(n_m) : 1;
+            int mb = bit_length(n) > 1 ? bit_length(n) : 1;
+            int hb = 64 - gb - mb;
+            Py_ssize_t m = 0;
+            for (int64_t q = 0; q < n_groups; q++) {
+                if (!okg[q])
+                    continue;
+                for (int64_t t = goff[q]; t < goff[q + 1]; t++) {
+                    uint64_t h = 0;
+                    for (Py_ssize_t c = 0; c < wp; c++)
+                        h += (uint64_t)alt[t * wp + c] * W[c % 256];
+                    away[members[t]] = 1;
+                    ks[m].k1 = (uint64_t)g[q];
+                    ks[m].k2 = hb >= 16 ? h >> (64 - hb) : h;
+                    ks[m++].i = t; /* position in members/alt; same order as the index */
+                }
+            }
+            /* ks is in group order already: sort each group's run (small: insertion) */
+            for (Py_ssize_t j0 = 0; j0 < m;) {
+                Py_ssize_t j1 = j0 + 1;
+                while (j1 < m && ks[j1].k1 == ks[j0].k1)
+                    j1++;
+                if (j1 - j0 > 32)
+                    qsort(ks + j0, (size_t)(j1 - j0), sizeof(Key3), key3_cmp);
+                else
+                    for (Py_ssize_t x = j0 + 1; x < j1; x++) {
+                        Key3 v = ks[x];
+                        Py_ssize_t y = x;
+                        while (y > j0 && key3_cmp(&ks[y - 1], &v) > 0) {
+                            ks[y] = ks[y - 1];
+                            y--;
+                        }
+                        ks[y] = v;
+                    }
+                j0 = j1;
+            }
+            /* drop a remainder repeated within a group (the lowest index stays) */
+            sizes = calloc((size_t)n_m, sizeof(int64_t));
+            start = calloc((size_t)n_m + 1, sizeof(int64_t));
+            int64_t *kept = malloc(sizeof(int64_t) * (size_t)m + 8);
+            if (!sizes || !start || !kept) {
+                free(goff);
+                free(common);
+                free(kept);
+                goto nomem;
+            }
+            Py_ssize_t nk = 0;
+            for (Py_ssize_t j = 0; j < m; j++) {
+                if (j && ks[j].k1 == ks[j - 1].k1 &&
+                    !memcmp(alt + ks[j].i * wp, alt + ks[j - 1].i * wp,
+                            sizeof(int64_t) * (size_t)wp))
+                    continue;
+                kept[nk++] = ks[j].i;
+                sizes[ks[j].k1]++;
+            }
+            int64_t maxsize = 0;
+            for (Py_ssize_t q = 0; q < n_m; q++) {
+                start[q + 1] = start[q] + sizes[q];
+                if (sizes[q] > maxsize)
+                    maxsize = sizes[q];
+            }
+            /* X per distinct list of alternatives, numbered by first group */
+            Py_ssize_t tw = (Py_ssize_t)maxsize * wp;
+            Key3 *gs = malloc(sizeof(Key3) * (size_t)n_m);
+            x_of = malloc(sizeof(int64_t) * (size_t)n_m);
+            int64_t *reps = malloc(sizeof(int64_t) * (size_t)n_m);
+            if (!gs || !x_of || !reps) {
+                free(goff);
+                free(common);
+                free(kept);
+                free(gs);
+                free(reps);
+                goto nomem;
+            }
+            for (Py_ssize_t q = 0; q < n_m; q++) {
+                uint64_t h = 0;
+                Py_ssize_t len = sizes[q] * wp;
+                for (Py_ssize_t c = 0; c < tw; c++) {
+                    int64_t v = c < len ? alt[kept[start[q] + c / wp] * wp + c % wp] : MERGE_BIG;
+                    h += (uint64_t)v * W[c % 256];
+                }
+                gs[q].k1 = h;
+                gs[q].k2 = 0;
+                gs[q].i = q;
+            }
+            qsort(gs, (size_t)n_m, sizeof(Key3), key3_cmp);
+            Py_ssize_t n_runs = 0;
+            int64_t *run_of = malloc(sizeof(int64_t) * (size_t)n_m);
+            if (!run_of) {
+                free(goff);
+                free(common);
+                free(kept);
+                free(gs);
+                free(reps);
+                goto nomem;
+            }
+            for (Py_ssize_t j = 0; j < n_m; j++) {
+                int same = 0;
+                if (j && gs[j].k1 == gs[j - 1].k1) {
+                    int64_t q0 = gs[j - 1].i, q1 = gs[j].i;
+                    same = sizes[q0] == sizes[q1];
+                    for (int64_t p = 0; same && p < sizes[q0]; p++)
+                        same = !memcmp(alt + kept[start[q0] + p] * wp,
+                                       alt + kept[start[q1] + p] * wp,
+                                       sizeof(int64_t) * (size_t)wp);
+                }
+                if (!same)
+                    reps[n_runs++] = gs[j].i; /* the run's first = lowest group */
+                run_of[gs[j].i] = n_runs - 1;
+            }
+            /* X ids: runs by their first group */
+            int64_t *run_x = malloc(sizeof(int64_t) * (size_t)n_runs + 8);
+            int64_t *is_rep = calloc((size_t)n_m, sizeof(int64_t));
+            if (!run_x || !is_rep) {
+                free(goff);
+                free(common);
+                free(kept);
+                free(gs);
+                free(reps);
+                free(run_of);
+                free(run_x);
+                free(is_rep);
+                goto nomem;
+            }
+            for (Py_ssize_t r = 0; r < n_runs; r++)
+                is_rep[reps[r]] = r + 1;
+            n_x = 0;
+            for (Py_ssize_t q = 0; q < n_m; q++)
+                if (is_rep[q])
+                    run_x[is_rep[q] - 1] = n_x++;
+            for (Py_ssize_t q = 0; q < n_m; q++)
+                x_of[q] = run_x[run_of[q]];
+            /* the extra actions: merged (one per kept group), then auxiliary per X */
+            int ok = !i64_push(&pre_off, 0) && !i64_push(&add_off, 0) &&
+                     !i64_push(&member_off, 0);
+            int64_t *orig = malloc(sizeof(int64_t) * (size_t)n_m); /* kept group -> group */
+            if (!orig)
+                ok = 0;
+            for (int64_t q = 0; ok && q < n_groups; q++)
+                if (okg[q])
+                    orig[g[q]] = q;
+            for (Py_ssize_t q = 0; ok && q < n_m; q++) {
+                int64_t q0 = orig[q], lead = members[kept[start[q]]];
+                for (int64_t c = 0; ok && c < common_n[q0]; c++)
+                    ok = !i64_push(&pre_v, common[q0 * wp + c]);
+                ok = ok && !i64_push(&pre_v, n_facts + x_of[q]) &&
+                     !i64_push(&pre_off, pre_v.n);
+                for (Py_ssize_t c = 0; ok && c < wa; c++)
+                    if (D[lead * wa + c] >= 0)
+                        ok = !i64_push(&add_v, D[lead * wa + c]);
+                ok = ok && !i64_push(&add_off, add_v.n) && !i64_push(&weight_of, lead) &&
+                     !i64_push(&link, n_facts + x_of[q]) &&
+                     !i64_push(&member_off, start[q + 1]);
+            }
+            for (Py_ssize_t j = 0; ok && j < nk; j++)
+                ok = !i64_push(&mem_out, members[kept[j]]);
+            for (Py_ssize_t q = 0; ok && q < n_m; q++) { /* X order = ascending first group */
+                if (!is_rep[q])
+                    continue;
+                int64_t x = run_x[is_rep[q] - 1];
+                for (int64_t p = 0; ok && p < sizes[q]; p++) {
+                    const int64_t *row = alt + kept[start[q] + p] * wp;
+                    for (Py_ssize_t c = 0; ok && c < wp && row[c] != MERGE_BIG; c++)
+                        ok = !i64_push(&pre_v, row[c]);
+                    ok = ok && !i64_push(&pre_off, pre_v.n) &&
+                         !i64_push(&add_v, n_facts + x) && !i64_push(&add_off, add_v.n) &&
+                         !i64_push(&weight_of, -1) && !i64_push(&link, p);
+                }
+            }
+            free(orig);
+            free(goff);
+            free(common);
+            free(kept);
+            free(gs);
+            free(reps);
+            free(run_of);
+            free(run_x);
+            free(is_rep);
+            if (!ok)
+                goto nomem;
+            goto build;
+        }
+        free(goff);
+        free(common);
+        /* no kept group: nothing merged */
+        memset(away, 0, (size_t)n);
+    }
+    n_m = 0;
+    n_x = 0;
+    if (i64_push(&pre_off, 0) || i64_push(&add_off, 0) || i64_push(&member_off, 0))
+        goto nomem;
+build:
+    {
+        PyObject *away_b = PyBytes_FromStringAndSize((const char *)away, n);
+        result = Py_BuildValue("(nnNNNNNNNNN)", n_facts + n_x, n_m, away_b,
+                               i64_bytes(pre_off.v, pre_off.n), i64_bytes(pre_v.v, pre_v.n),
+                               i64_bytes(add_off.v, add_off.n), i64_bytes(add_v.v, add_v.n),
+                               i64_bytes(weight_of.v, weight_of.n), i64_bytes(link.v, link.n),
+                               i64_bytes(member_off.v, member_off.n),
+                               i64_bytes(mem_out.v, mem_out.n));
+    }
+    goto done;
+nomem:
+    PyErr_NoMemory();
+done:
+    free(key);
+    free(full);
+    free(gid);
+    free(first);
+    free(rank);
+    free(members);
+    free(g);
+    free(alt);
+    free(cnt);
+    free(start);
+    free(sizes);
+    free(x_of);
+    free(common_n);
+    free(free_);
+    free(away);
+    free(okg);
+    free(ks);
+    free(slot);
+    free(slot_g);
+    free(pre_off.v);
+    free(pre_v.v);
+    free(add_off.v);
+    free(add_v.v);
+    free(weight_of.v);
+    free(link.v);
+    free(member_off.v);
+    free(mem_out.v);
+    for (int j = 0; j < got; j++)
+        PyBuffer_Release(&b[j]);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"gather_rows", gather_rows, METH_VARARGS,
      "gather_rows(rows, matrix, width, n_facts, n_words, row_ids, k, read, out, out_bits): "
@@ -448,6 +1009,11 @@ static PyMethodDef methods[] = {
      "clause_neg, n_neg, allowed, goal, n_goal, goal_neg, n_goal_neg, add_index, "
      "delete_index) -> bytearray: 1 for each allowed row that can contribute to the goal "
      "(the indexes over n facts)"},
+    {"relaxed_merge", relaxed_merge, METH_VARARGS,
+     "relaxed_merge(n, arity, pre_width, add_width, n_facts, arg_ids, pre, add, cost_bits, "
+     "probability_bits, eligible, weights) -> (n_rfacts, n_merged, away, pre_off, pre, "
+     "add_off, add, weight_of, link, member_off, members): relaxed_merge.py's merge of "
+     "actions differing in one argument (int64 matrices, -1 padded; bytes out)"},
     {NULL, NULL, 0, NULL},
 };
 

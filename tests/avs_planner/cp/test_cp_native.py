@@ -12,8 +12,8 @@ from pathlib import Path
 import pytest
 
 from avs_planner.cp import native
-from avs_planner.cp.relaxed_merge import merge_task
 from avs_planner.cp.grounding import ground, world_state
+from avs_planner.cp.relaxed_merge import merge_task
 from avs_planner.cp.search import PlanStatus, SearchOptions, search
 from avs_planner.cp.symmetry import NO_SYMMETRIES, find_symmetries
 from avs_planner.cp.task import GroundAction, GroundTask
