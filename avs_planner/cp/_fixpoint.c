@@ -516,8 +516,10 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
     int64_t *gid = NULL, *first = NULL, *rank = NULL, *members = NULL, *g = NULL, *alt = NULL;
     int64_t *cnt = NULL, *start = NULL, *sizes = NULL, *x_of = NULL, *common_n = NULL;
     uint8_t *free_ = NULL, *away = NULL, *okg = NULL;
-    Key3 *ks = NULL;
-    int64_t *slot = NULL, *slot_g = NULL;
+    Key3 *ks = NULL, *gs = NULL;
+    int64_t *slot = NULL, *slot_g = NULL, *gains = NULL, *korder = NULL, *goff = NULL;
+    int64_t *common = NULL, *kept = NULL, *reps = NULL, *run_of = NULL, *run_x = NULL;
+    int64_t *is_rep = NULL, *orig = NULL;
     I64List pre_off = {0}, pre_v = {0}, add_off = {0}, add_v = {0}, weight_of = {0},
             link = {0}, member_off = {0}, mem_out = {0};
     Py_ssize_t n_x = 0, n_m = 0;
@@ -538,13 +540,10 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
         full = malloc(sizeof(uint64_t) * (size_t)n);
         free_ = malloc((size_t)n);
         ks = malloc(sizeof(Key3) * (size_t)n);
-        int64_t *gains = calloc((size_t)arity, sizeof(int64_t));
-        int64_t *korder = malloc(sizeof(int64_t) * (size_t)arity);
-        if (!key || !full || !free_ || !ks || !gains || !korder) {
-            free(gains);
-            free(korder);
+        gains = calloc((size_t)arity, sizeof(int64_t));
+        korder = malloc(sizeof(int64_t) * (size_t)arity);
+        if (!key || !full || !free_ || !ks || !gains || !korder)
             goto nomem;
-        }
         for (Py_ssize_t i = 0; i < n; i++) {
             uint64_t *row = key + i * K, h = 0;
             for (Py_ssize_t c = 0; c < arity; c++)
@@ -563,11 +562,8 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
             cap <<= 1;
         slot = malloc(sizeof(int64_t) * cap);
         slot_g = malloc(sizeof(int64_t) * (size_t)n);
-        if (!slot || !slot_g) {
-            free(gains);
-            free(korder);
+        if (!slot || !slot_g)
             goto nomem;
-        }
         for (Py_ssize_t k = 0; k < arity; k++) { /* gains: rows whose hash an earlier has */
             memset(slot, 0xff, sizeof(int64_t) * cap);
             uint64_t wk = W[k % 256];
@@ -638,8 +634,6 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
                     free_[i] = 0;
             (void)n_seen;
         }
-        free(gains);
-        free(korder);
         if (n_groups) { /* renumber by first member */
             first = malloc(sizeof(int64_t) * (size_t)n_groups);
             rank = malloc(sizeof(int64_t) * (size_t)n_groups);
@@ -669,11 +663,9 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
         for (Py_ssize_t i = 0; i < n; i++)
             if (gid[i] + 1 > n_groups)
                 n_groups = gid[i] + 1;
-        int64_t *goff = calloc((size_t)n_groups + 1, sizeof(int64_t));
-        if (!members || !goff) {
-            free(goff);
+        goff = calloc((size_t)n_groups + 1, sizeof(int64_t));
+        if (!members || !goff)
             goto nomem;
-        }
         for (Py_ssize_t i = 0; i < n; i++)
             if (gid[i] >= 0)
                 goff[gid[i] + 1]++;
@@ -681,10 +673,8 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
             goff[q + 1] += goff[q];
         {
             int64_t *fill = calloc((size_t)n_groups, sizeof(int64_t));
-            if (!fill) {
-                free(goff);
+            if (!fill)
                 goto nomem;
-            }
             for (Py_ssize_t i = 0; i < n; i++)
                 if (gid[i] >= 0)
                     members[goff[gid[i]] + fill[gid[i]]++] = i;
@@ -695,12 +685,9 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
         okg = malloc((size_t)n_groups);
         alt = malloc(sizeof(int64_t) * (size_t)(n_mem * wp));
         common_n = calloc((size_t)n_groups, sizeof(int64_t));
-        int64_t *common = malloc(sizeof(int64_t) * (size_t)(n_groups * wp) + 8);
-        if (!cnt || !okg || !alt || !common_n || !common) {
-            free(goff);
-            free(common);
+        common = malloc(sizeof(int64_t) * (size_t)(n_groups * wp) + 8);
+        if (!cnt || !okg || !alt || !common_n || !common)
             goto nomem;
-        }
         for (int64_t q = 0; q < n_groups; q++) {
             int64_t size = goff[q + 1] - goff[q];
             for (int64_t t = goff[q]; t < goff[q + 1]; t++)
@@ -738,21 +725,15 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
         }
         /* dense ids over the kept groups */
         g = malloc(sizeof(int64_t) * (size_t)n_groups);
-        if (!g) {
-            free(goff);
-            free(common);
+        if (!g)
             goto nomem;
-        }
         for (int64_t q = 0; q < n_groups; q++)
             g[q] = okg[q] ? n_m++ : -1;
         if (n_m) {
             /* members of kept groups ordered by (group, hash bits of remainder, index) */
             ks = ks ? ks : malloc(sizeof(Key3) * (size_t)n_mem);
-            if (!ks) {
-                free(goff);
-                free(common);
+            if (!ks)
                 goto nomem;
-            }
             int gb = bit_length(n_m) > 1 ? bit_length(n_m) : 1;
             int mb = bit_length(n) > 1 ? bit_length(n) : 1;
             int hb = 64 - gb - mb;
@@ -792,13 +773,9 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
             /* drop a remainder repeated within a group (the lowest index stays) */
             sizes = calloc((size_t)n_m, sizeof(int64_t));
             start = calloc((size_t)n_m + 1, sizeof(int64_t));
-            int64_t *kept = malloc(sizeof(int64_t) * (size_t)m + 8);
-            if (!sizes || !start || !kept) {
-                free(goff);
-                free(common);
-                free(kept);
+            kept = malloc(sizeof(int64_t) * (size_t)m + 8);
+            if (!sizes || !start || !kept)
                 goto nomem;
-            }
             Py_ssize_t nk = 0;
             for (Py_ssize_t j = 0; j < m; j++) {
                 if (j && ks[j].k1 == ks[j - 1].k1 &&
@@ -816,39 +793,35 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
             }
             /* X per distinct list of alternatives, numbered by first group */
             Py_ssize_t tw = (Py_ssize_t)maxsize * wp;
-            Key3 *gs = malloc(sizeof(Key3) * (size_t)n_m);
+            gs = malloc(sizeof(Key3) * (size_t)n_m);
             x_of = malloc(sizeof(int64_t) * (size_t)n_m);
-            int64_t *reps = malloc(sizeof(int64_t) * (size_t)n_m);
-            if (!gs || !x_of || !reps) {
-                free(goff);
-                free(common);
-                free(kept);
-                free(gs);
-                free(reps);
+            reps = malloc(sizeof(int64_t) * (size_t)n_m);
+            if (!gs || !x_of || !reps)
                 goto nomem;
-            }
+            /* a group's row is its members' remainders, padded with MERGE_BIG to tw
+             * entries; the padding's share of the hash comes from prefix sums of the weights
+             * (a row by row sum would be quadratic with one large group among many) */
+            uint64_t wsum[257];
+            wsum[0] = 0;
+            for (int c = 0; c < 256; c++)
+                wsum[c + 1] = wsum[c] + W[c];
             for (Py_ssize_t q = 0; q < n_m; q++) {
                 uint64_t h = 0;
                 Py_ssize_t len = sizes[q] * wp;
-                for (Py_ssize_t c = 0; c < tw; c++) {
-                    int64_t v = c < len ? alt[kept[start[q] + c / wp] * wp + c % wp] : MERGE_BIG;
-                    h += (uint64_t)v * W[c % 256];
-                }
+                for (Py_ssize_t c = 0; c < len; c++)
+                    h += (uint64_t)alt[kept[start[q] + c / wp] * wp + c % wp] * W[c % 256];
+                uint64_t upto_tw = (uint64_t)(tw / 256) * wsum[256] + wsum[tw % 256];
+                uint64_t upto_len = (uint64_t)(len / 256) * wsum[256] + wsum[len % 256];
+                h += (uint64_t)MERGE_BIG * (upto_tw - upto_len);
                 gs[q].k1 = h;
                 gs[q].k2 = 0;
                 gs[q].i = q;
             }
             qsort(gs, (size_t)n_m, sizeof(Key3), key3_cmp);
             Py_ssize_t n_runs = 0;
-            int64_t *run_of = malloc(sizeof(int64_t) * (size_t)n_m);
-            if (!run_of) {
-                free(goff);
-                free(common);
-                free(kept);
-                free(gs);
-                free(reps);
+            run_of = malloc(sizeof(int64_t) * (size_t)n_m);
+            if (!run_of)
                 goto nomem;
-            }
             for (Py_ssize_t j = 0; j < n_m; j++) {
                 int same = 0;
                 if (j && gs[j].k1 == gs[j - 1].k1) {
@@ -864,19 +837,10 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
                 run_of[gs[j].i] = n_runs - 1;
             }
             /* X ids: runs by their first group */
-            int64_t *run_x = malloc(sizeof(int64_t) * (size_t)n_runs + 8);
-            int64_t *is_rep = calloc((size_t)n_m, sizeof(int64_t));
-            if (!run_x || !is_rep) {
-                free(goff);
-                free(common);
-                free(kept);
-                free(gs);
-                free(reps);
-                free(run_of);
-                free(run_x);
-                free(is_rep);
+            run_x = malloc(sizeof(int64_t) * (size_t)n_runs + 8);
+            is_rep = calloc((size_t)n_m, sizeof(int64_t));
+            if (!run_x || !is_rep)
                 goto nomem;
-            }
             for (Py_ssize_t r = 0; r < n_runs; r++)
                 is_rep[reps[r]] = r + 1;
             n_x = 0;
@@ -888,7 +852,7 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
             /* the extra actions: merged (one per kept group), then auxiliary per X */
             int ok = !i64_push(&pre_off, 0) && !i64_push(&add_off, 0) &&
                      !i64_push(&member_off, 0);
-            int64_t *orig = malloc(sizeof(int64_t) * (size_t)n_m); /* kept group -> group */
+            orig = malloc(sizeof(int64_t) * (size_t)n_m); /* kept group -> group */
             if (!orig)
                 ok = 0;
             for (int64_t q = 0; ok && q < n_groups; q++)
@@ -922,21 +886,10 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
                          !i64_push(&weight_of, -1) && !i64_push(&link, p);
                 }
             }
-            free(orig);
-            free(goff);
-            free(common);
-            free(kept);
-            free(gs);
-            free(reps);
-            free(run_of);
-            free(run_x);
-            free(is_rep);
             if (!ok)
                 goto nomem;
             goto build;
         }
-        free(goff);
-        free(common);
         /* no kept group: nothing merged */
         memset(away, 0, (size_t)n);
     }
@@ -975,6 +928,17 @@ done:
     free(away);
     free(okg);
     free(ks);
+    free(gs);
+    free(gains);
+    free(korder);
+    free(goff);
+    free(common);
+    free(kept);
+    free(reps);
+    free(run_of);
+    free(run_x);
+    free(is_rep);
+    free(orig);
     free(slot);
     free(slot_g);
     free(pre_off.v);

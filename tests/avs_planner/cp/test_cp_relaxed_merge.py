@@ -116,3 +116,26 @@ def test_merging_keeps_hmax_and_hadd(heuristic, monkeypatch):
     for (hc, hl, _), (pc, pl, _) in zip(merged, plain, strict=True):
         assert hc == pytest.approx(pc, rel=1e-12, abs=1e-9)
         assert hl == pytest.approx(pl, rel=1e-12, abs=1e-9)
+
+
+@compiled
+def test_one_large_group_among_many_small_ones(monkeypatch):
+    # 300 actions differing in their second argument (one group), then 50 pairs
+    big, pairs = 300, 50
+    n = big + 2 * pairs
+    args = np.zeros((n, 2), dtype=np.int64)
+    args[:big, 1] = np.arange(big)
+    args[big:, 0] = 1 + np.arange(2 * pairs) // 2
+    args[big:, 1] = np.arange(2 * pairs) % 2
+    n_facts = 400
+    pre = np.full((n, 2), -1, dtype=np.int64)
+    pre[:, 0] = 0  # common to all
+    pre[:, 1] = 1 + np.arange(n) % 37  # remainders, some repeated within a group
+    add = np.full((n, 1), -1, dtype=np.int64)
+    add[:big, 0] = 390
+    add[big:, 0] = 100 + np.arange(2 * pairs) // 2
+    cost, probability = np.ones(n), np.full(n, 0.5)
+    expected, got = _both(monkeypatch, n_facts, args, pre, add, cost, probability,
+                          np.ones(n, dtype=bool))
+    assert got.n_merged == 1 + pairs
+    _assert_same(expected, got)
