@@ -17,6 +17,8 @@
  * relevant: backward relevance. An allowed row is kept when it adds a fact needed true or
  *   deletes one needed false; a kept row's positive conditions (pre and clause positives)
  *   become needed true, its negative ones (pre_neg and clause negatives) needed false.
+ * relaxed_merge: not a fixpoint, but per call on a task's action rows too: the relaxed merge
+ *   of avs_planner/cp/relaxed_merge.py (numpy there, the fallback and the tests' reference).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -599,7 +601,6 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
              * slot holds the first such row, slot_g its group (-1 while alone) */
             memset(slot, 0xff, sizeof(int64_t) * cap);
             uint64_t wk = W[k % 256];
-            Py_ssize_t n_seen = 0;
             for (Py_ssize_t i = 0; i < n; i++) {
                 if (!free_[i] || A[i * arity + k] < 0)
                     continue;
@@ -621,7 +622,6 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
                 if (slot[s] < 0) {
                     slot[s] = i;
                     slot_g[i] = -1;
-                    n_seen++;
                     continue;
                 }
                 int64_t r = slot[s];
@@ -632,7 +632,6 @@ static PyObject *relaxed_merge(PyObject *self, PyObject *args)
             for (Py_ssize_t i = 0; i < n; i++) /* grouped rows leave the pool after this k */
                 if (gid[i] >= 0)
                     free_[i] = 0;
-            (void)n_seen;
         }
         if (n_groups) { /* renumber by first member */
             first = malloc(sizeof(int64_t) * (size_t)n_groups);
@@ -983,7 +982,8 @@ static PyMethodDef methods[] = {
 
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, "_fixpoint",
-    "The grounder's relaxed reachability and relevance fixpoints, compiled.", -1, methods,
+    "The grounder's relaxed reachability and relevance fixpoints and the relaxed merge, "
+    "compiled.", -1, methods,
     NULL, NULL, NULL, NULL,
 };
 

@@ -16,6 +16,7 @@ from array import array
 from collections import OrderedDict
 from itertools import chain
 
+from avs_planner.cp.relaxed_merge import merge_task
 from avs_planner.cp.structure import bit_words
 from avs_planner.cp.symmetry import Symmetries
 from avs_planner.cp.task import GroundTask
@@ -75,8 +76,6 @@ def pack_task(task: GroundTask):
 
 
 def _pack(task: GroundTask):
-    from avs_planner.cp.relaxed_merge import merge_task
-
     base = task_arrays(task) if task.arrays is not None else task_args(task)
     return _native.Task(*base, *merge_args(merge_task(task)))
 
