@@ -11,7 +11,7 @@ $(BIN)/python:
 
 # Stamp files: reinstall when pyproject.toml, setup.py or the C search core change (the
 # install compiles the extensions in avs_planner/cp in place).
-NATIVE := setup.py avs_planner/cp/_native.c avs_planner/cp/_fixpoint.c
+NATIVE := setup.py avs_planner/cp/_native.c avs_planner/cp/_fixpoint.c avs_planner/cp/_ground.c
 
 $(VENV)/.installed: pyproject.toml $(NATIVE) | $(BIN)/python
 	$(BIN)/python -m pip install -q -e .

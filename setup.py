@@ -1,4 +1,4 @@
-"""Build of the optional compiled search core and grounding fixpoints; the project's
+"""Build of the optional compiled search core, grounding structure and fixpoints; the project's
 metadata is in pyproject.toml."""
 
 from setuptools import Extension, setup
@@ -10,6 +10,12 @@ setup(
             ["avs_planner/cp/_native.c"],
             # -ffp-contract=off: no fused multiply-add, so every float matches the Python search
             extra_compile_args=["-O2", "-std=c11", "-ffp-contract=off"],
+            optional=True,
+        ),
+        Extension(
+            "avs_planner.cp._ground",
+            ["avs_planner/cp/_ground.c"],
+            extra_compile_args=["-O2", "-std=c11"],
             optional=True,
         ),
         Extension(

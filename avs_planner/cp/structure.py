@@ -20,6 +20,11 @@ from avs_planner.cp.schema import AtomTemplate, LiftedSchema
 from avs_planner.cp.task import Atom
 from avs_planner.errors import PlanningError
 
+try:  # the compiled join, encoding and numbering; the numpy code below computes the same
+    from avs_planner.cp import _ground
+except ImportError:
+    _ground = None
+
 MAX_GROUND_ACTIONS = 2_000_000
 MAX_BINDINGS = 20_000_000  # partial bindings of one schema while joining its static atoms
 _PAD_TRUE = -1  # padding code of precondition arrays (an always-true fact)
@@ -169,21 +174,47 @@ def _term_params(terms: Sequence[str]) -> frozenset[str]:
     return frozenset(t for t in terms if t[0] == "?")
 
 
-def _bindings(
-    schema: LiftedSchema, space: AtomSpace, is_static: Callable[[np.ndarray], np.ndarray]
-) -> tuple[dict[str, np.ndarray], int]:
-    """Every parameter binding consistent with types, static atoms and (in)equalities, as
-    columns of object ids in lexicographic order of the schema's parameters. A join: one
-    parameter at a time (the one closing most constraints first), filtering as soon as a
-    constraint's parameters are all bound."""
-    params = schema.params
-    domain = {p: space.objects_of(t) for p, t in zip(params, schema.param_types, strict=True)}
-    pending = (
+def _constraints(schema: LiftedSchema) -> list[tuple[str, tuple, frozenset[str]]]:
+    """(kind, atom template or term pair, parameters read) of the schema's static atoms
+    ("in", "out") and (in)equalities ("eq", "ne")."""
+    return (
         [("in", t, _term_params(t[1:])) for t in schema.static_pos]
         + [("out", t, _term_params(t[1:])) for t in schema.static_neg]
         + [("eq", pair, _term_params(pair)) for pair in schema.equal]
         + [("ne", pair, _term_params(pair)) for pair in schema.not_equal]
     )
+
+
+def _join_order(schema: LiftedSchema, domain: Mapping[str, np.ndarray],
+                constraints: list) -> list[str]:
+    """The parameters in join order: next the one closing most constraints, then the one
+    with fewest objects, then the first."""
+    params = schema.params
+    pending = [c for c in constraints if c[2]]
+    bound: set[str] = set()
+    remaining = list(params)
+    chosen: list[str] = []
+    while remaining:
+        param = min(remaining, key=lambda p: (
+            -sum(1 for c in pending if c[2] <= bound | {p}), len(domain[p]), params.index(p)
+        ))
+        remaining.remove(param)
+        chosen.append(param)
+        bound.add(param)
+        pending = [c for c in pending if not c[2] <= bound]
+    return chosen
+
+
+def _bindings(
+    schema: LiftedSchema, space: AtomSpace, is_static: Callable[[np.ndarray], np.ndarray]
+) -> tuple[dict[str, np.ndarray], int]:
+    """Every parameter binding consistent with types, static atoms and (in)equalities, as
+    columns of object ids in lexicographic order of the schema's parameters. A join: one
+    parameter at a time (`_join_order`), filtering as soon as a constraint's parameters are
+    all bound. (`_Compiled.bindings` is the same join in C.)"""
+    params = schema.params
+    domain = {p: space.objects_of(t) for p, t in zip(params, schema.param_types, strict=True)}
+    constraints = _constraints(schema)
     columns: dict[str, np.ndarray] = {}
     rows = 1
 
@@ -209,16 +240,12 @@ def _bindings(
             rows = len(at)
 
     bound: set[str] = set()
-    apply([c for c in pending if not c[2]])
-    pending = [c for c in pending if c[2]]
-    remaining = list(params)
-    chosen: list[str] = []
-    while remaining and rows:
-        param = min(remaining, key=lambda p, pending=pending: (
-            -sum(1 for c in pending if c[2] <= bound | {p}), len(domain[p]), params.index(p)
-        ))
-        remaining.remove(param)
-        chosen.append(param)
+    apply([c for c in constraints if not c[2]])
+    pending = [c for c in constraints if c[2]]
+    chosen = _join_order(schema, domain, constraints)
+    for param in chosen:
+        if not rows:
+            break
         objects = domain[param]
         if rows * len(objects) > MAX_BINDINGS:
             raise PlanningError(
@@ -230,12 +257,99 @@ def _bindings(
         bound.add(param)
         apply([c for c in pending if c[2] <= bound])
         pending = [c for c in pending if not c[2] <= bound]
-    if not rows or remaining:
+    if not rows or len(bound) < len(params):
         return {p: np.zeros(0, dtype=np.int64) for p in params}, 0
     if chosen != list(params):  # joined in another order: sort the rows lexicographically
         order = np.lexsort([columns[p] for p in reversed(params)])
         columns = {p: columns[p][order] for p in params}
     return columns, rows
+
+
+class _Compiled:
+    """The join and atom encoding of one structure in C (`_ground`): the same rows and codes
+    as `_bindings` and `_codes`, with templates and checks as flat int64 records."""
+
+    def __init__(self, space: AtomSpace, static_codes: np.ndarray):
+        self.space = space
+        self.n_objects = len(space.names)
+        self.dense = space.size <= _DENSE_CODES
+        if self.dense:
+            table = np.zeros(space.size, dtype=np.uint8)
+            table[static_codes] = 1
+            self.static = table
+        else:
+            self.static = np.unique(static_codes)
+        self._tables: list[np.ndarray] = []
+        self._table_at: dict[int, int] = {}  # id of a local table -> its offset
+        self._locals = np.zeros(0, dtype=np.int64)
+
+    def _local_offset(self, local: np.ndarray) -> int:
+        at = self._table_at.get(id(local))
+        if at is None:
+            at = self._table_at[id(local)] = len(self._tables) * self.n_objects
+            self._tables.append(local)
+            self._locals = np.concatenate(self._tables)
+        return at
+
+    def _template(self, template: AtomTemplate, index: Mapping[str, int]) -> list[int]:
+        """[base, n_terms, (param, stride, local offset) per parameter term]: constants are
+        folded into the base as `AtomSpace.encode_rows` folds them."""
+        space = self.space
+        name = template[0]
+        base = space.base[name]
+        terms: list[int] = []
+        for term_, stride, local in zip(template[1:], space.strides[name], space._locals[name],
+                                        strict=True):
+            if term_[0] == "?":
+                terms += (index[term_], stride, self._local_offset(local))
+            else:
+                base += stride * int(local[space.object_id[term_]])
+        return [base, len(terms) // 3, *terms]
+
+    def bindings(self, schema: LiftedSchema) -> tuple[np.ndarray, int]:
+        """(rows x parameters matrix of object ids, rows) in the parameters' lexicographic
+        order; the matrix's columns are the parameters."""
+        space, params = self.space, schema.params
+        index = {p: i for i, p in enumerate(params)}
+        domain = {p: space.objects_of(t) for p, t in zip(params, schema.param_types, strict=True)}
+        constraints = _constraints(schema)
+        chosen = _join_order(schema, domain, constraints)
+        level = {p: k for k, p in enumerate(chosen)}
+        records: list[int] = []
+        for kind, item, read in constraints:
+            at = max((level[p] for p in read), default=-1)
+            if kind in ("in", "out"):
+                base, n_terms, *terms = self._template(item, index)
+                records += (at, 0 if kind == "in" else 1, n_terms, base, *terms)
+            else:
+                terms = [index[t] if t[0] == "?" else -1 - space.object_id[t] for t in item]
+                records += (at, 2 if kind == "eq" else 3, 2, 0, terms[0], 0, 0, terms[1], 0, 0)
+        domains = [domain[p] for p in chosen]
+        offsets = np.cumsum([0] + [len(d) for d in domains], dtype=np.int64)
+        data, rows, status = _ground.join(
+            self.n_objects, offsets, np.concatenate(domains or [np.zeros(0, np.int64)]),
+            np.array([index[p] for p in chosen], dtype=np.int64),
+            np.array(records, dtype=np.int64), self._locals, self.static, self.dense,
+            MAX_BINDINGS, MAX_GROUND_ACTIONS,
+        )
+        if status == 1:
+            raise PlanningError(
+                f"action {schema.name}: more than {MAX_BINDINGS} partial bindings to ground")
+        if status == 2:
+            raise PlanningError(f"grounding exceeds {MAX_GROUND_ACTIONS} actions")
+        return np.frombuffer(data, dtype=np.int64).reshape(rows, len(params)), rows
+
+    def codes(self, templates: Sequence[AtomTemplate], index: Mapping[str, int],
+              matrix: np.ndarray) -> np.ndarray:
+        """`_codes` of the templates under the matrix's rows of bindings."""
+        out = np.empty((len(matrix), len(templates)), dtype=np.int64)
+        if not templates or not len(matrix):
+            return out
+        records = [x for t in templates for x in self._template(t, index)]
+        _ground.encode(np.ascontiguousarray(matrix), len(matrix), matrix.shape[1],
+                       np.array(records, dtype=np.int64), len(templates), self._locals,
+                       self.n_objects, out)
+        return out
 
 
 def _codes(templates: Sequence[AtomTemplate], space: AtomSpace, columns: Columns,
@@ -330,9 +444,11 @@ def build_structure(
 ) -> GroundStructure:
     """Ground every action over the objects, filtered by types and static atoms."""
     space = AtomSpace(problem)
-    is_static = _code_set(np.array(
+    static_codes = np.array(
         [c for c in (space.encode(a) for a in static) if c is not None], dtype=np.int64
-    ), space.size)
+    )
+    compiled = _Compiled(space, static_codes) if _ground is not None else None
+    is_static = _code_set(static_codes, space.size) if compiled is None else None
     if static_names is None:
         static_names = frozenset(f.name for f in problem.get_static_fluents())
     formulas = FormulaGrounder(static, static_names, space.names_of)
@@ -341,11 +457,23 @@ def build_structure(
     for schema in schemas:
         if schema.never:
             continue
-        columns, rows = _bindings(schema, space, is_static)
+        if compiled is not None:
+            matrix, rows = compiled.bindings(schema)
+            index = {p: i for i, p in enumerate(schema.params)}
+            by_param = np.ascontiguousarray(matrix.T)
+            columns = {p: by_param[i] for p, i in index.items()}
+
+            def code(templates, index=index, matrix=matrix):
+                return compiled.codes(templates, index, matrix)
+        else:
+            columns, rows = _bindings(schema, space, is_static)
+
+            def code(templates, columns=columns, rows=rows):
+                return _codes(templates, space, columns, rows)
         if not rows:
             continue
-        pre = _codes(schema.pre_pos, space, columns, rows)
-        neg = _codes(schema.pre_neg, space, columns, rows)
+        pre = code(schema.pre_pos)
+        neg = code(schema.pre_neg)
         clauses: list[tuple] | None = None  # per row, only for schemas with complex conditions
         if schema.complex:
             keep, more_pos, more_neg, clauses = _complex_rows(
@@ -357,8 +485,8 @@ def build_structure(
             keep = np.ones(rows, dtype=bool)
         if pre.shape[1] and neg.shape[1]:  # a condition and its negation: never applicable
             keep &= ~(pre[:, :, None] == neg[:, None, :]).any(axis=(1, 2))
-        add = _codes(schema.add, space, columns, rows)
-        delete = _codes(schema.delete, space, columns, rows)
+        add = code(schema.add)
+        delete = code(schema.delete)
         if add.shape[1] and delete.shape[1]:  # add wins over delete (PDDL: deletes first)
             delete[(delete[:, :, None] == add[:, None, :]).any(axis=2)] = _PAD_NONE
         if not keep.all():
@@ -384,26 +512,14 @@ def _assemble(space: AtomSpace, parts: list, assumptive: Mapping[str, bool]) -> 
     distinct_clauses = list(dict.fromkeys(row_clauses.values()))
     clause_codes = np.array([c for row in distinct_clauses for clause in row for side in clause
                              for c in side], dtype=np.int64)
-    codes, renumber = _fact_numbering(
-        space.size, [part[3 + k] for part in parts for k in range(4)], clause_codes
-    )
+    arrays = [[part[3 + k] for part in parts] for k in range(4)]
+    entries = sum(a.size for kind in arrays for a in kind) + clause_codes.size
+    if _ground is not None and space.size <= max(_DENSE_CODES, 2 * entries):
+        stacked, codes = _stack_compiled(space.size, arrays, clause_codes, starts[-1])
+    else:
+        stacked, codes = _stack(space.size, arrays, clause_codes, starts)
     n = len(codes)
     facts = tuple(space.decode_many(codes))
-    # each schema's codes renumbered straight into the stacked arrays, whose padding is
-    # already the pads' fact ids (one pass over the big arrays instead of two)
-    stacked = {}
-    for k, (key, pad) in enumerate((("pre", n), ("neg", n + 1), ("add", n + 1),
-                                    ("delete", n + 1))):
-        arrays = [part[3 + k] for part in parts]
-        width = max((a.shape[1] for a in arrays), default=0)
-        out = stacked[key] = np.empty((starts[-1], width), dtype=np.int64)
-        for array, start in zip(arrays, starts, strict=False):
-            rows = out[start:start + len(array)]
-            if array.shape[1] == width:  # contiguous: written in place
-                renumber(array, rows)
-            else:
-                rows[:, : array.shape[1]] = renumber(array)
-                rows[:, array.shape[1]:] = pad
     index_of = {c: i for i, c in enumerate(codes.tolist())}
     renumbered = {
         row: tuple((tuple(index_of[c] for c in pos), tuple(index_of[c] for c in neg))
@@ -425,6 +541,48 @@ def _assemble(space: AtomSpace, parts: list, assumptive: Mapping[str, bool]) -> 
         pre_neg=stacked["neg"], add=stacked["add"], delete=stacked["delete"], clauses=clauses,
         arg_ids=arg_ids,
     )
+
+
+_KINDS = ("pre", "neg", "add", "delete")
+
+
+def _stack(space_size: int, arrays: list[list[np.ndarray]], extra: np.ndarray,
+           starts: list[int]) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """The four stacked matrices of fact ids (each padded with its pad's fact id) and the
+    atom codes used, sorted (fact id = position)."""
+    codes, renumber = _fact_numbering(space_size, [a for kind in arrays for a in kind], extra)
+    n = len(codes)
+    # each schema's codes renumbered straight into the stacked arrays, whose padding is
+    # already the pads' fact ids (one pass over the big arrays instead of two)
+    stacked = {}
+    for key, pad, kind in zip(_KINDS, (n, n + 1, n + 1, n + 1), arrays, strict=True):
+        width = max((a.shape[1] for a in kind), default=0)
+        out = stacked[key] = np.empty((starts[-1], width), dtype=np.int64)
+        for array, start in zip(kind, starts, strict=False):
+            rows = out[start:start + len(array)]
+            if array.shape[1] == width:  # contiguous: written in place
+                renumber(array, rows)
+            else:
+                rows[:, : array.shape[1]] = renumber(array)
+                rows[:, array.shape[1]:] = pad
+    return stacked, codes
+
+
+def _stack_compiled(space_size: int, arrays: list[list[np.ndarray]], extra: np.ndarray,
+                    total: int) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """`_stack` in C (`_ground.number` and `_ground.renumber`): the same arrays."""
+    flat = [np.ascontiguousarray(a, dtype=np.int64) for kind in arrays for a in kind]
+    codes, table = _ground.number(space_size, [*flat, np.ascontiguousarray(extra)])
+    codes = np.frombuffer(codes, dtype=np.int64)
+    n = len(codes)
+    stacked, k = {}, 0
+    for key, pad, kind in zip(_KINDS, (n, n + 1, n + 1, n + 1), arrays, strict=True):
+        width = max((a.shape[1] for a in kind), default=0)
+        out = stacked[key] = np.empty((total, width), dtype=np.int64)
+        _ground.renumber(table, flat[k:k + len(kind)],
+                         np.array([a.shape for a in kind], dtype=np.int64), out, width, pad)
+        k += len(kind)
+    return stacked, codes
 
 
 def _fact_numbering(
