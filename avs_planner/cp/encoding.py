@@ -263,12 +263,48 @@ class ConstantExpr:
     """A `VectorExpr` that reads nothing; callers may use `value` without building columns."""
 
     __slots__ = ("value",)
+    params: frozenset[str] = frozenset()
 
     def __init__(self, value: float):
         self.value = value
 
     def __call__(self, space, cols, rows, values) -> np.ndarray:
         return np.full(rows, self.value)
+
+
+class _FluentExpr:
+    """A numeric fluent term `(f ?x obj ...)`: its value per binding, an error naming the
+    first atom without one. `params`: the parameters it reads (callers build only those
+    columns)."""
+
+    __slots__ = ("template", "where", "params")
+
+    def __init__(self, template: tuple[str, ...], where: str):
+        self.template = template
+        self.where = where
+        self.params = frozenset(t for t in template[1:] if t[0] == "?")
+
+    def __call__(self, space, cols, rows, values) -> np.ndarray:
+        return _lookup(space, self.template, cols, rows, values, self.where)
+
+
+class _ArithExpr:
+    """+ - * / over sub-expressions, left to right (division by zero gives inf or nan, which
+    the grounder's checks then name)."""
+
+    __slots__ = ("parts", "op", "params")
+
+    def __init__(self, parts: list, op: Callable[[float, float], float]):
+        self.parts = parts
+        self.op = op
+        self.params = frozenset().union(*(getattr(p, "params", frozenset()) for p in parts))
+
+    def __call__(self, space, cols, rows, values) -> np.ndarray:
+        acc = self.parts[0](space, cols, rows, values)
+        for part in self.parts[1:]:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                acc = self.op(acc, part(space, cols, rows, values))
+        return acc
 
 
 def compile_vector(node: FNode | None, where: str, default: float) -> VectorExpr:
@@ -278,23 +314,10 @@ def compile_vector(node: FNode | None, where: str, default: float) -> VectorExpr
     if node.is_constant():
         return ConstantExpr(float(Fraction(str(node.constant_value()))))
     if node.is_fluent_exp():
-        template = (node.fluent().name, *(term(a) for a in node.args))
-        return lambda space, cols, rows, values: _lookup(
-            space, template, cols, rows, values, where
-        )
+        return _FluentExpr((node.fluent().name, *(term(a) for a in node.args)), where)
     kind = node.node_type.name
     if kind in _ARITH and node.args:
-        parts = [compile_vector(a, where, default) for a in node.args]
-        op = _ARITH[kind]
-
-        def arith(space, cols, rows, values):
-            acc = parts[0](space, cols, rows, values)
-            for part in parts[1:]:
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    acc = op(acc, part(space, cols, rows, values))
-            return acc
-
-        return arith
+        return _ArithExpr([compile_vector(a, where, default) for a in node.args], _ARITH[kind])
     raise PlanningError(f"{where}: unsupported numeric expression {node}")
 
 

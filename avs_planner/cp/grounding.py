@@ -36,24 +36,28 @@ def world_state(problem: Problem) -> WorldState:
     """The problem's initial state as atoms and numeric values (explicit :init entries)."""
     atoms: set[Atom] = set()
     values: dict[Atom, float] = {}
-    names: dict[FNode, str] = {}  # UP shares one node per object and per constant:
-    constants: dict[FNode, bool | float | None] = {}  # read each once
+    # UP shares one node per object and per constant: each is read once, found again by its
+    # id (hashing an FNode runs Python code; the nodes live as long as the problem)
+    names: dict[int, str] = {}
+    constants: dict[int, bool | float | None] = {}
     for fluent_exp, value in problem.explicit_initial_values.items():
         key = [fluent_exp.fluent().name]
         for arg in fluent_exp.args:
-            name = names.get(arg)
+            name = names.get(id(arg))
             if name is None:
-                name = names[arg] = arg.object().name
+                name = names[id(arg)] = arg.object().name
             key.append(name)
-        if value in constants:
-            constant = constants[value]
-        else:
-            constant = constants[value] = _constant(value)
+        constant = constants.get(id(value), _UNREAD)
+        if constant is _UNREAD:
+            constant = constants[id(value)] = _constant(value)
         if constant is True:
             atoms.add(tuple(key))
         elif constant is not None and constant is not False:
             values[tuple(key)] = constant
     return WorldState(frozenset(atoms), values)
+
+
+_UNREAD = object()
 
 
 def _constant(value: FNode) -> bool | float | None:
@@ -140,7 +144,7 @@ def _evaluate_rows(st: GroundStructure, rows: np.ndarray, values: NumericValues,
         if isinstance(expr, ConstantExpr):
             out[block.start:block.stop][sel] = expr.value
             continue
-        columns, count = block.select(sel)
+        columns, count = block.select(sel, getattr(expr, "params", None))
         out[block.start:block.stop][sel] = expr(st.space, columns, count, values)
     return out
 

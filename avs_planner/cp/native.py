@@ -133,13 +133,20 @@ def _clauses(task: GroundTask, n_bytes: int, n_facts: int) -> tuple[bytes, bytes
     n_actions = len(task.actions)
     offsets = np.zeros(n_actions + 1, dtype="<i8")
     pos_words, neg_words = [], []
+    packed: dict[tuple[int, int], tuple[bytes, bytes]] = {}  # rows often share clauses
     for i in sorted(by_action):
         if not 0 <= i < n_actions:
             raise PlanningError("native search: a clause names an action outside the task")
         offsets[i + 1] = len(by_action[i])
-        for pos, neg in by_action[i]:
-            pos_words.append(_bits(pos, n_bytes, n_facts, lambda i=i: task.actions[i].label))
-            neg_words.append(_bits(neg, n_bytes, n_facts, lambda i=i: task.actions[i].label))
+        for clause in by_action[i]:
+            words_of = packed.get(clause)
+            if words_of is None:
+                def where(i=i) -> str:
+                    return task.actions[i].label
+                words_of = packed[clause] = (_bits(clause[0], n_bytes, n_facts, where),
+                                             _bits(clause[1], n_bytes, n_facts, where))
+            pos_words.append(words_of[0])
+            neg_words.append(words_of[1])
     np.cumsum(offsets, out=offsets)
     return offsets.tobytes(), b"".join(pos_words), b"".join(neg_words)
 

@@ -42,9 +42,14 @@ class _Block:
     columns: Mapping[str, np.ndarray]  # parameter -> object id, one per row
     assumptive: bool
 
-    def select(self, mask: np.ndarray) -> tuple[Columns, int]:
-        """Columns of the rows where `mask` (over this block's rows) is true."""
-        return {p: np.compress(mask, c) for p, c in self.columns.items()}, int(mask.sum())
+    def select(self, mask: np.ndarray, params: frozenset[str] | None = None
+               ) -> tuple[Columns, int]:
+        """Columns (all, or those of `params`) of the rows where `mask` (over this block's
+        rows) is true."""
+        columns = self.columns.items()
+        if params is not None:
+            columns = [(p, c) for p, c in columns if p in params]
+        return {p: np.compress(mask, c) for p, c in columns}, int(np.count_nonzero(mask))
 
 
 @dataclass(frozen=True)
