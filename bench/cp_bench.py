@@ -11,7 +11,8 @@ grounding cache) and, for AVS, also of 5 warm replans from the same state (groun
 action table and packed task reused; in episodes about 60% of replans reuse their table) and
 of 5 replans with what the last call left for reuse dropped first (action table and
 evaluations, as a replan whose new state reaches other actions and values: "warm, new
-actions" in the summary). FD's time is the wall time
+actions" in the summary); the summary also splits the 20-place problems' cold calls by
+stage (`cold_stages`). FD's time is the wall time
 of `OneshotPlanner.solve`, one run (writing PDDL, translate, search). Our plans are checked
 with UP's sequential plan validator.
 """
@@ -32,9 +33,10 @@ from unified_planning.io import PDDLReader
 from unified_planning.model import MinimizeActionCosts, Problem
 from unified_planning.shortcuts import Fluent, IntType, OneshotPlanner, get_environment
 
-from avs_planner.cp.grounding import GroundingCache, ground
+from avs_planner.cp.grounding import GroundingCache, gc_paused, ground
 from avs_planner.cp.planner import plan
-from avs_planner.cp.search import PlanResult, SearchOptions, objective
+from avs_planner.cp.search import PlanResult, SearchOptions, objective, search
+from avs_planner.cp.symmetry import find_symmetries
 from avs_planner.cp.task import GroundTask
 from avs_planner.pddl import read_text
 from avs_planner.pddl.model import ProbabilisticProblem
@@ -157,7 +159,9 @@ def bench_case(label: str, pproblem: ProbabilisticProblem, probabilistic: bool,
     task = ground(pproblem, cache=cache)
     fd_input = fd_problem(pproblem, task) if probabilistic else pproblem.problem
     fd_time, fd_plan = run_fd(fd_input)
+    stages = cold_stages(pproblem, runs) if probabilistic else {}
     row = {"label": label, "ours_s": statistics.median(r.planning_time_s for r in colds),
+           "stages": stages,
            "warm_s": statistics.median(warms) if warms else math.nan,
            "new_table_s": statistics.median(fresh_tables) if fresh_tables else math.nan,
            "fd_s": fd_time,
@@ -168,6 +172,34 @@ def bench_case(label: str, pproblem: ProbabilisticProblem, probabilistic: bool,
     if fd_plan is not None:
         row["fd_cost"], _, row["fd_obj"] = true_objective(task, fd_plan)
     return row
+
+
+STAGES = ("structure", "instance", "symmetries", "search")
+
+
+def cold_stages(pproblem: ProbabilisticProblem, runs: int) -> dict[str, float]:
+    """Median seconds of each stage of a cold call, run one by one as `plan` runs them:
+    structure (the :init read, schemas and the cached grounding structure), instance (the
+    rest of grounding: reachability, evaluation, relevance, action table), symmetries, and
+    search (packing for the C core included)."""
+    times: dict[str, list[float]] = {stage: [] for stage in STAGES}
+    for _ in range(runs):
+        fresh, cache = replace(pproblem), GroundingCache()
+        gc.collect()
+        with gc_paused():
+            start = time.perf_counter()
+            state = cache.initial_state(fresh)
+            cache.structure(fresh, state)
+            marks = [time.perf_counter()]
+            task = ground(fresh, state, cache)
+            marks.append(time.perf_counter())
+            symmetries = find_symmetries(fresh, state, task)
+            marks.append(time.perf_counter())
+            search(task, OPTIONS, symmetries)
+            marks.append(time.perf_counter())
+        for stage, begin, end in zip(STAGES, [start, *marks[:-1]], marks, strict=True):
+            times[stage].append(end - begin)
+    return {stage: statistics.median(t) for stage, t in times.items()}
 
 
 def _fmt(value, spec: str) -> str:
@@ -206,6 +238,10 @@ def report(rows: list[dict], title: str, probabilistic: bool) -> list[float]:
                       f"{statistics.median(r['warm_s'] for r in group) * 1e3:.1f} ms warm, "
                       f"{statistics.median(r['new_table_s'] for r in group) * 1e3:.1f} ms "
                       f"warm, new actions")
+                parts = ", ".join(
+                    f"{stage} {statistics.median(r['stages'][stage] for r in group) * 1e3:.1f}"
+                    for stage in STAGES)
+                print(f"   cold by stage (ms, medians): {parts}")
     warm = [r["warm_s"] for r in rows if not math.isnan(r["warm_s"])]
     if warm:
         warm_ratios = [r["fd_s"] / r["warm_s"] for r in rows
