@@ -119,7 +119,9 @@ def _check_actions(task: GroundTask) -> tuple[bytes, bytes, bytes]:
                             "probability is not in [0, 1]")
     values, inverse = np.unique(probability, return_inverse=True)
     logs = np.array([-math.log(p) if p > 0 else math.inf for p in values.tolist()], "<f8")
-    return cost.tobytes(), probability.tobytes(), logs[inverse].tobytes()
+    # arrays go to `_native.Task` as they are (it copies any C-contiguous buffer)
+    return (np.ascontiguousarray(cost), np.ascontiguousarray(probability),
+            logs[inverse.ravel()])
 
 
 def _clauses(task: GroundTask, n_bytes: int, n_facts: int) -> tuple[bytes, bytes, bytes]:
@@ -133,20 +135,22 @@ def _clauses(task: GroundTask, n_bytes: int, n_facts: int) -> tuple[bytes, bytes
     n_actions = len(task.actions)
     offsets = np.zeros(n_actions + 1, dtype="<i8")
     pos_words, neg_words = [], []
-    packed: dict[tuple[int, int], tuple[bytes, bytes]] = {}  # rows often share clauses
+    packed: dict[tuple, tuple[bytes, bytes]] = {}  # rows often share their clauses
     for i in sorted(by_action):
         if not 0 <= i < n_actions:
             raise PlanningError("native search: a clause names an action outside the task")
-        offsets[i + 1] = len(by_action[i])
-        for clause in by_action[i]:
-            words_of = packed.get(clause)
-            if words_of is None:
-                def where(i=i) -> str:
-                    return task.actions[i].label
-                words_of = packed[clause] = (_bits(clause[0], n_bytes, n_facts, where),
-                                             _bits(clause[1], n_bytes, n_facts, where))
-            pos_words.append(words_of[0])
-            neg_words.append(words_of[1])
+        clauses = by_action[i]
+        offsets[i + 1] = len(clauses)
+        words_of = packed.get(clauses)
+        if words_of is None:
+            def where(i=i) -> str:
+                return task.actions[i].label
+            words_of = packed[clauses] = (
+                b"".join(_bits(pos, n_bytes, n_facts, where) for pos, _ in clauses),
+                b"".join(_bits(neg, n_bytes, n_facts, where) for _, neg in clauses),
+            )
+        pos_words.append(words_of[0])
+        neg_words.append(words_of[1])
     np.cumsum(offsets, out=offsets)
     return offsets.tobytes(), b"".join(pos_words), b"".join(neg_words)
 
@@ -193,11 +197,11 @@ def task_arrays(task: GroundTask) -> tuple:
             raise PlanningError("native search: the task's arrays name a fact outside it")
         return m
 
-    def csr(m: np.ndarray) -> tuple[bytes, bytes]:
+    def csr(m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         valid = m >= 0
         offsets = np.zeros(n_actions + 1, dtype="<i8")
         np.cumsum(valid.sum(axis=1), out=offsets[1:])
-        return offsets.tobytes(), m[valid].astype("<i8").tobytes()
+        return offsets, np.ascontiguousarray(m[valid], dtype="<i8")
 
     pre, neg, add, delete = (matrix(m) for m in (arrays.pre, arrays.pre_neg, arrays.add,
                                                  arrays.delete))
@@ -205,9 +209,9 @@ def task_arrays(task: GroundTask) -> tuple:
     if given is not None and all(
         b.dtype == np.dtype("<u8") and b.shape == (n_actions, n_words) for b in given
     ):
-        masks = tuple(np.ascontiguousarray(b).tobytes() for b in given)
+        masks = tuple(np.ascontiguousarray(b) for b in given)
     else:
-        masks = tuple(bit_words(m, n_facts).tobytes() for m in (pre, neg, add, delete))
+        masks = tuple(bit_words(m, n_facts) for m in (pre, neg, add, delete))
     return (n_facts, n_actions, *masks,
             *_check_actions(task), *csr(pre), *csr(add),
             *_clauses(task, 8 * n_words, n_facts))
