@@ -42,8 +42,14 @@ class Derived:
         self.clauses = _clause_csr(st)
         clause_rows = sorted(st.clauses)
         self.clause_rows = np.array(clause_rows, dtype=np.int64)
-        self.clause_bits = {row: tuple((bitset(pos), bitset(neg)) for pos, neg in st.clauses[row])
-                            for row in clause_rows}
+        bits_of: dict[tuple, tuple[tuple[int, int], ...]] = {}  # rows share clause lists
+        self.clause_bits = {}
+        for row in clause_rows:
+            clauses = st.clauses[row]
+            bits = bits_of.get(clauses)
+            if bits is None:
+                bits = bits_of[clauses] = tuple((bitset(p), bitset(q)) for p, q in clauses)
+            self.clause_bits[row] = bits
         offsets = self.clauses[0]  # rows without clauses have no clause facts to repeat
         at = self.clause_rows * 2
         self.clause_pos_rows = np.repeat(self.clause_rows, offsets[at + 2] - offsets[at])
@@ -101,13 +107,22 @@ def _clause_csr(st: GroundStructure) -> tuple[np.ndarray, np.ndarray, np.ndarray
     counts = np.zeros((2, st.size + 1), dtype=np.int64)  # facts of row r at [:, r + 1]
     positives: list[int] = []
     negatives: list[int] = []
-    for row in sorted(st.clauses):
-        before = len(positives), len(negatives)
-        for pos, neg in st.clauses[row]:
-            positives.extend(pos)
-            negatives.extend(neg)
-        counts[0, row + 1] = len(positives) - before[0]
-        counts[1, row + 1] = len(negatives) - before[1]
+    flat: dict[tuple, tuple[list[int], list[int]]] = {}  # rows share clause lists
+    rows = sorted(st.clauses)
+    n_pos, n_neg = [], []
+    for row in rows:
+        clauses = st.clauses[row]
+        facts = flat.get(clauses)
+        if facts is None:
+            facts = flat[clauses] = ([f for pos, _ in clauses for f in pos],
+                                     [f for _, neg in clauses for f in neg])
+        positives.extend(facts[0])
+        negatives.extend(facts[1])
+        n_pos.append(len(facts[0]))
+        n_neg.append(len(facts[1]))
+    at = np.array(rows, dtype=np.int64) + 1
+    counts[0, at] = n_pos
+    counts[1, at] = n_neg
     offsets = np.empty(2 * (st.size + 1), dtype=np.int64)
     np.cumsum(counts[0], out=offsets[0::2])
     np.cumsum(counts[1], out=offsets[1::2])
