@@ -1,6 +1,7 @@
-/* The cached grounding structure's construction (avs_planner/cp/structure.py), compiled.
+/* The cached grounding structure's construction, compiled (avs_planner/cp/bindings.py and
+ * structure.py call it).
  *
- * structure.py builds the same arrays with numpy when this module is not built; tests compare
+ * Those modules build the same arrays with numpy when this one is not built; tests compare
  * the two. Atoms are integer codes (avs_planner/cp/encoding.py): a lifted atom's code under a
  * binding is base + sum(stride * local[object of parameter]), `local` being a table of each
  * object's position among the objects of one type (read from one flat `locals` buffer at an

@@ -297,7 +297,7 @@ class _ArithExpr:
     def __init__(self, parts: list, op: Callable[[float, float], float]):
         self.parts = parts
         self.op = op
-        self.params = frozenset().union(*(getattr(p, "params", frozenset()) for p in parts))
+        self.params = frozenset().union(*(p.params for p in parts))
 
     def __call__(self, space, cols, rows, values) -> np.ndarray:
         acc = self.parts[0](space, cols, rows, values)

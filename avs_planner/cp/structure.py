@@ -14,13 +14,20 @@ from dataclasses import dataclass, field
 import numpy as np
 from unified_planning.model import FNode, Problem
 
+from avs_planner.cp.bindings import (
+    DENSE_CODES,
+    CompiledJoin,
+    code_set,
+    encode_numpy,
+    join_numpy,
+)
 from avs_planner.cp.encoding import AtomSpace, Columns
 from avs_planner.cp.formulas import FormulaGrounder
-from avs_planner.cp.schema import AtomTemplate, LiftedSchema
+from avs_planner.cp.schema import LiftedSchema
 from avs_planner.cp.task import Atom
 from avs_planner.errors import PlanningError
 
-try:  # the compiled join, encoding and numbering; the numpy code below computes the same
+try:  # the compiled join, encoding and numbering; the numpy code computes the same
     from avs_planner.cp import _ground
 except ImportError:
     _ground = None
@@ -29,7 +36,6 @@ MAX_GROUND_ACTIONS = 2_000_000
 MAX_BINDINGS = 20_000_000  # partial bindings of one schema while joining its static atoms
 _PAD_TRUE = -1  # padding code of precondition arrays (an always-true fact)
 _PAD_NONE = -2  # padding code of the other arrays (a fact nothing reads or makes true)
-_DENSE_CODES = 1 << 16  # atom code spaces up to this size are renumbered through a table
 
 
 @dataclass(frozen=True)
@@ -157,213 +163,6 @@ def bitset(ids) -> int:
     return bits
 
 
-def _code_set(codes: np.ndarray, space_size: int) -> Callable[[np.ndarray], np.ndarray]:
-    """Membership test for a set of atom codes: a lookup table over a small code space (one
-    numpy call per test; joins test many times), else a binary search over sorted codes."""
-    if space_size <= _DENSE_CODES:
-        table = np.zeros(space_size, dtype=bool)
-        table[codes] = True
-        return table.__getitem__
-    sorted_codes = np.unique(codes)
-    return lambda queries: _member(queries, sorted_codes)
-
-
-def _member(codes: np.ndarray, sorted_codes: np.ndarray) -> np.ndarray:
-    if len(sorted_codes) == 0:
-        return np.zeros(len(codes), dtype=bool)
-    at = np.minimum(np.searchsorted(sorted_codes, codes), len(sorted_codes) - 1)
-    return sorted_codes[at] == codes
-
-
-def _term_params(terms: Sequence[str]) -> frozenset[str]:
-    return frozenset(t for t in terms if t[0] == "?")
-
-
-def _constraints(schema: LiftedSchema) -> list[tuple[str, tuple, frozenset[str]]]:
-    """(kind, atom template or term pair, parameters read) of the schema's static atoms
-    ("in", "out") and (in)equalities ("eq", "ne")."""
-    return (
-        [("in", t, _term_params(t[1:])) for t in schema.static_pos]
-        + [("out", t, _term_params(t[1:])) for t in schema.static_neg]
-        + [("eq", pair, _term_params(pair)) for pair in schema.equal]
-        + [("ne", pair, _term_params(pair)) for pair in schema.not_equal]
-    )
-
-
-def _join_order(schema: LiftedSchema, domain: Mapping[str, np.ndarray],
-                constraints: list) -> list[str]:
-    """The parameters in join order: next the one closing most constraints, then the one
-    with fewest objects, then the first."""
-    params = schema.params
-    pending = [c for c in constraints if c[2]]
-    bound: set[str] = set()
-    remaining = list(params)
-    chosen: list[str] = []
-    while remaining:
-        param = min(remaining, key=lambda p: (
-            -sum(1 for c in pending if c[2] <= bound | {p}), len(domain[p]), params.index(p)
-        ))
-        remaining.remove(param)
-        chosen.append(param)
-        bound.add(param)
-        pending = [c for c in pending if not c[2] <= bound]
-    return chosen
-
-
-def _bindings(
-    schema: LiftedSchema, space: AtomSpace, is_static: Callable[[np.ndarray], np.ndarray]
-) -> tuple[dict[str, np.ndarray], int]:
-    """Every parameter binding consistent with types, static atoms and (in)equalities, as
-    columns of object ids in lexicographic order of the schema's parameters. A join: one
-    parameter at a time (`_join_order`), filtering as soon as a constraint's parameters are
-    all bound. (`_Compiled.bindings` is the same join in C.)"""
-    params = schema.params
-    domain = {p: space.objects_of(t) for p, t in zip(params, schema.param_types, strict=True)}
-    constraints = _constraints(schema)
-    columns: dict[str, np.ndarray] = {}
-    rows = 1
-
-    def value(term: str, rows: int) -> np.ndarray:
-        if term[0] == "?":
-            return columns[term]
-        return np.full(rows, space.object_id[term], dtype=np.int64)
-
-    def apply(ready: list) -> None:
-        nonlocal columns, rows
-        mask = None
-        for kind, item, _ in ready:
-            if kind in ("in", "out"):
-                hit = is_static(space.encode_rows(item, columns, rows))
-                ok = hit if kind == "in" else ~hit
-            else:
-                same = value(item[0], rows) == value(item[1], rows)
-                ok = same if kind == "eq" else ~same
-            mask = ok if mask is None else np.logical_and(mask, ok, out=mask)
-        if mask is not None and not mask.all():
-            at = np.flatnonzero(mask)
-            columns = {p: c[at] for p, c in columns.items()}
-            rows = len(at)
-
-    bound: set[str] = set()
-    apply([c for c in constraints if not c[2]])
-    pending = [c for c in constraints if c[2]]
-    chosen = _join_order(schema, domain, constraints)
-    for param in chosen:
-        if not rows:
-            break
-        objects = domain[param]
-        if rows * len(objects) > MAX_BINDINGS:
-            raise PlanningError(
-                f"action {schema.name}: more than {MAX_BINDINGS} partial bindings to ground"
-            )
-        columns = {p: np.repeat(c, len(objects)) for p, c in columns.items()}
-        columns[param] = np.repeat(objects[None, :], rows, axis=0).ravel()  # np.tile, faster
-        rows *= len(objects)
-        bound.add(param)
-        apply([c for c in pending if c[2] <= bound])
-        pending = [c for c in pending if not c[2] <= bound]
-    if not rows or len(bound) < len(params):
-        return {p: np.zeros(0, dtype=np.int64) for p in params}, 0
-    if chosen != list(params):  # joined in another order: sort the rows lexicographically
-        order = np.lexsort([columns[p] for p in reversed(params)])
-        columns = {p: columns[p][order] for p in params}
-    return columns, rows
-
-
-class _Compiled:
-    """The join and atom encoding of one structure in C (`_ground`): the same rows and codes
-    as `_bindings` and `_codes`, with templates and checks as flat int64 records."""
-
-    def __init__(self, space: AtomSpace, static_codes: np.ndarray):
-        self.space = space
-        self.n_objects = len(space.names)
-        self.dense = space.size <= _DENSE_CODES
-        if self.dense:
-            table = np.zeros(space.size, dtype=np.uint8)
-            table[static_codes] = 1
-            self.static = table
-        else:
-            self.static = np.unique(static_codes)
-        self._tables: list[np.ndarray] = []
-        self._table_at: dict[int, int] = {}  # id of a local table -> its offset
-        self._locals = np.zeros(0, dtype=np.int64)
-
-    def _local_offset(self, local: np.ndarray) -> int:
-        at = self._table_at.get(id(local))
-        if at is None:
-            at = self._table_at[id(local)] = len(self._tables) * self.n_objects
-            self._tables.append(local)
-            self._locals = np.concatenate(self._tables)
-        return at
-
-    def _template(self, template: AtomTemplate, index: Mapping[str, int]) -> list[int]:
-        """[base, n_terms, (param, stride, local offset) per parameter term]: constants are
-        folded into the base as `AtomSpace.encode_rows` folds them."""
-        space = self.space
-        name = template[0]
-        base = space.base[name]
-        terms: list[int] = []
-        for term_, stride, local in zip(template[1:], space.strides[name], space._locals[name],
-                                        strict=True):
-            if term_[0] == "?":
-                terms += (index[term_], stride, self._local_offset(local))
-            else:
-                base += stride * int(local[space.object_id[term_]])
-        return [base, len(terms) // 3, *terms]
-
-    def bindings(self, schema: LiftedSchema) -> tuple[np.ndarray, int]:
-        """(rows x parameters matrix of object ids, rows) in the parameters' lexicographic
-        order; the matrix's columns are the parameters."""
-        space, params = self.space, schema.params
-        index = {p: i for i, p in enumerate(params)}
-        domain = {p: space.objects_of(t) for p, t in zip(params, schema.param_types, strict=True)}
-        constraints = _constraints(schema)
-        chosen = _join_order(schema, domain, constraints)
-        level = {p: k for k, p in enumerate(chosen)}
-        records: list[int] = []
-        for kind, item, read in constraints:
-            at = max((level[p] for p in read), default=-1)
-            if kind in ("in", "out"):
-                base, n_terms, *terms = self._template(item, index)
-                records += (at, 0 if kind == "in" else 1, n_terms, base, *terms)
-            else:
-                terms = [index[t] if t[0] == "?" else -1 - space.object_id[t] for t in item]
-                records += (at, 2 if kind == "eq" else 3, 2, 0, terms[0], 0, 0, terms[1], 0, 0)
-        domains = [domain[p] for p in chosen]
-        offsets = np.cumsum([0] + [len(d) for d in domains], dtype=np.int64)
-        data, rows, status = _ground.join(
-            self.n_objects, offsets, np.concatenate(domains or [np.zeros(0, np.int64)]),
-            np.array([index[p] for p in chosen], dtype=np.int64),
-            np.array(records, dtype=np.int64), self._locals, self.static, self.dense,
-            MAX_BINDINGS, MAX_GROUND_ACTIONS,
-        )
-        if status == 1:
-            raise PlanningError(
-                f"action {schema.name}: more than {MAX_BINDINGS} partial bindings to ground")
-        if status == 2:
-            raise PlanningError(f"grounding exceeds {MAX_GROUND_ACTIONS} actions")
-        return np.frombuffer(data, dtype=np.int64).reshape(rows, len(params)), rows
-
-    def codes(self, templates: Sequence[AtomTemplate], index: Mapping[str, int],
-              matrix: np.ndarray) -> np.ndarray:
-        """`_codes` of the templates under the matrix's rows of bindings."""
-        out = np.empty((len(matrix), len(templates)), dtype=np.int64)
-        if not templates or not len(matrix):
-            return out
-        records = [x for t in templates for x in self._template(t, index)]
-        _ground.encode(np.ascontiguousarray(matrix), len(matrix), matrix.shape[1],
-                       np.array(records, dtype=np.int64), len(templates), self._locals,
-                       self.n_objects, out)
-        return out
-
-
-def _codes(templates: Sequence[AtomTemplate], space: AtomSpace, columns: Columns,
-           rows: int) -> np.ndarray:
-    if not templates:
-        return np.empty((rows, 0), dtype=np.int64)
-    return np.stack([space.encode_rows(t, columns, rows) for t in templates], axis=1)
-
-
 def _pad(lists: list[list[int]], pad: int) -> np.ndarray:
     width = max((len(x) for x in lists), default=0)
     out = np.full((len(lists), width), pad, dtype=np.int64)
@@ -452,8 +251,8 @@ def build_structure(
     static_codes = np.array(
         [c for c in (space.encode(a) for a in static) if c is not None], dtype=np.int64
     )
-    compiled = _Compiled(space, static_codes) if _ground is not None else None
-    is_static = _code_set(static_codes, space.size) if compiled is None else None
+    compiled = CompiledJoin(space, static_codes) if _ground is not None else None
+    is_static = code_set(static_codes, space.size) if compiled is None else None
     if static_names is None:
         static_names = frozenset(f.name for f in problem.get_static_fluents())
     formulas = FormulaGrounder(static, static_names, space.names_of)
@@ -463,7 +262,7 @@ def build_structure(
         if schema.never:
             continue
         if compiled is not None:
-            matrix, rows = compiled.bindings(schema)
+            matrix, rows = compiled.bindings(schema, MAX_BINDINGS, MAX_GROUND_ACTIONS)
             index = {p: i for i, p in enumerate(schema.params)}
             by_param = np.ascontiguousarray(matrix.T)
             columns = {p: by_param[i] for p, i in index.items()}
@@ -471,10 +270,10 @@ def build_structure(
             def code(templates, index=index, matrix=matrix):
                 return compiled.codes(templates, index, matrix)
         else:
-            columns, rows = _bindings(schema, space, is_static)
+            columns, rows = join_numpy(schema, space, is_static, MAX_BINDINGS)
 
             def code(templates, columns=columns, rows=rows):
-                return _codes(templates, space, columns, rows)
+                return encode_numpy(templates, space, columns, rows)
         if not rows:
             continue
         pre = code(schema.pre_pos)
@@ -519,7 +318,7 @@ def _assemble(space: AtomSpace, parts: list, assumptive: Mapping[str, bool]) -> 
                              for c in side], dtype=np.int64)
     arrays = [[part[3 + k] for part in parts] for k in range(4)]
     entries = sum(a.size for kind in arrays for a in kind) + clause_codes.size
-    if _ground is not None and space.size <= max(_DENSE_CODES, 2 * entries):
+    if _ground is not None and space.size <= max(DENSE_CODES, 2 * entries):
         stacked, codes = _stack_compiled(space.size, arrays, clause_codes, starts[-1])
     else:
         stacked, codes = _stack(space.size, arrays, clause_codes, starts)
@@ -600,7 +399,7 @@ def _fact_numbering(
     searchsorted, several times faster; huge code spaces (up to `MAX_CODE`) take the sorted
     path."""
     entries = sum(a.size for a in arrays) + extra.size
-    if space_size <= max(_DENSE_CODES, 2 * entries):
+    if space_size <= max(DENSE_CODES, 2 * entries):
         used = np.zeros(space_size + 2, dtype=bool)  # the pads index the last two slots
         for array in (*arrays, extra):
             used[array.reshape(-1)] = True

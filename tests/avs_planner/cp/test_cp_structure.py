@@ -9,9 +9,10 @@ import itertools
 
 import numpy as np
 
+from avs_planner.cp.bindings import code_set as _code_set
 from avs_planner.cp.encoding import AtomSpace
 from avs_planner.cp.grounding import GroundingCache, world_state
-from avs_planner.cp.structure import _PAD_NONE, _PAD_TRUE, _code_set, _fact_numbering
+from avs_planner.cp.structure import _PAD_NONE, _PAD_TRUE, _fact_numbering
 from avs_planner.pddl import read_text
 
 DOMAIN = """
