@@ -12,7 +12,7 @@ from __future__ import annotations
 import itertools
 import math
 import operator
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from fractions import Fraction
 
 import numpy as np
@@ -105,6 +105,20 @@ class AtomSpace:
             local = self._local[key] = np.full(len(self.names), -1, dtype=np.int64)
             local[ids] = np.arange(len(ids))
         return local
+
+    def encode_product(self, fluent: str, name_sets: Sequence[Iterable[str]]) -> np.ndarray:
+        """Codes of every atom of `fluent` whose i-th argument is in `name_sets[i]` (names
+        not of the argument's type, or unknown, are left out)."""
+        if fluent not in self.base:
+            return np.zeros(0, dtype=np.int64)
+        codes = np.full(1, self.base[fluent], dtype=np.int64)
+        for names, stride, local in zip(name_sets, self.strides[fluent], self._locals[fluent],
+                                        strict=True):
+            ids = [self.object_id[n] for n in names if n in self.object_id]
+            part = local[np.array(ids, dtype=np.int64)]
+            part = part[part >= 0] * stride
+            codes = np.add.outer(codes, part).ravel()
+        return codes
 
     def encode_rows(self, template: tuple[str, ...], columns: Columns, rows: int) -> np.ndarray:
         """Codes of a lifted atom `(f ?x obj ...)` under `rows` bindings."""

@@ -1,0 +1,126 @@
+"""Atoms no action adds (`addable.py`): which fluents are limited, which true atoms are pinned
+(and key the cached structure), that the join leaves out what they rule out, and that the
+ground task and plan are the same as without the limits on every kind of problem."""
+
+from __future__ import annotations
+
+import pytest
+from unified_planning.io import PDDLReader
+
+from avs_planner.cp import grounding
+from avs_planner.cp.addable import NO_LIMITS, add_limits
+from avs_planner.cp.grounding import GroundingCache, ground
+from avs_planner.cp.planner import plan
+from avs_planner.cp.search import SearchOptions
+from avs_planner.cp.task import WorldState
+from avs_planner.pddl import read_files, read_text
+from avs_planner.pddl.model import ProbabilisticProblem
+from bench.avs_generator import AvsSize, generate
+
+from .conftest import AVS_DOMAIN, IPC, random_problem
+from .test_cp_structure_compiled import STATICS_DOMAIN, STATICS_PROBLEM
+
+
+def _statics() -> ProbabilisticProblem:
+    return read_text(STATICS_DOMAIN, STATICS_PROBLEM, "d.pddl", "p.pddl")
+
+
+def test_a_fluent_added_for_a_subtype_only_is_limited():
+    pproblem = _statics()
+    limits = add_limits(pproblem.problem, GroundingCache().schemas(pproblem))
+    # cook adds (base ?k) for kitchens; at and visited are added for every place and robot
+    assert set(limits.adds) == {"base"}
+    assert limits.addable(("base", "k1"))
+    assert not limits.addable(("base", "p1"))
+    assert limits.addable(("at", "r1", "p1"))  # not limited: anything may be added
+    state = GroundingCache().initial_state(pproblem)
+    assert limits.pinned(state.true_atoms) == {("base", "p3")}
+
+
+def test_avs_domain_limits_in_room_and_virtual():
+    pproblem = read_files(AVS_DOMAIN, AVS_DOMAIN.parent / "problems" / "corridor.pddl")
+    limits = add_limits(pproblem.problem, GroundingCache().schemas(pproblem))
+    assert {"in-room", "virtual"} <= set(limits.adds)
+    assert "at" not in limits.adds and "visited" not in limits.adds
+    assert limits.adds["virtual"] == ()  # only ever deleted
+    assert not limits.addable(("in-room", "place0", "room1"))  # ordinary places: never added
+    assert limits.addable(("in-room", "place1", "room1"))  # a placeholder: an assumption may
+
+
+def test_pinned_atoms_key_the_structure_and_addable_ones_do_not():
+    pproblem = _statics()
+    cache = GroundingCache()
+    state = cache.initial_state(pproblem)
+    first = cache.structure(pproblem, state)
+    # a kitchen's base may be added by cook: the same structure serves both states
+    with_kitchen = WorldState(state.true_atoms | {("base", "k1")}, state.values)
+    assert cache.structure(pproblem, with_kitchen) is first
+    # an ordinary place's base can only be true from the start: another structure, which
+    # grounds the actions it allows
+    with_p1 = WorldState(state.true_atoms | {("base", "p1")}, state.values)
+    other = cache.structure(pproblem, with_p1)
+    assert other is not first
+    labels = {other.label(r) for r in range(other.size)}
+    assert "(stay r1 p1 p1)" in labels
+    assert "(stay r1 p1 p1)" not in {first.label(r) for r in range(first.size)}
+
+
+def test_a_pinned_atom_that_is_deleted_still_counts():
+    """A limited atom true at the start may be deleted; plans that need it first are found."""
+    domain = """
+    (define (domain once)
+      (:requirements :strips :typing)
+      (:types thing)
+      (:predicates (fresh ?t - thing) (used ?t - thing))
+      (:action use :parameters (?t - thing)
+        :precondition (fresh ?t) :effect (and (used ?t) (not (fresh ?t)))))
+    """
+    problem = """
+    (define (problem once1) (:domain once)
+      (:objects a b c - thing)
+      (:init (fresh a) (fresh c))
+      (:goal (and (used a) (used c))))
+    """
+    pproblem = read_text(domain, problem, "d.pddl", "p.pddl")
+    result = plan(pproblem, SearchOptions(weight=1.0, heuristic="hmax"), cache=GroundingCache())
+    assert result.solved
+    assert sorted(step.label for step in result.plan) == ["(use a)", "(use c)"]
+    task = ground(pproblem, cache=GroundingCache())
+    assert sorted(a.label for a in task.actions) == ["(use a)", "(use c)"]  # never b
+
+
+def _cases() -> list[tuple[str, object]]:
+    avs = AVS_DOMAIN.read_text()
+    cases: list[tuple[str, object]] = [("statics", _statics)]
+    for problem in sorted((AVS_DOMAIN.parent / "problems").glob("*.pddl")):
+        cases.append((problem.stem, lambda p=problem: read_files(AVS_DOMAIN, p)))
+    for seed in (0, 1):
+        cases.append((f"gen-s{seed}", lambda s=seed: read_text(
+            avs, generate(AvsSize(8, 2, 2, 4), s), "d.pddl", "p.pddl")))
+    for seed in range(3):
+        cases.append((f"random-{seed}", lambda s=seed: random_problem(s, 6, 8)))
+    for domain in sorted(IPC.glob("*/domain.pddl")):
+        instance = domain.parent / "instance-1.pddl"
+        if instance.exists():
+            cases.append((domain.parent.name, lambda d=domain, i=instance: ProbabilisticProblem(
+                PDDLReader().parse_problem(str(d), str(i)))))
+    return cases
+
+
+@pytest.mark.parametrize(("name", "make"), _cases(), ids=[n for n, _ in _cases()])
+def test_same_actions_and_plan_as_without_limits(name, make, monkeypatch):
+    """The limits only leave out what the reachability pass dropped anyway."""
+    pproblem = make()
+    options = SearchOptions(timeout_s=30.0)
+    limited_task = ground(pproblem, cache=GroundingCache())
+    limited = plan(pproblem, options, cache=GroundingCache())
+    with monkeypatch.context() as m:
+        m.setattr(grounding, "add_limits", lambda problem, schemas: NO_LIMITS)
+        full_task = ground(pproblem, cache=GroundingCache())
+        full = plan(pproblem, options, cache=GroundingCache())
+    assert [a.label for a in limited_task.actions] == [a.label for a in full_task.actions]
+    assert set(limited_task.facts) <= set(full_task.facts)
+    assert limited.status == full.status
+    assert [s.label for s in limited.plan] == [s.label for s in full.plan]
+    assert (limited.cost, limited.objective, limited.expanded) == (
+        full.cost, full.objective, full.expanded)
