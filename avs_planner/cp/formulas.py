@@ -30,63 +30,112 @@ _PARAM, _VARIABLE, _OBJECT = (OperatorKind.PARAM_EXP, OperatorKind.VARIABLE_EXP,
 
 
 class FormulaGrounder:
-    """Grounds one formula under a binding of parameters/variables to object names."""
+    """Grounds one formula under a binding of parameters/variables to object names.
+
+    Each formula is compiled once into nested closures (its node kinds, fluent names,
+    argument keys and quantifier domains read from UP's nodes up front), which are then
+    called per binding: reading the nodes again for each binding cost more than the
+    grounding itself on quantified conditions."""
 
     def __init__(self, static: frozenset[Atom], static_names: set[str],
                  objects_of: Callable[[Type], list[str]]):
         self.static = static
         self.static_names = static_names
         self.objects_of = objects_of
+        self._compiled: dict[int, tuple[FNode, _Grounding]] = {}
 
     def cnf(self, node: FNode, binding: Mapping[str, str], positive: bool = True) -> Cnf:
-        # One read of the node's kind, most frequent kinds first: a chain of `is_...()`
-        # calls cost more than the grounding itself on quantified conditions.
+        hit = self._compiled.get(id(node))
+        if hit is None or hit[0] is not node:
+            hit = self._compiled[id(node)] = (node, self._compile(node))  # a strong ref
+        return hit[1](binding, positive)
+
+    def _compile(self, node: FNode) -> _Grounding:
         kind = node.node_type
         if kind is _FLUENT:
-            atom = (node.fluent().name, *(self._term(a, binding) for a in node.args))
-            if atom[0] in self.static_names:
-                return TRUE if (atom in self.static) == positive else FALSE
-            return [frozenset([(atom, positive)])]
+            return self._fluent(node)
         if kind is _AND or kind is _OR:
-            parts = [self.cnf(a, binding, positive) for a in node.args]
-            return _and(parts) if (kind is _AND) == positive else _or(parts)
+            parts = [self._compile(a) for a in node.args]
+            conjunction = kind is _AND
+
+            def junction(binding, positive):
+                cnfs = [p(binding, positive) for p in parts]
+                return _and(cnfs) if conjunction == positive else _or(cnfs)
+            return junction
         if kind is _NOT:
-            return self.cnf(node.arg(0), binding, not positive)
+            inner = self._compile(node.arg(0))
+            return lambda binding, positive: inner(binding, not positive)
         if kind is _IMPLIES:
-            left, right = node.arg(0), node.arg(1)
-            parts = [self.cnf(left, binding, not positive), self.cnf(right, binding, positive)]
-            return _or(parts) if positive else _and(parts)
+            left, right = self._compile(node.arg(0)), self._compile(node.arg(1))
+
+            def implies(binding, positive):
+                cnfs = [left(binding, not positive), right(binding, positive)]
+                return _or(cnfs) if positive else _and(cnfs)
+            return implies
         if kind is _FORALL or kind is _EXISTS:
-            return self._quantifier(node, binding, positive)
+            return self._quantifier(node)
         if kind is _BOOL:
-            return TRUE if node.bool_constant_value() == positive else FALSE
+            value = node.bool_constant_value()
+            return lambda binding, positive: TRUE if value == positive else FALSE
         if kind is _EQUALS:
-            same = self._term(node.arg(0), binding) == self._term(node.arg(1), binding)
-            return TRUE if same == positive else FALSE
+            left, right = _term(node.arg(0)), _term(node.arg(1))
+
+            def equals(binding, positive):
+                return TRUE if (_value(left, binding) == _value(right, binding)) == positive \
+                    else FALSE
+            return equals
         raise PlanningError(f"unsupported condition {node}")
 
-    def _quantifier(self, node: FNode, binding: Mapping[str, str], positive: bool) -> Cnf:
+    def _fluent(self, node: FNode) -> _Grounding:
+        name = node.fluent().name
+        terms = tuple(_term(a) for a in node.args)
+        if name in self.static_names:
+            static = self.static
+
+            def static_atom(binding, positive):
+                atom = (name, *[_value(t, binding) for t in terms])
+                return TRUE if (atom in static) == positive else FALSE
+            return static_atom
+
+        def atom(binding, positive):
+            return [frozenset([((name, *[_value(t, binding) for t in terms]), positive)])]
+        return atom
+
+    def _quantifier(self, node: FNode) -> _Grounding:
         variables = node.variables()
         domains = [self.objects_of(v.type) for v in variables]
         keys = ["?v:" + v.name for v in variables]
-        body = node.arg(0)
-        parts = []
-        for values in itertools.product(*domains):
-            inner = dict(binding)
-            inner.update(zip(keys, values, strict=True))
-            parts.append(self.cnf(body, inner, positive))
-        return _and(parts) if node.is_forall() == positive else _or(parts)
+        body = self._compile(node.arg(0))
+        forall = node.is_forall()
 
-    @staticmethod
-    def _term(node: FNode, binding: Mapping[str, str]) -> str:
-        kind = node.node_type
-        if kind is _PARAM:
-            return binding["?" + node.parameter().name]
-        if kind is _VARIABLE:
-            return binding["?v:" + node.variable().name]
-        if kind is _OBJECT:
-            return node.object().name
-        raise PlanningError(f"unsupported argument {node}")
+        def quantifier(binding, positive):
+            parts = []
+            for values in itertools.product(*domains):
+                inner = dict(binding)
+                inner.update(zip(keys, values, strict=True))
+                parts.append(body(inner, positive))
+            return _and(parts) if forall == positive else _or(parts)
+        return quantifier
+
+
+_Grounding = Callable[[Mapping[str, str], bool], Cnf]
+_Term = tuple[str | None, str | None]  # (binding key, None) or (None, object name)
+
+
+def _term(node: FNode) -> _Term:
+    kind = node.node_type
+    if kind is _PARAM:
+        return "?" + node.parameter().name, None
+    if kind is _VARIABLE:
+        return "?v:" + node.variable().name, None
+    if kind is _OBJECT:
+        return None, node.object().name
+    raise PlanningError(f"unsupported argument {node}")
+
+
+def _value(term: _Term, binding: Mapping[str, str]) -> str:
+    key, name = term
+    return binding[key] if key is not None else name  # type: ignore[return-value]
 
 
 def _and(parts: Iterable[Cnf]) -> Cnf:

@@ -229,16 +229,16 @@ def _ground_cnf(
     pos: list[int] = []
     neg: list[int] = []
     longer = []
-    for clause in sorted(cnf, key=lambda c: sorted(c)):
-        if not clause:
+    for literals in sorted(map(sorted, cnf)):  # each clause's literals sorted once
+        if not literals:
             return False, pos, neg, tuple(longer)
-        if len(clause) == 1:
-            ((atom, positive),) = clause
+        if len(literals) == 1:
+            ((atom, positive),) = literals
             (pos if positive else neg).append(code(atom))
         else:
             longer.append((
-                tuple(code(a) for a, positive in sorted(clause) if positive),
-                tuple(code(a) for a, positive in sorted(clause) if not positive),
+                tuple(code(a) for a, positive in literals if positive),
+                tuple(code(a) for a, positive in literals if not positive),
             ))
     return True, pos, neg, tuple(longer)
 

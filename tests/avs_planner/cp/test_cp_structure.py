@@ -8,11 +8,13 @@ from __future__ import annotations
 import itertools
 
 import numpy as np
+import pytest
 
 from avs_planner.cp.bindings import code_set as _code_set
 from avs_planner.cp.encoding import AtomSpace
-from avs_planner.cp.grounding import GroundingCache, world_state
+from avs_planner.cp.grounding import GroundingCache, ground, world_state
 from avs_planner.cp.structure import _PAD_NONE, _PAD_TRUE, _fact_numbering
+from avs_planner.errors import PlanningError
 from avs_planner.pddl import read_text
 
 DOMAIN = """
@@ -102,3 +104,28 @@ def test_decode_many_keeps_input_order_and_one_tuple_per_atom():
     assert decoded == atoms
     assert decoded[1] is first and decoded[0] is decoded[4]
     assert space.decode_many(codes[:0]) == []
+
+
+NUMERIC_OR_DOMAIN = """
+(define (domain numor)
+  (:requirements :strips :typing :numeric-fluents :disjunctive-preconditions)
+  (:types thing)
+  (:predicates (p ?t - thing) (done ?t - thing))
+  (:functions (level ?t - thing))
+  (:action act :parameters (?t - thing)
+    :precondition (or (p ?t) (> (level ?t) 1))
+    :effect (done ?t)))
+"""
+
+NUMERIC_OR_PROBLEM = """
+(define (problem numor1) (:domain numor)
+  (:objects a - thing)
+  (:init (= (level a) 2))
+  (:goal (done a)))
+"""
+
+
+def test_an_unsupported_condition_inside_a_disjunction_is_named():
+    pproblem = read_text(NUMERIC_OR_DOMAIN, NUMERIC_OR_PROBLEM, "d.pddl", "p.pddl")
+    with pytest.raises(PlanningError, match=r"unsupported condition \(1 < level\(t\)\)"):
+        ground(pproblem, cache=GroundingCache())
