@@ -335,6 +335,11 @@ def compile_vector(node: FNode | None, where: str, default: float) -> VectorExpr
     raise PlanningError(f"{where}: unsupported numeric expression {node}")
 
 
+def fluent_template(expr: VectorExpr) -> tuple[str, ...] | None:
+    """The lifted atom `(f ?x obj ...)` of an expression that is one numeric fluent term."""
+    return expr.template if isinstance(expr, _FluentExpr) else None
+
+
 def term(node: FNode) -> str:
     """A lifted atom's argument: `?name` for a parameter, else the object's name."""
     if node.is_parameter_exp():

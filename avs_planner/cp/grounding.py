@@ -23,10 +23,10 @@ import numpy as np
 from unified_planning.model import FNode, InstantaneousAction, Problem
 
 from avs_planner.cp.action_table import ActionTable
-from avs_planner.cp.addable import AddLimits, add_limits
 from avs_planner.cp.derived import derived, ids_of, reachable, relevant, task_rows
 from avs_planner.cp.encoding import ConstantExpr, NumericValues
 from avs_planner.cp.schema import LiftedSchema, compile_schemas
+from avs_planner.cp.settled import SettledAtoms, settled_atoms
 from avs_planner.cp.structure import GroundStructure, bitset, build_structure
 from avs_planner.cp.task import Atom, GroundTask, TaskArrays, WorldState
 from avs_planner.errors import PlanningError
@@ -195,7 +195,7 @@ class GroundingCache:
         self._structures: OrderedDict[tuple, GroundStructure] = OrderedDict()
         self._problem_keys: OrderedDict[int, tuple] = OrderedDict()
         self._initial: OrderedDict[int, tuple[ProbabilisticProblem, WorldState]] = OrderedDict()
-        self._add_limits: OrderedDict[int, tuple] = OrderedDict()
+        self._settled_atoms: OrderedDict[int, tuple] = OrderedDict()
         self.hits = 0
         self.misses = 0
 
@@ -253,27 +253,27 @@ class GroundingCache:
         schemas = self.schemas(pproblem)
         objects = self._problem_keys[id(pproblem)][3]
         static = frozenset(a for a in state.true_atoms if a[0] in static_names)
-        limits = self._limits(pproblem, schemas)
-        pinned = limits.pinned(state.true_atoms)
-        key = (schema_key, objects, static, pinned)
+        settled = self._settled(pproblem, schemas, static_names)
+        settled_key = settled.key(state)
+        key = (schema_key, objects, static, settled_key)
         assumptive = {s.name: pproblem.is_assumptive(s.name) for s in schemas}
         return self._remember(
             self._structures, key,
             lambda: build_structure(problem, schemas, static, assumptive, static_names,
-                                    limits, pinned),
+                                    settled, settled_key),
         )
 
-    def _limits(self, pproblem: ProbabilisticProblem, schemas: tuple[LiftedSchema, ...]
-                ) -> AddLimits:
-        """`addable.add_limits` of the problem, computed once per problem object."""
-        hit = self._add_limits.get(id(pproblem))
+    def _settled(self, pproblem: ProbabilisticProblem, schemas: tuple[LiftedSchema, ...],
+                 static_names: frozenset[str]) -> SettledAtoms:
+        """`settled.settled_atoms` of the problem, computed once per problem object."""
+        hit = self._settled_atoms.get(id(pproblem))
         if hit is not None and hit[0] is pproblem and hit[1] is schemas:
             return hit[2]
-        limits = add_limits(pproblem.problem, schemas)
-        self._add_limits[id(pproblem)] = (pproblem, schemas, limits)  # a strong ref
-        while len(self._add_limits) > self.size:
-            self._add_limits.popitem(last=False)
-        return limits
+        settled = settled_atoms(pproblem.problem, schemas, static_names)
+        self._settled_atoms[id(pproblem)] = (pproblem, schemas, settled)  # a strong ref
+        while len(self._settled_atoms) > self.size:
+            self._settled_atoms.popitem(last=False)
+        return settled
 
     def forget_last_calls(self) -> None:
         """Drop what the last calls left for reuse (action tables, see `_action_table`, and

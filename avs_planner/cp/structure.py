@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from unified_planning.model import FNode, Problem
 
-from avs_planner.cp.addable import NO_LIMITS, AddLimits
 from avs_planner.cp.bindings import (
     DENSE_CODES,
     CompiledJoin,
@@ -25,6 +24,7 @@ from avs_planner.cp.bindings import (
 from avs_planner.cp.encoding import AtomSpace, Columns
 from avs_planner.cp.formulas import FormulaGrounder
 from avs_planner.cp.schema import LiftedSchema
+from avs_planner.cp.settled import NO_KEY, NOTHING_SETTLED, Key, SettledAtoms
 from avs_planner.cp.task import Atom
 from avs_planner.errors import PlanningError
 
@@ -246,16 +246,16 @@ def _ground_cnf(
 def build_structure(
     problem: Problem, schemas: Sequence[LiftedSchema], static: frozenset[Atom],
     assumptive: Mapping[str, bool], static_names: frozenset[str] | None = None,
-    limits: AddLimits = NO_LIMITS, pinned: frozenset[Atom] = frozenset(),
+    settled: SettledAtoms = NOTHING_SETTLED, settled_key: Key = NO_KEY,
 ) -> GroundStructure:
-    """Ground every action over the objects, filtered by types, static atoms and (`limits`,
-    see `addable.py`) atoms no action adds that are not true (`pinned`)."""
+    """Ground every action over the objects, filtered by types, static atoms and what the
+    state settles for good (`settled.py`: `settled_key` is `settled.key` of the state)."""
     space = AtomSpace(problem)
     static_codes = np.array(
         [c for c in (space.encode(a) for a in static) if c is not None], dtype=np.int64
     )
-    if limits.adds:
-        static_codes = np.concatenate([static_codes, limits.codes(space, pinned)])
+    if settled is not NOTHING_SETTLED:
+        static_codes = np.concatenate([static_codes, settled.codes(space, settled_key)])
     compiled = CompiledJoin(space, static_codes) if _ground is not None else None
     is_static = code_set(static_codes, space.size) if compiled is None else None
     if static_names is None:
@@ -267,7 +267,7 @@ def build_structure(
         if schema.never:
             continue
         if compiled is not None:
-            matrix, rows = compiled.bindings(limits.joined(schema), MAX_BINDINGS,
+            matrix, rows = compiled.bindings(settled.joined(schema), MAX_BINDINGS,
                                              MAX_GROUND_ACTIONS)
             index = {p: i for i, p in enumerate(schema.params)}
             by_param = np.ascontiguousarray(matrix.T)
@@ -276,7 +276,7 @@ def build_structure(
             def code(templates, index=index, matrix=matrix):
                 return compiled.codes(templates, index, matrix)
         else:
-            columns, rows = join_numpy(limits.joined(schema), space, is_static, MAX_BINDINGS)
+            columns, rows = join_numpy(settled.joined(schema), space, is_static, MAX_BINDINGS)
 
             def code(templates, columns=columns, rows=rows):
                 return encode_numpy(templates, space, columns, rows)

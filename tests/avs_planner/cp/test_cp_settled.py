@@ -1,6 +1,7 @@
-"""Atoms no action adds (`addable.py`): which fluents are limited, which true atoms are pinned
-(and key the cached structure), that the join leaves out what they rule out, and that the
-ground task and plan are the same as without the limits on every kind of problem."""
+"""What a state settles for good (`settled.py`): which fluents are limited, which true atoms are
+pinned and which probability atoms are zero (both key the cached structure), that the join
+leaves out what they rule out, and that the ground task and plan are the same as without them
+on every kind of problem."""
 
 from __future__ import annotations
 
@@ -8,11 +9,12 @@ import pytest
 from unified_planning.io import PDDLReader
 
 from avs_planner.cp import grounding
-from avs_planner.cp.addable import NO_LIMITS, add_limits
 from avs_planner.cp.grounding import GroundingCache, ground
 from avs_planner.cp.planner import plan
 from avs_planner.cp.search import SearchOptions
+from avs_planner.cp.settled import NOTHING_SETTLED, settled_atoms
 from avs_planner.cp.task import WorldState
+from avs_planner.errors import PlanningError
 from avs_planner.pddl import read_files, read_text
 from avs_planner.pddl.model import ProbabilisticProblem
 from bench.avs_generator import AvsSize, generate
@@ -21,13 +23,18 @@ from .conftest import AVS_DOMAIN, IPC, random_problem
 from .test_cp_structure_compiled import STATICS_DOMAIN, STATICS_PROBLEM
 
 
+def _settled(pproblem: ProbabilisticProblem):
+    cache = GroundingCache()
+    return settled_atoms(pproblem.problem, cache.schemas(pproblem), cache._keys(pproblem)[1])
+
+
 def _statics() -> ProbabilisticProblem:
     return read_text(STATICS_DOMAIN, STATICS_PROBLEM, "d.pddl", "p.pddl")
 
 
 def test_a_fluent_added_for_a_subtype_only_is_limited():
     pproblem = _statics()
-    limits = add_limits(pproblem.problem, GroundingCache().schemas(pproblem))
+    limits = _settled(pproblem)
     # cook adds (base ?k) for kitchens; at and visited are added for every place and robot
     assert set(limits.adds) == {"base"}
     assert limits.addable(("base", "k1"))
@@ -39,7 +46,7 @@ def test_a_fluent_added_for_a_subtype_only_is_limited():
 
 def test_avs_domain_limits_in_room_and_virtual():
     pproblem = read_files(AVS_DOMAIN, AVS_DOMAIN.parent / "problems" / "corridor.pddl")
-    limits = add_limits(pproblem.problem, GroundingCache().schemas(pproblem))
+    limits = _settled(pproblem)
     assert {"in-room", "virtual"} <= set(limits.adds)
     assert "at" not in limits.adds and "visited" not in limits.adds
     assert limits.adds["virtual"] == ()  # only ever deleted
@@ -89,9 +96,67 @@ def test_a_pinned_atom_that_is_deleted_still_counts():
     assert sorted(a.label for a in task.actions) == ["(use a)", "(use c)"]  # never b
 
 
+ODDS_DOMAIN = """
+(define (domain odds)
+  (:requirements :strips :typing :numeric-fluents :action-costs :probabilistic-effects)
+  (:types thing)
+  (:predicates (have ?t - thing))
+  (:functions (total-cost) - number (chance ?t - thing) - number)
+  (:action get :parameters (?t - thing)
+    :effect (probabilistic (chance ?t) (have ?t))))
+"""
+
+
+def _odds_problem(chances: dict[str, str], goal: str = "(have a)") -> ProbabilisticProblem:
+    values = " ".join(f"(= (chance {t}) {v})" for t, v in chances.items())
+    problem = f"""
+    (define (problem odds1) (:domain odds)
+      (:objects a b c - thing)
+      (:init {values})
+      (:goal {goal}))
+    """
+    return read_text(ODDS_DOMAIN, problem, "d.pddl", "p.pddl")
+
+
+def test_actions_that_never_succeed_are_not_ground():
+    pproblem = _odds_problem({"a": "0.5", "b": "0", "c": "1"})
+    settled = _settled(pproblem)
+    assert settled.odds == {"get": ("chance", "?t")}
+    cache = GroundingCache()
+    state = cache.initial_state(pproblem)
+    assert settled.key(state) == (frozenset(), frozenset({("chance", "b")}))
+    st = cache.structure(pproblem, state)
+    assert {st.label(r) for r in range(st.size)} == {"(get a)", "(get c)"}
+    # other zeros: another structure; other non-zero values: the same one
+    assert cache.structure(pproblem, WorldState(state.true_atoms, {
+        **state.values, ("chance", "b"): 0.25})) is not st
+    assert cache.structure(pproblem, WorldState(state.true_atoms, {
+        **state.values, ("chance", "a"): 0.75})) is st
+
+
+def test_a_goal_only_a_zero_chance_action_reaches_is_unsolvable():
+    pproblem = _odds_problem({"a": "0", "b": "0.5", "c": "1"})
+    result = plan(pproblem, SearchOptions(), cache=GroundingCache())
+    assert result.status.value == "unsolvable"
+
+
+def test_a_missing_probability_is_still_named():
+    """(The reader rejects such a problem; a state built by a caller may still lack one.)"""
+    pproblem = _odds_problem({"a": "0.5", "b": "0", "c": "1"})
+    cache = GroundingCache()
+    state = cache.initial_state(pproblem)
+    values = {k: v for k, v in state.values.items() if k != ("chance", "a")}
+    with pytest.raises(PlanningError, match=r"chance a"):
+        ground(pproblem, WorldState(state.true_atoms, values), cache=cache)
+
+
 def _cases() -> list[tuple[str, object]]:
     avs = AVS_DOMAIN.read_text()
-    cases: list[tuple[str, object]] = [("statics", _statics)]
+    cases: list[tuple[str, object]] = [
+        ("statics", _statics),
+        ("odds", lambda: _odds_problem({"a": "0.5", "b": "0", "c": "1"},
+                                       "(and (have a) (have c))")),
+    ]
     for problem in sorted((AVS_DOMAIN.parent / "problems").glob("*.pddl")):
         cases.append((problem.stem, lambda p=problem: read_files(AVS_DOMAIN, p)))
     for seed in (0, 1):
@@ -109,13 +174,14 @@ def _cases() -> list[tuple[str, object]]:
 
 @pytest.mark.parametrize(("name", "make"), _cases(), ids=[n for n, _ in _cases()])
 def test_same_actions_and_plan_as_without_limits(name, make, monkeypatch):
-    """The limits only leave out what the reachability pass dropped anyway."""
+    """The join only leaves out what the reachability pass and the probability check
+    dropped anyway."""
     pproblem = make()
     options = SearchOptions(timeout_s=30.0)
     limited_task = ground(pproblem, cache=GroundingCache())
     limited = plan(pproblem, options, cache=GroundingCache())
     with monkeypatch.context() as m:
-        m.setattr(grounding, "add_limits", lambda problem, schemas: NO_LIMITS)
+        m.setattr(grounding, "settled_atoms", lambda *args: NOTHING_SETTLED)
         full_task = ground(pproblem, cache=GroundingCache())
         full = plan(pproblem, options, cache=GroundingCache())
     assert [a.label for a in limited_task.actions] == [a.label for a in full_task.actions]
