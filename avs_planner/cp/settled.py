@@ -104,8 +104,7 @@ class SettledAtoms:
         parts = [space.encode_product(name, sets)
                  for name, templates in self.adds.items() for sets in templates]
         pinned, zeros = key
-        atoms = [c for c in map(space.encode, (*pinned, *zeros)) if c is not None]
-        parts.append(np.array(atoms, dtype=np.int64))
+        parts.append(space.encode_all((*pinned, *zeros)))
         return np.concatenate(parts)
 
 

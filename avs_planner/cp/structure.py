@@ -251,9 +251,7 @@ def build_structure(
     """Ground every action over the objects, filtered by types, static atoms and what the
     state settles for good (`settled.py`: `settled_key` is `settled.key` of the state)."""
     space = AtomSpace(problem)
-    static_codes = np.array(
-        [c for c in (space.encode(a) for a in static) if c is not None], dtype=np.int64
-    )
+    static_codes = space.encode_all(static)
     if settled is not NOTHING_SETTLED:
         static_codes = np.concatenate([static_codes, settled.codes(space, settled_key)])
     compiled = CompiledJoin(space, static_codes) if _ground is not None else None

@@ -129,3 +129,15 @@ def test_an_unsupported_condition_inside_a_disjunction_is_named():
     pproblem = read_text(NUMERIC_OR_DOMAIN, NUMERIC_OR_PROBLEM, "d.pddl", "p.pddl")
     with pytest.raises(PlanningError, match=r"unsupported condition \(1 < level\(t\)\)"):
         ground(pproblem, cache=GroundingCache())
+
+
+def test_encode_all_gives_the_codes_encode_gives():
+    pproblem = read_text(DOMAIN, PROBLEM, "d.pddl", "p.pddl")
+    space = AtomSpace(pproblem.problem)
+    state = world_state(pproblem.problem)
+    atoms = [*state.true_atoms, *state.values, ("no-such-fluent", "x"),
+             (next(iter(state.true_atoms))[0], "no-such-object"), ("at",)]
+    expected = sorted(c for c in map(space.encode, atoms) if c is not None)
+    assert sorted(space.encode_all(atoms).tolist()) == expected
+    assert len(expected) == len(state.true_atoms) + len(state.values)
+    assert space.encode_all([]).tolist() == []
