@@ -25,6 +25,9 @@ Columns = Mapping[str, np.ndarray]  # parameter ("?x") -> object ids, one per bi
 MAX_CODE = 2**62
 
 
+_FEW = 48  # below this many atoms of a fluent, `encode_all` encodes them one by one
+
+
 class AtomSpace:
     """Object ids, per-type object lists and the integer code of every possible atom."""
 
@@ -106,16 +109,21 @@ class AtomSpace:
             local[ids] = np.arange(len(ids))
         return local
 
-    def encode_product(self, fluent: str, name_sets: Sequence[Iterable[str]]) -> np.ndarray:
-        """Codes of every atom of `fluent` whose i-th argument is in `name_sets[i]` (names
-        not of the argument's type, or unknown, are left out)."""
+    def encode_product(self, fluent: str, terms: Sequence[Type | str]) -> np.ndarray:
+        """Codes of every atom of `fluent` whose i-th argument is an object of type
+        `terms[i]` (a `Type`) or the object named `terms[i]` (a `str`); objects not of the
+        argument's type, or unknown names, are left out."""
         if fluent not in self.base:
             return np.zeros(0, dtype=np.int64)
         codes = np.full(1, self.base[fluent], dtype=np.int64)
-        for names, stride, local in zip(name_sets, self.strides[fluent], self._locals[fluent],
-                                        strict=True):
-            ids = [self.object_id[n] for n in names if n in self.object_id]
-            part = local[np.array(ids, dtype=np.int64)]
+        for t, stride, local in zip(terms, self.strides[fluent], self._locals[fluent],
+                                    strict=True):
+            if isinstance(t, str):
+                ids = np.array([self.object_id[t]] if t in self.object_id else [],
+                               dtype=np.int64)
+            else:
+                ids = self.objects_of(t)
+            part = local[ids]
             part = part[part >= 0] * stride
             codes = np.add.outer(codes, part).ravel()
         return codes
@@ -151,6 +159,10 @@ class AtomSpace:
         for name, group in groups.items():
             strides = self.strides.get(name)
             if strides is None:
+                continue
+            if len(group) < _FEW:  # numpy's per-call cost outweighs a loop
+                codes = [c for c in map(self.encode, group) if c is not None]
+                parts.append(np.array(codes, dtype=np.int64))
                 continue
             arity = len(strides)
             group = [a for a in group if len(a) == arity + 1]

@@ -47,7 +47,12 @@ class SettledAtoms:
 
     adds: Mapping[str, tuple[NameSets, ...]]
     odds: Mapping[str, AtomTemplate] = field(default_factory=dict)
-    _joined: dict[str, tuple[LiftedSchema, LiftedSchema]] = field(
+    add_terms: Mapping[str, tuple[tuple[Type | str, ...], ...]] = field(default_factory=dict)
+    """`adds` as types and constants, the same products (for `AtomSpace.encode_product`)."""
+    checks: Mapping[str, tuple[AtomTemplate, ...]] = field(default_factory=dict)
+    """Per schema, its positive preconditions on limited fluents that some binding may make
+    an atom no add effect covers (the others can never rule a binding out)."""
+    _joined: dict[str, tuple[LiftedSchema, AtomTemplate | None, LiftedSchema]] = field(
         default_factory=dict, compare=False, repr=False)
 
     @property
@@ -82,27 +87,30 @@ class SettledAtoms:
             return NO_KEY
         return self.pinned(state.true_atoms), self.zeros(state.values)
 
-    def joined(self, schema: LiftedSchema) -> LiftedSchema:
-        """The schema with its positive preconditions on limited fluents also checked by the
-        join (they stay dynamic preconditions too: an action may delete them) and, if its
-        success probability is a static fluent term, that term checked not to be 0."""
-        hit = self._joined.get(schema.name)
-        if hit is not None and hit[0] is schema:
-            return hit[1]
-        extra = tuple(t for t in schema.pre_pos if t[0] in self.adds)
+    def joined(self, schema: LiftedSchema, key: Key) -> LiftedSchema:
+        """The schema with its `checks` also checked by the join (they stay dynamic
+        preconditions too: an action may delete them) and, if its success probability is a
+        static fluent term of which `key` has zero atoms, that term checked not to be 0.
+        Each check costs the join a little, so none is added that cannot rule out a binding."""
         odds = self.odds.get(schema.name)
+        if odds is not None and not any(a[0] == odds[0] for a in key[1]):
+            odds = None
+        hit = self._joined.get(schema.name)
+        if hit is not None and hit[0] is schema and hit[1] == odds:
+            return hit[2]
+        extra = self.checks.get(schema.name, ())
         out = schema
         if extra or odds is not None:
             out = replace(schema, static_pos=schema.static_pos + extra,
                           static_neg=schema.static_neg + ((odds,) if odds else ()))
-        self._joined[schema.name] = (schema, out)
+        self._joined[schema.name] = (schema, odds, out)
         return out
 
     def codes(self, space: AtomSpace, key: Key) -> np.ndarray:
         """Codes the join reads as "in": every atom a limited fluent may have true (addable
         or pinned), and the zero atoms (read by the negated probability terms)."""
-        parts = [space.encode_product(name, sets)
-                 for name, templates in self.adds.items() for sets in templates]
+        parts = [space.encode_product(name, terms)
+                 for name, templates in self.add_terms.items() for terms in templates]
         pinned, zeros = key
         parts.append(space.encode_all((*pinned, *zeros)))
         return np.concatenate(parts)
@@ -120,36 +128,60 @@ def settled_atoms(problem: Problem, schemas: Sequence[LiftedSchema],
         template = fluent_template(schema.probability)
         if not schema.never and template is not None and template[0] in static_names:
             odds[schema.name] = template
-    adds = _limited_adds(problem, schemas)
-    return SettledAtoms(adds, odds) if adds or odds else NOTHING_SETTLED
+    names = _names_by_type(problem)
+    adds, terms = _limited_adds(problem, schemas, names)
+    checks = {}
+    for schema in schemas:
+        if schema.never:
+            continue
+        types = dict(zip(schema.params, schema.param_types, strict=True))
+        useful = tuple(t for t in schema.pre_pos if t[0] in adds and not any(
+            all(map(frozenset.issuperset, sets, _sets_of(
+                tuple(types[x] if x[0] == "?" else x for x in t[1:]), names)))
+            for sets in adds[t[0]]))
+        if useful:
+            checks[schema.name] = useful
+    used = {t[0] for templates in checks.values() for t in templates}
+    adds = {k: v for k, v in adds.items() if k in used}
+    terms = {k: v for k, v in terms.items() if k in used}
+    if not adds and not odds:
+        return NOTHING_SETTLED
+    return SettledAtoms(adds, odds, terms, checks)
 
 
-def _limited_adds(problem: Problem, schemas: Sequence[LiftedSchema]
-                  ) -> dict[str, tuple[NameSets, ...]]:
+def _limited_adds(problem: Problem, schemas: Sequence[LiftedSchema],
+                  names: Mapping[str, frozenset[str]]) -> tuple[dict, dict]:
+    """Per limited fluent, its add effects as name sets, and as types and constants."""
     read = {t[0] for s in schemas if not s.never for t in s.pre_pos}
     if not read:
-        return {}
-    names = _names_by_type(problem)
+        return {}, {}
     signature = {f.name: tuple(p.type for p in f.signature) for f in problem.fluents}
-    adds: dict[str, list[NameSets]] = {name: [] for name in read}
+    adds: dict[str, list[tuple[Type | str, ...]]] = {name: [] for name in read}
     for schema in schemas:
         if schema.never:
             continue
         types = dict(zip(schema.params, schema.param_types, strict=True))
         for template in schema.add:
             if template[0] in adds:
-                adds[template[0]].append(tuple(
-                    names.get(str(types[t]), frozenset()) if t[0] == "?" else frozenset((t,))
-                    for t in template[1:]))
-    limited = {}
+                adds[template[0]].append(
+                    tuple(types[t] if t[0] == "?" else t for t in template[1:]))
+
+    limited, limited_terms = {}, {}
     for name, templates in adds.items():
         full = tuple(names.get(str(t), frozenset()) for t in signature[name])
-        if any(all(map(frozenset.issuperset, sets, full)) for sets in templates):
+        name_sets = tuple(_sets_of(terms, names) for terms in templates)
+        if any(all(map(frozenset.issuperset, sets, full)) for sets in name_sets):
             continue  # one effect adds every atom of the fluent
-        if sum(_product(sets) for sets in templates) > MAX_ADDABLE:
+        if sum(_product(sets) for sets in name_sets) > MAX_ADDABLE:
             continue
-        limited[name] = tuple(templates)
-    return limited
+        limited[name], limited_terms[name] = name_sets, tuple(templates)
+    return limited, limited_terms
+
+
+def _sets_of(terms: tuple[Type | str, ...], names: Mapping[str, frozenset[str]]) -> NameSets:
+    """Per term, the names it may take: a type's objects or a constant."""
+    return tuple(frozenset((t,)) if isinstance(t, str) else names.get(str(t), frozenset())
+                 for t in terms)
 
 
 def _product(sets: NameSets) -> int:

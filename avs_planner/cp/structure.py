@@ -265,7 +265,7 @@ def build_structure(
         if schema.never:
             continue
         if compiled is not None:
-            matrix, rows = compiled.bindings(settled.joined(schema), MAX_BINDINGS,
+            matrix, rows = compiled.bindings(settled.joined(schema, settled_key), MAX_BINDINGS,
                                              MAX_GROUND_ACTIONS)
             index = {p: i for i, p in enumerate(schema.params)}
             by_param = np.ascontiguousarray(matrix.T)
@@ -274,7 +274,8 @@ def build_structure(
             def code(templates, index=index, matrix=matrix):
                 return compiled.codes(templates, index, matrix)
         else:
-            columns, rows = join_numpy(settled.joined(schema), space, is_static, MAX_BINDINGS)
+            columns, rows = join_numpy(settled.joined(schema, settled_key), space, is_static,
+                                       MAX_BINDINGS)
 
             def code(templates, columns=columns, rows=rows):
                 return encode_numpy(templates, space, columns, rows)

@@ -16,6 +16,9 @@ from avs_planner.cp.grounding import GroundingCache, ground, world_state
 from avs_planner.cp.structure import _PAD_NONE, _PAD_TRUE, _fact_numbering
 from avs_planner.errors import PlanningError
 from avs_planner.pddl import read_text
+from bench.avs_generator import AvsSize, generate
+
+from .conftest import AVS_DOMAIN
 
 DOMAIN = """
 (define (domain looks)
@@ -131,8 +134,15 @@ def test_an_unsupported_condition_inside_a_disjunction_is_named():
         ground(pproblem, cache=GroundingCache())
 
 
-def test_encode_all_gives_the_codes_encode_gives():
-    pproblem = read_text(DOMAIN, PROBLEM, "d.pddl", "p.pddl")
+@pytest.mark.parametrize("size", ["small", "large"])
+def test_encode_all_gives_the_codes_encode_gives(size):
+    """Small groups of atoms are encoded one by one, large ones on arrays (a 20-place AVS
+    problem has 192 `p-obj-on` values)."""
+    if size == "small":
+        pproblem = read_text(DOMAIN, PROBLEM, "d.pddl", "p.pddl")
+    else:
+        pproblem = read_text(AVS_DOMAIN.read_text(), generate(AvsSize(20, 5, 4, 8), 0),
+                             "d.pddl", "p.pddl")
     space = AtomSpace(pproblem.problem)
     state = world_state(pproblem.problem)
     atoms = [*state.true_atoms, *state.values, ("no-such-fluent", "x"),
