@@ -26,6 +26,25 @@ CORRIDOR = ROOT / "domains" / "avs" / "problems" / "corridor.pddl"
 IPC = Path("/work/shared/ipc") if Path("/work/shared/ipc").is_dir() else ROOT.parent / "shared/ipc"
 
 
+def avs_and_ipc_makers() -> list[tuple[str, object]]:
+    """(name, problem maker) of every AVS example problem and of each IPC domain's
+    instance-1, for tests that compare two ways of grounding or planning on them."""
+    from unified_planning.io import PDDLReader
+
+    from avs_planner.pddl import read_files
+
+    cases: list[tuple[str, object]] = [
+        (problem.stem, lambda p=problem: read_files(AVS_DOMAIN, p))
+        for problem in sorted((AVS_DOMAIN.parent / "problems").glob("*.pddl"))
+    ]
+    for domain in sorted(IPC.glob("*/domain.pddl")):
+        instance = domain.parent / "instance-1.pddl"
+        if instance.exists():
+            cases.append((domain.parent.name, lambda d=domain, i=instance: ProbabilisticProblem(
+                PDDLReader().parse_problem(str(d), str(i)))))
+    return cases
+
+
 def random_problem(seed: int, n_fluents: int = 4, n_actions: int = 6) -> ProbabilisticProblem:
     """A propositional problem with random pre/add/del, costs 1..5, p in {1, .9, .6, .3}."""
     rng = random.Random(seed)

@@ -6,7 +6,6 @@ on every kind of problem."""
 from __future__ import annotations
 
 import pytest
-from unified_planning.io import PDDLReader
 
 from avs_planner.cp import grounding
 from avs_planner.cp.grounding import GroundingCache, ground
@@ -19,7 +18,7 @@ from avs_planner.pddl import read_files, read_text
 from avs_planner.pddl.model import ProbabilisticProblem
 from bench.avs_generator import AvsSize, generate
 
-from .conftest import AVS_DOMAIN, IPC, random_problem
+from .conftest import AVS_DOMAIN, avs_and_ipc_makers, random_problem
 from .test_cp_structure_compiled import STATICS_DOMAIN, STATICS_PROBLEM
 
 
@@ -157,19 +156,12 @@ def _cases() -> list[tuple[str, object]]:
         ("odds", lambda: _odds_problem({"a": "0.5", "b": "0", "c": "1"},
                                        "(and (have a) (have c))")),
     ]
-    for problem in sorted((AVS_DOMAIN.parent / "problems").glob("*.pddl")):
-        cases.append((problem.stem, lambda p=problem: read_files(AVS_DOMAIN, p)))
     for seed in (0, 1):
         cases.append((f"gen-s{seed}", lambda s=seed: read_text(
             avs, generate(AvsSize(8, 2, 2, 4), s), "d.pddl", "p.pddl")))
     for seed in range(3):
         cases.append((f"random-{seed}", lambda s=seed: random_problem(s, 6, 8)))
-    for domain in sorted(IPC.glob("*/domain.pddl")):
-        instance = domain.parent / "instance-1.pddl"
-        if instance.exists():
-            cases.append((domain.parent.name, lambda d=domain, i=instance: ProbabilisticProblem(
-                PDDLReader().parse_problem(str(d), str(i)))))
-    return cases
+    return cases + avs_and_ipc_makers()
 
 
 @pytest.mark.parametrize(("name", "make"), _cases(), ids=[n for n, _ in _cases()])

@@ -10,16 +10,15 @@ import os
 
 import numpy as np
 import pytest
-from unified_planning.io import PDDLReader
 
 from avs_planner.cp import structure
 from avs_planner.cp.grounding import GroundingCache
 from avs_planner.errors import PlanningError
-from avs_planner.pddl import read_files, read_text
+from avs_planner.pddl import read_text
 from avs_planner.pddl.model import ProbabilisticProblem
 from bench.avs_generator import AvsSize, generate
 
-from .conftest import AVS_DOMAIN, IPC, random_problem
+from .conftest import AVS_DOMAIN, avs_and_ipc_makers, random_problem
 from .test_cp_structure import DOMAIN as LOOKS_DOMAIN
 from .test_cp_structure import PROBLEM as LOOKS_PROBLEM
 
@@ -92,19 +91,12 @@ def _problems() -> list[tuple[str, object]]:
         ("looks", lambda: read_text(LOOKS_DOMAIN, LOOKS_PROBLEM, "d.pddl", "p.pddl")),
         ("statics", lambda: read_text(STATICS_DOMAIN, STATICS_PROBLEM, "d.pddl", "p.pddl")),
     ]
-    for problem in sorted((AVS_DOMAIN.parent / "problems").glob("*.pddl")):
-        cases.append((problem.stem, lambda p=problem: read_files(AVS_DOMAIN, p)))
     for seed in (0,):
         cases.append((f"gen-s{seed}", lambda s=seed: read_text(
             avs, generate(AvsSize(8, 2, 2, 4), s), "d.pddl", "p.pddl")))
     for seed in range(4):
         cases.append((f"random-{seed}", lambda s=seed: random_problem(s, 6, 8)))
-    for domain in sorted(IPC.glob("*/domain.pddl")):
-        instance = domain.parent / "instance-1.pddl"
-        if instance.exists():
-            cases.append((domain.parent.name, lambda d=domain, i=instance: ProbabilisticProblem(
-                PDDLReader().parse_problem(str(d), str(i)))))
-    return cases
+    return cases + avs_and_ipc_makers()
 
 
 def test_the_compiled_structure_is_built():
