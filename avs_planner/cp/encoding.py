@@ -150,7 +150,8 @@ class AtomSpace:
 
     def encode_all(self, atoms: Iterable[Atom]) -> np.ndarray:
         """Codes of the atoms `encode` gives one (unknown or mistyped ones are left out), on
-        arrays per fluent: ~10x faster than `encode` per atom for hundreds of atoms."""
+        arrays per fluent (0.8 vs 1.75 ms for `encode` per atom on the 445 valued atoms of a
+        20-place AVS problem)."""
         groups: dict[str, list[Atom]] = {}
         for atom in atoms:
             groups.setdefault(atom[0], []).append(atom)
