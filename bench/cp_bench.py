@@ -1,6 +1,6 @@
 """Continual planner vs Fast Downward lama-first (through UP), same run, per instance.
 
-Run: `.venv/bin/python -m bench.cp_bench [--quick | --full]` (default ~2 min; --full ~3).
+Run: `.venv/bin/python -m bench.cp_bench [--quick | --full]` (default ~2.5 min here).
 Instances: the AVS problems in domains/avs/problems, generated AVS problems of growing size
 (bench/avs_generator.py, seeds 0-2 of each size) and IPC instances from /work/shared/ipc. Per
 instance it prints both times, their ratio (FD / ours, > 1 means we are faster), both plans'
@@ -52,7 +52,7 @@ SIZES = (AvsSize(8, 2, 2, 4), AvsSize(12, 3, 3, 6), AvsSize(20, 5, 4, 8))
 RUNS = 5  # our timings per instance (median); FD runs once (0.3-9 s each)
 
 
-def avs_cases(quick: bool, full: bool = False) -> list[tuple[str, ProbabilisticProblem]]:
+def avs_cases(quick: bool) -> list[tuple[str, ProbabilisticProblem]]:
     domain_text = (ROOT / "domains/avs/domain.pddl").read_text()
     cases = [
         (f"avs/{p.stem}", read_text(domain_text, p.read_text(), "domain.pddl", p.name))
@@ -285,7 +285,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer instances")
     parser.add_argument("--full", action="store_true",
-                        help="every IPC instance (~3 min)")
+                        help="every IPC instance")
     parser.add_argument("--grounding-only", action="store_true",
                         help="only compare the grounders")
     args = parser.parse_args()
@@ -295,7 +295,7 @@ def main() -> None:
         return
     print(f"options: R={OPTIONS.reward} w={OPTIONS.weight} h={OPTIONS.heuristic} "
           f"timeout={OPTIONS.timeout_s}s; FD: lama-first through UP")
-    avs = [bench_case(label, p, True) for label, p in avs_cases(args.quick, args.full)]
+    avs = [bench_case(label, p, True) for label, p in avs_cases(args.quick)]
     report(avs, "AVS problems (probabilistic; FD on -ln p costs)", True)
     ipc = [bench_case(label, p, False) for label, p in ipc_cases(args.quick, args.full)]
     report(ipc, "IPC instances (deterministic)", False)

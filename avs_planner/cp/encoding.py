@@ -28,6 +28,23 @@ MAX_CODE = 2**62
 _FEW = 48  # below this many atoms of a fluent, `encode_all` encodes them one by one
 
 
+def objects_by_type(problem: Problem) -> dict[str, np.ndarray]:
+    """Object ids (positions in `problem.all_objects`) of every type that has objects,
+    subtypes included, in the problem's order: one pass over the objects and their types'
+    ancestors, instead of a pass over all objects per type (`Problem.objects(type)`), which
+    dominated small problems."""
+    by_type: dict[Type, list[int]] = {}
+    for i, obj in enumerate(problem.all_objects):
+        by_type.setdefault(obj.type, []).append(i)
+    members: dict[str, list[int]] = {}
+    for type_, ids in by_type.items():
+        ancestor: Type | None = type_
+        while ancestor is not None:
+            members.setdefault(str(ancestor), []).extend(ids)
+            ancestor = ancestor.father  # type: ignore[attr-defined]
+    return {k: np.sort(np.array(v, dtype=np.int64)) for k, v in members.items()}
+
+
 class AtomSpace:
     """Object ids, per-type object lists and the integer code of every possible atom."""
 
@@ -35,7 +52,7 @@ class AtomSpace:
         self.problem = problem
         self.names: list[str] = [o.name for o in problem.all_objects]
         self.object_id: dict[str, int] = {n: i for i, n in enumerate(self.names)}
-        self._of_type: dict[str, np.ndarray] = self._members(problem)
+        self._of_type: dict[str, np.ndarray] = objects_by_type(problem)
         self._local: dict[str, np.ndarray] = {}
         self._locals: dict[str, tuple[np.ndarray, ...]] = {}  # per fluent, per argument
         self._names_of: dict[str, list[str]] = {}
@@ -67,22 +84,6 @@ class AtomSpace:
         self._decoded: dict[int, Atom] = {}
         self._name_arrays: dict[str, np.ndarray] = {}
 
-    @staticmethod
-    def _members(problem: Problem) -> dict[str, np.ndarray]:
-        """Object ids of every type that has objects (subtypes included), in the problem's
-        order: one pass over the objects and their types' ancestors, instead of a pass over
-        all objects per type (`Problem.objects(type)`), which dominated small problems."""
-        by_type: dict[Type, list[int]] = {}
-        for i, obj in enumerate(problem.all_objects):
-            by_type.setdefault(obj.type, []).append(i)
-        members: dict[str, list[int]] = {}
-        for type_, ids in by_type.items():
-            ancestor: Type | None = type_
-            while ancestor is not None:
-                members.setdefault(str(ancestor), []).extend(ids)
-                ancestor = ancestor.father  # type: ignore[attr-defined]
-        return {k: np.sort(np.array(v, dtype=np.int64)) for k, v in members.items()}
-
     def objects_of(self, type_: Type) -> np.ndarray:
         """Object ids of `type_` (subtypes included), in the problem's order."""
         key = str(type_)
@@ -109,20 +110,16 @@ class AtomSpace:
             local[ids] = np.arange(len(ids))
         return local
 
-    def encode_product(self, fluent: str, terms: Sequence[Type | str]) -> np.ndarray:
-        """Codes of every atom of `fluent` whose i-th argument is an object of type
-        `terms[i]` (a `Type`) or the object named `terms[i]` (a `str`); objects not of the
-        argument's type, or unknown names, are left out."""
+    def encode_product(self, fluent: str, name_sets: Sequence[Iterable[str]]) -> np.ndarray:
+        """Codes of every atom of `fluent` whose i-th argument is in `name_sets[i]` (names
+        not of the argument's type, or unknown, are left out)."""
         if fluent not in self.base:
             return np.zeros(0, dtype=np.int64)
         codes = np.full(1, self.base[fluent], dtype=np.int64)
-        for t, stride, local in zip(terms, self.strides[fluent], self._locals[fluent],
-                                    strict=True):
-            if isinstance(t, str):
-                ids = np.array([self.object_id[t]] if t in self.object_id else [],
-                               dtype=np.int64)
-            else:
-                ids = self.objects_of(t)
+        for names, stride, local in zip(name_sets, self.strides[fluent], self._locals[fluent],
+                                        strict=True):
+            ids = np.array([self.object_id[n] for n in names if n in self.object_id],
+                           dtype=np.int64)
             part = local[ids]
             part = part[part >= 0] * stride
             codes = np.add.outer(codes, part).ravel()
@@ -156,31 +153,35 @@ class AtomSpace:
         for atom in atoms:
             groups.setdefault(atom[0], []).append(atom)
         parts = []
-        object_id = self.object_id
         for name, group in groups.items():
-            strides = self.strides.get(name)
-            if strides is None:
+            if name not in self.strides:
                 continue
             if len(group) < _FEW:  # numpy's per-call cost outweighs a loop
                 codes = [c for c in map(self.encode, group) if c is not None]
                 parts.append(np.array(codes, dtype=np.int64))
                 continue
-            arity = len(strides)
-            group = [a for a in group if len(a) == arity + 1]
-            codes = np.full(len(group), self.base[name], dtype=np.int64)
-            if arity and group:
-                flat = [o for a in group for o in a[1:]]
-                ids = np.fromiter(map(object_id.get, flat, itertools.repeat(-1)),
-                                  dtype=np.int64, count=len(flat)).reshape(len(group), arity)
-                valid = np.ones(len(group), dtype=bool)
-                for i, (stride, local) in enumerate(zip(strides, self._locals[name],
-                                                        strict=True)):
-                    part = np.where(ids[:, i] >= 0, local[ids[:, i]], -1)
-                    valid &= part >= 0
-                    codes += stride * part
-                codes = codes[valid]
-            parts.append(codes)
+            group = [a for a in group if len(a) == len(self.strides[name]) + 1]
+            codes, valid = self.fluent_codes(name, group)
+            parts.append(codes[valid])
         return np.concatenate(parts) if parts else np.zeros(0, dtype=np.int64)
+
+    def fluent_codes(self, fluent: str, atoms: Sequence[Atom]) -> tuple[np.ndarray, np.ndarray]:
+        """(code, valid) per atom of `fluent`, all of its arity, on arrays: invalid where an
+        object is unknown or not of its argument's type (as `encode` gives None)."""
+        strides = self.strides.get(fluent, ())
+        arity = len(strides)
+        codes = np.full(len(atoms), self.base.get(fluent, 0), dtype=np.int64)
+        valid = np.ones(len(atoms), dtype=bool)
+        if arity and len(atoms):
+            flat = [o for a in atoms for o in a[1:]]
+            ids = np.fromiter(map(self.object_id.get, flat, itertools.repeat(-1)),
+                              dtype=np.int64, count=len(flat)).reshape(len(atoms), arity)
+            for i, (stride, local) in enumerate(zip(strides, self._locals[fluent],
+                                                    strict=True)):
+                part = np.where(ids[:, i] >= 0, local[ids[:, i]], -1)
+                valid &= part >= 0
+                codes += stride * part
+        return codes, valid
 
     def encode(self, atom: Atom) -> int | None:
         """Code of a ground atom; None if its fluent or an object is unknown or mistyped."""
@@ -285,21 +286,9 @@ class NumericValues:
             for atom, value in self.values.items():
                 groups.setdefault(atom[0], []).append((atom, value))
             self._groups = groups
-        space = self.space
-        strides = space.strides.get(fluent, ())
-        arity = len(strides)
+        arity = len(self.space.strides.get(fluent, ()))
         entries = [(a, v) for a, v in self._groups.get(fluent, ()) if len(a) == arity + 1]
-        codes = np.full(len(entries), space.base.get(fluent, 0), dtype=np.int64)
-        valid = np.ones(len(entries), dtype=bool)
-        if arity and entries:
-            flat = [o for a, _ in entries for o in a[1:]]
-            ids = np.fromiter(map(space.object_id.get, flat, itertools.repeat(-1)),
-                              dtype=np.int64, count=len(flat)).reshape(len(entries), arity)
-            for i, (stride, local) in enumerate(zip(strides, space._locals[fluent],
-                                                    strict=True)):
-                part = np.where(ids[:, i] >= 0, local[ids[:, i]], -1)
-                valid &= part >= 0
-                codes += stride * part
+        codes, valid = self.space.fluent_codes(fluent, [a for a, _ in entries])
         numbers = np.array([v for _, v in entries], dtype=float)
         codes, numbers = codes[valid], numbers[valid]
         order = np.argsort(codes, kind="stable")
