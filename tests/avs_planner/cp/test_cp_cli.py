@@ -43,3 +43,14 @@ def test_exit_codes(capsys, tmp_path):
         capsys.readouterr()
         assert main(["plan", DOMAIN, str(bad), "--json"]) == 2
         assert json.loads(capsys.readouterr().out)["status"] == "unsolvable"
+
+
+def test_a_limit_with_hadd_or_hmax_suggests_ff(capsys):
+    for heuristic in ("hadd", "hmax"):
+        capsys.readouterr()
+        assert main(["plan", DOMAIN, CORRIDOR, "--node-limit", "1", "--heuristic",
+                     heuristic]) == 3
+        err = capsys.readouterr().err
+        assert f"with --heuristic {heuristic}; ff (the default)" in err
+    assert main(["plan", DOMAIN, CORRIDOR, "--node-limit", "1"]) == 3
+    assert capsys.readouterr().err == ""  # ff itself: nothing to suggest
