@@ -8,8 +8,10 @@ setup(
         Extension(
             "avs_planner.cp._native",
             ["avs_planner/cp/_native.c"],
-            # -ffp-contract=off: no fused multiply-add, so every float matches the Python search
-            extra_compile_args=["-O2", "-std=c11", "-ffp-contract=off"],
+            # -ffp-contract=off: no fused multiply-add, so every float matches the Python search;
+            # -pthread: the second evaluating thread of large searches (SearchOptions.threads)
+            extra_compile_args=["-O2", "-std=c11", "-ffp-contract=off", "-pthread"],
+            extra_link_args=["-pthread"],
             optional=True,
         ),
         Extension(

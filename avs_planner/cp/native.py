@@ -325,9 +325,11 @@ def run(
     preferred: bool,
     symmetries: Symmetries,
     start: float,
+    threads: int | None = None,
 ) -> tuple[str, tuple[int, ...], int, int, str | None]:
     """Run the C search: (status name, action indices of the plan, expanded, generated, why
-    the best plan so far was returned: one of STOP_NAMES)."""
+    the best plan so far was returned: one of STOP_NAMES). `threads`: 1 or 2 evaluating
+    threads, None for the core's choice (two for large tasks on a multi-CPU machine)."""
     packed = pack_task(task)
     n_facts = len(task.facts)
     n_bytes = 8 * words(n_facts)
@@ -342,6 +344,7 @@ def run(
         _bits(task.goal_neg, n_bytes, n_facts, "the goal"),
         HEURISTIC_CODES[heuristic], float(reward), float(weight), float(min_success),
         remaining, _c_limit(node_limit), _c_limit(patience), lazy, preferred, *sym,
+        0 if threads is None else threads,
     )
     return STATUS_NAMES[status], path, expanded, generated, STOP_NAMES[stopped]
 

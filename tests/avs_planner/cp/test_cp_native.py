@@ -368,3 +368,46 @@ def test_symmetry_packing_does_not_depend_on_the_order_of_checks():
     assert native.pack_symmetries(replace(symmetries, checks=shuffled), n_actions, n_facts) \
         == native.pack_symmetries(symmetries, n_actions, n_facts)
     same(task, SearchOptions(reward=500.0), replace(symmetries, checks=shuffled))
+
+
+@needs_native
+@pytest.mark.parametrize("heuristic", ["ff", "hadd", "hmax"])
+def test_a_second_evaluating_thread_changes_nothing(heuristic, make_random):
+    """threads=2 evaluates each expansion's new states on a worker thread as well (their
+    estimates are recorded in the order they were generated): the same plan and counts as
+    the Python search and as one thread, clauses, symmetries and helpful actions included."""
+    tasks = [(random_ground_task(seed), NO_SYMMETRIES) for seed in range(12)]
+    tasks += [(ground(make_random(seed, n_fluents=6, n_actions=10)), NO_SYMMETRIES)
+              for seed in range(8)]
+    tasks += [_avs("corridor"), _avs("room3-kitchen")]
+    for task, symmetries in tasks:
+        for weight in (1.0, 2.0):
+            options = SearchOptions(reward=100.0, heuristic=heuristic, weight=weight,
+                                    lazy=False, threads=2)
+            two = same(task, options, symmetries)
+            one = search(task, replace(options, threads=1, engine="native"), symmetries)
+            assert outcome(one) == outcome(two)
+
+
+@needs_native
+def test_threads_on_a_20_place_problem():
+    """The size the automatic choice gives two threads: 1, 2 and automatic agree."""
+    from avs_planner.pddl import read_text
+    from bench.avs_generator import AvsSize, generate
+
+    text = generate(AvsSize(20, 5, 4, 8), 1)
+    pproblem = read_text((ROOT / "domains/avs/domain.pddl").read_text(), text, "domain", "p20")
+    state = world_state(pproblem.problem)
+    task = ground(pproblem, state)
+    symmetries = find_symmetries(pproblem, state, task)
+    results = [outcome(search(task, SearchOptions(reward=500.0, threads=t), symmetries))
+               for t in (1, 2, None)]
+    assert results[0] == results[1] == results[2]
+    assert results[0][0] == PlanStatus.SOLVED and results[0][4] > 10  # a real search
+
+
+def test_threads_must_be_one_or_two():
+    for bad in (0, 3, -1):
+        with pytest.raises(PlanningError, match="threads must be 1 or 2"):
+            SearchOptions(threads=bad).check()
+    assert SearchOptions(threads=2).check().threads == 2
