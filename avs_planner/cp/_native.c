@@ -668,13 +668,14 @@ typedef struct {
 
 #define MAX_EVAL 2 /* evaluating threads: the search's own and at most one worker */
 
-/* A batch of states to evaluate; on two threads the worker takes the odd indices */
+/* A batch of states to evaluate: each state k is claimed by one thread (owner[k]), whose
+ * Eval's help list holds its helpful actions from help_at[k], help_n[k] of them */
 typedef struct {
     const int32_t *sids;
     int32_t n;
     double *hc, *hl;
-    int64_t *help_at; /* where in its Eval's help list each state's helpful actions start */
-    int64_t *help_n;
+    int64_t *help_at, *help_n;
+    int8_t *owner;
 } Batch;
 
 typedef struct {
@@ -721,7 +722,7 @@ typedef struct {
     int32_t *kid_act, *todo;
     double *kid_c, *kid_p, *todo_hc, *todo_hl;
     int64_t *todo_at, *todo_n;
-    int8_t *kid_pref;
+    int8_t *kid_pref, *todo_owner;
     Batch batch;
     struct Worker *worker; /* NULL: evaluations run on the search's thread only */
     word *succ;
@@ -1602,7 +1603,8 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
             }
         }
         if (n_todo) {
-            s->batch = (Batch){s->todo, n_todo, s->todo_hc, s->todo_hl, s->todo_at, s->todo_n};
+            s->batch = (Batch){s->todo, n_todo, s->todo_hc, s->todo_hl, s->todo_at, s->todo_n,
+                               s->todo_owner};
             if (evaluate_batch(s))
                 return -1;
         }
@@ -1663,7 +1665,8 @@ static void search_free(Search *s)
                     s->slots, s->n_state, s->n_parent, s->n_via, s->n_c, s->n_p, s->n_h,
                     s->n_alive, s->n_eval, s->heap.v, s->pref.v, s->help, s->combined,
                     s->help_stamp, s->succ, s->kids, s->kid_act, s->todo, s->kid_c,
-                    s->kid_p, s->todo_hc, s->todo_hl, s->todo_at, s->todo_n, s->kid_pref};
+                    s->kid_p, s->todo_hc, s->todo_hl, s->todo_at, s->todo_n, s->kid_pref,
+                    s->todo_owner};
     for (size_t i = 0; i < sizeof(ptrs) / sizeof(ptrs[0]); i++)
         free(ptrs[i]);
     for (int i = 0; i < MAX_EVAL; i++)
@@ -1712,6 +1715,7 @@ static int grow_kids(Search *s, int32_t n, int32_t *cap)
     GROW_KIDS(todo_at, sizeof(int64_t));
     GROW_KIDS(todo_n, sizeof(int64_t));
     GROW_KIDS(kid_pref, 1);
+    GROW_KIDS(todo_owner, 1);
 #undef GROW_KIDS
     *cap = c;
     return 0;
@@ -1723,26 +1727,27 @@ static int grow_kids(Search *s, int32_t n, int32_t *cap)
 /* Evaluations are pure functions of the state (each thread has its own Eval scratch), and
  * their results are written to the states' records in the order the successors were
  * generated, so the search runs exactly as on one thread: same plan, same counts. */
-static void eval_share(Search *s, int who, int stride)
+static void eval_one(Search *s, int who, int32_t k)
 {
     const Batch *b = &s->batch;
     Eval *e = &s->ev[who];
-    e->n_help = 0;
-    for (int32_t k = who; k < b->n; k += stride) {
-        b->help_at[k] = e->n_help;
-        evaluate_state(s, e, s->sdata + (Py_ssize_t)b->sids[k] * s->W, &b->hc[k], &b->hl[k]);
-        b->help_n[k] = e->n_help - b->help_at[k];
-    }
+    b->owner[k] = (int8_t)who;
+    b->help_at[k] = e->n_help;
+    evaluate_state(s, e, s->sdata + (Py_ssize_t)b->sids[k] * s->W, &b->hc[k], &b->hl[k]);
+    b->help_n[k] = e->n_help - b->help_at[k];
 }
 
 #if (defined(__unix__) || defined(__APPLE__)) && (defined(__GNUC__) || defined(__clang__))
 #include <pthread.h>
 #include <unistd.h>
 
-/* Hand-over: the search posts a batch (posted++), both threads evaluate, the worker reports
- * (finished = posted). Each side spins a little before it sleeps on a condition variable:
- * batches come every few tens of microseconds, and a sleeping thread takes longer than that
- * to wake. The counters are read and written atomically; the mutex only guards sleeping. */
+/* Hand-over. The search publishes a batch as a ticket, (n << 32) | next index, and both
+ * threads claim states from it with an atomic add until the index reaches n; `done` counts
+ * the finished ones. A worker that wakes late finds fewer states left (or none), so the search
+ * never waits on it, only on a state it is still evaluating. A claim from a finished batch's
+ * ticket is past its n, so a late worker cannot take a state twice. The worker spins a little
+ * before it sleeps on a condition variable: batches come every few tens of microseconds, and
+ * a sleeping thread takes longer than that to wake. */
 #define SPINS 2000 /* ~0.1 ms of pause instructions */
 
 static inline void cpu_relax(void)
@@ -1757,14 +1762,34 @@ static inline void cpu_relax(void)
 struct Worker {
     pthread_t thread;
     pthread_mutex_t mu;
-    pthread_cond_t go, done;
+    pthread_cond_t go, done_cv;
     Search *s;
-    uint64_t posted, finished;
+    uint64_t posted; /* batches published (wakes the worker) */
+    uint64_t ticket;
+    int32_t done;
     int quit;
 };
 
 #define LOAD(x) __atomic_load_n(&(x), __ATOMIC_ACQUIRE)
 #define STORE(x, v) __atomic_store_n(&(x), (v), __ATOMIC_RELEASE)
+
+/* Claim and evaluate states of the current batch until none is left. */
+static void claim_states(struct Worker *w, int who)
+{
+    for (;;) {
+        uint64_t ticket = __atomic_fetch_add(&w->ticket, 1, __ATOMIC_ACQ_REL);
+        int32_t n = (int32_t)(ticket >> 32), k = (int32_t)(ticket & 0xffffffffu);
+        if (k >= n)
+            return;
+        eval_one(w->s, who, k);
+        if (__atomic_add_fetch(&w->done, 1, __ATOMIC_ACQ_REL) == n && who == 1) {
+            /* under the mutex: the search either saw done == n or already sleeps */
+            pthread_mutex_lock(&w->mu);
+            pthread_cond_signal(&w->done_cv);
+            pthread_mutex_unlock(&w->mu);
+        }
+    }
+}
 
 static void *worker_main(void *arg)
 {
@@ -1773,18 +1798,16 @@ static void *worker_main(void *arg)
     for (;;) {
         for (int i = 0; i < SPINS && LOAD(w->posted) == seen && !LOAD(w->quit); i++)
             cpu_relax();
-        pthread_mutex_lock(&w->mu);
-        while (LOAD(w->posted) == seen && !LOAD(w->quit))
-            pthread_cond_wait(&w->go, &w->mu);
-        pthread_mutex_unlock(&w->mu);
+        if (LOAD(w->posted) == seen && !LOAD(w->quit)) {
+            pthread_mutex_lock(&w->mu);
+            while (LOAD(w->posted) == seen && !LOAD(w->quit))
+                pthread_cond_wait(&w->go, &w->mu);
+            pthread_mutex_unlock(&w->mu);
+        }
         if (LOAD(w->quit))
             break;
         seen = LOAD(w->posted);
-        eval_share(w->s, 1, 2);
-        pthread_mutex_lock(&w->mu);
-        STORE(w->finished, seen);
-        pthread_cond_signal(&w->done);
-        pthread_mutex_unlock(&w->mu);
+        claim_states(w, 1);
     }
     return NULL;
 }
@@ -1809,11 +1832,11 @@ static void worker_start(Search *s)
     w->s = s;
     pthread_mutex_init(&w->mu, NULL);
     pthread_cond_init(&w->go, NULL);
-    pthread_cond_init(&w->done, NULL);
+    pthread_cond_init(&w->done_cv, NULL);
     if (pthread_create(&w->thread, NULL, worker_main, w)) {
         pthread_mutex_destroy(&w->mu);
         pthread_cond_destroy(&w->go);
-        pthread_cond_destroy(&w->done);
+        pthread_cond_destroy(&w->done_cv);
         eval_free(&s->ev[1]);
         free(w);
         return;
@@ -1833,27 +1856,32 @@ static void worker_stop(Search *s)
     pthread_join(w->thread, NULL);
     pthread_mutex_destroy(&w->mu);
     pthread_cond_destroy(&w->go);
-    pthread_cond_destroy(&w->done);
+    pthread_cond_destroy(&w->done_cv);
     free(w);
     s->worker = NULL;
 }
 
-/* Both threads evaluate their share of s->batch; returns when both are done. */
+/* Both threads evaluate states of s->batch; returns when every state is done. No state of
+ * the previous batch is in progress here (its done count reached n), so both Evals' help
+ * lists can start over. */
 static void run_batch(Search *s)
 {
     struct Worker *w = s->worker;
-    uint64_t batch = LOAD(w->posted) + 1;
+    int32_t n = s->batch.n;
+    s->ev[0].n_help = s->ev[1].n_help = 0;
+    STORE(w->done, 0);
+    STORE(w->ticket, (uint64_t)n << 32);
     pthread_mutex_lock(&w->mu);
-    STORE(w->posted, batch);
+    STORE(w->posted, LOAD(w->posted) + 1);
     pthread_cond_signal(&w->go);
     pthread_mutex_unlock(&w->mu);
-    eval_share(s, 0, 2);
-    for (int i = 0; i < SPINS && LOAD(w->finished) != batch; i++)
+    claim_states(w, 0);
+    for (int i = 0; i < SPINS && LOAD(w->done) != n; i++)
         cpu_relax();
-    if (LOAD(w->finished) != batch) {
+    if (LOAD(w->done) != n) {
         pthread_mutex_lock(&w->mu);
-        while (LOAD(w->finished) != batch)
-            pthread_cond_wait(&w->done, &w->mu);
+        while (LOAD(w->done) != n)
+            pthread_cond_wait(&w->done_cv, &w->mu);
         pthread_mutex_unlock(&w->mu);
     }
 }
@@ -1861,7 +1889,7 @@ static void run_batch(Search *s)
 static int online_cpus(void) { return 1; }
 static void worker_start(Search *s) { (void)s; }
 static void worker_stop(Search *s) { (void)s; }
-static void run_batch(Search *s) { eval_share(s, 0, 1); }
+static void run_batch(Search *s) { (void)s; }
 #endif
 
 /* Relaxed tasks with fewer (class, precondition) entries than this evaluate in a few
@@ -1886,18 +1914,20 @@ static int use_worker(const Search *s)
 static int evaluate_batch(Search *s)
 {
     const Batch *b = &s->batch;
-    int stride = s->worker && b->n > 1 ? 2 : 1;
-    if (stride == 2)
+    if (s->worker && b->n > 1) {
         run_batch(s);
-    else
-        eval_share(s, 0, 1);
-    for (int i = 0; i < stride; i++)
+    } else {
+        s->ev[0].n_help = 0;
+        for (int32_t k = 0; k < b->n; k++)
+            eval_one(s, 0, k);
+    }
+    for (int i = 0; i < MAX_EVAL; i++)
         if (s->ev[i].oom)
             s->oom = 1;
     if (s->oom)
         return -1;
     for (int32_t k = 0; k < b->n; k++) {
-        const Eval *e = &s->ev[k % stride];
+        const Eval *e = &s->ev[b->owner[k]];
         if (commit_estimate(s, b->sids[k], b->hc[k], b->hl[k], e->help + b->help_at[k],
                             b->help_n[k]))
             return -1;
