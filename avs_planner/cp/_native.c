@@ -1298,6 +1298,17 @@ static int labels_add(Search *s, StateRec *rec, double c, double p, int32_t node
     return 1;
 }
 
+/* realloc s->field to `count` elements of `size` bytes; on failure set s->oom, return -1 */
+#define GROW_FIELD(s, field, count, size)                                                       \
+    do {                                                                                        \
+        void *grown_ = realloc((s)->field, (size_t)(count) * (size));                           \
+        if (!grown_) {                                                                          \
+            (s)->oom = 1;                                                                       \
+            return -1;                                                                          \
+        }                                                                                       \
+        (s)->field = grown_;                                                                    \
+    } while (0)
+
 static int grow_nodes(Search *s)
 {
     if (s->cap_nodes > INT32_MAX / 2) {
@@ -1305,24 +1316,14 @@ static int grow_nodes(Search *s)
         return -1;
     }
     int32_t cap = s->cap_nodes ? s->cap_nodes * 2 : 4096;
-#define GROW(field, type)                                                                       \
-    do {                                                                                        \
-        type *v = realloc(s->field, (size_t)cap * sizeof(type));                                \
-        if (!v) {                                                                               \
-            s->oom = 1;                                                                         \
-            return -1;                                                                          \
-        }                                                                                       \
-        s->field = v;                                                                           \
-    } while (0)
-    GROW(n_state, int32_t);
-    GROW(n_parent, int32_t);
-    GROW(n_via, int32_t);
-    GROW(n_c, double);
-    GROW(n_p, double);
-    GROW(n_h, double);
-    GROW(n_alive, int8_t);
-    GROW(n_eval, int8_t);
-#undef GROW
+    GROW_FIELD(s, n_state, cap, sizeof(int32_t));
+    GROW_FIELD(s, n_parent, cap, sizeof(int32_t));
+    GROW_FIELD(s, n_via, cap, sizeof(int32_t));
+    GROW_FIELD(s, n_c, cap, sizeof(double));
+    GROW_FIELD(s, n_p, cap, sizeof(double));
+    GROW_FIELD(s, n_h, cap, sizeof(double));
+    GROW_FIELD(s, n_alive, cap, sizeof(int8_t));
+    GROW_FIELD(s, n_eval, cap, sizeof(int8_t));
     s->cap_nodes = cap;
     return 0;
 }
@@ -1696,27 +1697,17 @@ static int grow_kids(Search *s, int32_t n, int32_t *cap)
     if (n < *cap)
         return 0;
     int32_t c = *cap ? *cap * 2 : 64;
-#define GROW_KIDS(field, size)                                                                  \
-    do {                                                                                        \
-        void *v = realloc(s->field, (size_t)c * (size));                                        \
-        if (!v) {                                                                               \
-            s->oom = 1;                                                                         \
-            return -1;                                                                          \
-        }                                                                                       \
-        s->field = v;                                                                           \
-    } while (0)
-    GROW_KIDS(kids, 8 * (size_t)s->W);
-    GROW_KIDS(kid_act, sizeof(int32_t));
-    GROW_KIDS(todo, sizeof(int32_t));
-    GROW_KIDS(kid_c, sizeof(double));
-    GROW_KIDS(kid_p, sizeof(double));
-    GROW_KIDS(todo_hc, sizeof(double));
-    GROW_KIDS(todo_hl, sizeof(double));
-    GROW_KIDS(todo_at, sizeof(int64_t));
-    GROW_KIDS(todo_n, sizeof(int64_t));
-    GROW_KIDS(kid_pref, 1);
-    GROW_KIDS(todo_owner, 1);
-#undef GROW_KIDS
+    GROW_FIELD(s, kids, c, 8 * (size_t)s->W);
+    GROW_FIELD(s, kid_act, c, sizeof(int32_t));
+    GROW_FIELD(s, todo, c, sizeof(int32_t));
+    GROW_FIELD(s, kid_c, c, sizeof(double));
+    GROW_FIELD(s, kid_p, c, sizeof(double));
+    GROW_FIELD(s, todo_hc, c, sizeof(double));
+    GROW_FIELD(s, todo_hl, c, sizeof(double));
+    GROW_FIELD(s, todo_at, c, sizeof(int64_t));
+    GROW_FIELD(s, todo_n, c, sizeof(int64_t));
+    GROW_FIELD(s, kid_pref, c, 1);
+    GROW_FIELD(s, todo_owner, c, 1);
     *cap = c;
     return 0;
 }
