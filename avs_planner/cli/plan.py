@@ -50,6 +50,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--engine", choices=("auto", "native", "python"), default="auto",
                         help="search core: native (compiled, same results), python, or auto "
                         "(native when built; default)")
+    parser.add_argument("--threads", type=int, choices=(1, 2), default=None,
+                        help="threads the native core evaluates states on (same results; "
+                        "default: 2 for large tasks on a machine with 2+ CPUs, else 1)")
     parser.set_defaults(func=run)
 
 
@@ -62,6 +65,7 @@ def run(args: argparse.Namespace) -> int:
     options = SearchOptions(
         heuristic=args.heuristic, timeout_s=args.timeout, node_limit=args.node_limit,
         min_success=args.min_success, engine=args.engine, patience=args.patience,
+        threads=args.threads,
         **{k: v for k, v in given.items() if v is not None},
     ).check()
     pproblem = read_files(args.domain, args.problem)

@@ -54,3 +54,12 @@ def test_a_limit_with_hadd_or_hmax_suggests_ff(capsys):
         assert f"with --heuristic {heuristic}; ff (the default)" in err
     assert main(["plan", DOMAIN, CORRIDOR, "--node-limit", "1"]) == 3
     assert capsys.readouterr().err == ""  # ff itself: nothing to suggest
+
+
+def test_threads_option_gives_the_same_plan(capsys):
+    plans = []
+    for threads in ("1", "2"):
+        assert main(["plan", DOMAIN, CORRIDOR, "--json", "--threads", threads]) == 0
+        out = json.loads(capsys.readouterr().out)
+        plans.append((out["plan"], out["expanded"]))
+    assert plans[0] == plans[1]
