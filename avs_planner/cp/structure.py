@@ -110,13 +110,23 @@ class GroundStructure:
         n = len(self.facts)
         names = self.space.names
         at = np.array(missing, dtype=np.int64)
-        pre, neg, add, delete = (fact_matrix(a[at], n, None)
-                                 for a in (self.pre, self.pre_neg, self.add, self.delete))
-        pre_masks, neg_masks, add_masks, delete_masks = (
-            _row_masks(m, n) for m in (pre, neg, add, delete)
-        )
-        pre_count, add_count = (pre >= 0).sum(axis=1).tolist(), (add >= 0).sum(axis=1).tolist()
-        pre_rows, add_rows = pre.tolist(), add.tolist()
+        if len(missing) <= _FEW_ROWS:  # a plan's steps: Python lists beat numpy's per-call cost
+            pre_rows, add_rows, neg_ids, delete_ids = (
+                [sorted({f for f in row if f < n}) for row in a[at].tolist()]
+                for a in (self.pre, self.add, self.pre_neg, self.delete))
+            pre_masks, add_masks, neg_masks, delete_masks = (
+                [bitset(ids) for ids in rows]
+                for rows in (pre_rows, add_rows, neg_ids, delete_ids))
+            pre_count, add_count = [len(r) for r in pre_rows], [len(r) for r in add_rows]
+        else:
+            pre, neg, add, delete = (fact_matrix(a[at], n, None)
+                                     for a in (self.pre, self.pre_neg, self.add, self.delete))
+            pre_masks, neg_masks, add_masks, delete_masks = (
+                _row_masks(m, n) for m in (pre, neg, add, delete)
+            )
+            pre_count = (pre >= 0).sum(axis=1).tolist()
+            add_count = (add >= 0).sum(axis=1).tolist()
+            pre_rows, add_rows = pre.tolist(), add.tolist()
         arg_rows = self.arg_ids[at].tolist()
         starts = np.array([b.start for b in self.blocks], dtype=np.int64)
         block_rows = (np.searchsorted(starts, at, side="right") - 1).tolist()
@@ -135,6 +145,9 @@ class GroundStructure:
                 tuple(add_rows[k][: add_count[k]]), clauses, block.assumptive,
                 (schema.name.lower(), *[lowered[v] for v in ids]),
             )
+
+
+_FEW_ROWS = 64  # up to this many rows are built from Python lists (same result as numpy)
 
 
 def _row_masks(matrix: np.ndarray, n: int) -> list[int]:

@@ -167,3 +167,24 @@ def test_kept_evaluations_follow_the_numeric_values(corridor):
     halved = ground(corridor, _with_a_probability_halved(state), cache)
     fresh = ground(corridor, _with_a_probability_halved(state), GroundingCache())
     assert list(halved.actions) == list(fresh.actions)
+
+
+def test_a_few_rows_are_built_as_the_numpy_path_builds_them(monkeypatch):
+    """Up to `_FEW_ROWS` rows (a plan's steps) are built from Python lists, more with numpy:
+    both give the same actions, on every AVS example problem and IPC instance-1."""
+    import random
+
+    from avs_planner.cp import structure
+
+    from .conftest import avs_and_ipc_makers
+
+    for name, make in avs_and_ipc_makers():
+        task = ground(make(), cache=GroundingCache())
+        st, rows = task.actions._st, task.actions._rows.tolist()
+        sample = random.Random(name).sample(rows, min(40, len(rows)))
+        built = []
+        for few in (structure._FEW_ROWS, -1):
+            monkeypatch.setattr(structure, "_FEW_ROWS", few)
+            st._rows.clear()
+            built.append(st.rows(sample))
+        assert built[0] == built[1], name
