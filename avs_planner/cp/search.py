@@ -75,7 +75,8 @@ class SearchOptions:
         get_heuristic(self.heuristic)
         if self.patience is not None and not self.patience >= 0:
             raise PlanningError(f"patience must be >= 0 expansions (or inf), got {self.patience}")
-        if self.threads is not None and self.threads not in (1, 2):
+        if self.threads is not None and (type(self.threads) is not int
+                                         or self.threads not in (1, 2)):
             raise PlanningError(f"threads must be 1 or 2 (or None: automatic), got "
                                 f"{self.threads}")
         if self.engine not in ENGINES:

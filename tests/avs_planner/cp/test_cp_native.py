@@ -407,7 +407,7 @@ def test_threads_on_a_20_place_problem():
 
 
 def test_threads_must_be_one_or_two():
-    for bad in (0, 3, -1):
+    for bad in (0, 3, -1, 2.0, "2", True):  # e.g. from a JSON payload of the HTTP API
         with pytest.raises(PlanningError, match="threads must be 1 or 2"):
             SearchOptions(threads=bad).check()
     assert SearchOptions(threads=2).check().threads == 2
