@@ -725,7 +725,7 @@ typedef struct {
     int8_t *kid_pref, *todo_owner;
     Batch batch;
     struct Worker *worker; /* NULL: evaluations run on the search's thread only */
-    word *succ;
+    word *parent; /* the expanded state, copied: the state table may move */
     int oom;
     PyThreadState *thread; /* saved while the GIL is released (NULL: not released) */
 } Search;
@@ -1344,10 +1344,16 @@ static int queue_node(Search *s, double f, double h, int32_t node, int preferred
     return 0;
 }
 
+/* a successor with this probability is not pushed (p = 0, or below --min-success) */
+static inline int below_threshold(const Search *s, double p)
+{
+    return p <= 0.0 || p < s->min_success;
+}
+
 static int push_node(Search *s, const word *state, double c, double p, int32_t parent,
                      int32_t action, int preferred)
 {
-    if (p <= 0.0 || p < s->min_success) {
+    if (below_threshold(s, p)) {
         s->pruned_threshold |= p > 0.0;
         return 0;
     }
@@ -1513,8 +1519,8 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
         int32_t sid = s->n_state[node];
         double c = s->n_c[node], p = s->n_p[node];
         /* copy: the state table may move while successors are inserted */
-        memcpy(s->succ + W, s->sdata + (Py_ssize_t)sid * W, 8 * (size_t)W);
-        const word *state = s->succ + W;
+        memcpy(s->parent, s->sdata + (Py_ssize_t)sid * W, 8 * (size_t)W);
+        const word *state = s->parent;
         if (is_goal_state(s, state)) {
             double obj = objective(c, p, s->reward);
             if (obj < best_obj) {
@@ -1592,7 +1598,7 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
             s->kid_p[n_kids] = kp;
             s->kid_pref[n_kids] = (int8_t)(s->preferred && s->help_stamp[a] == mark);
             n_kids++;
-            if (batching && !(kp <= 0.0 || kp < s->min_success)) { /* push_node's test */
+            if (batching && !below_threshold(s, kp)) { /* else push_node drops it */
                 uint64_t h = hash_state(succ, W);
                 size_t slot = 0;
                 if (find_state(s, succ, h, &slot) < 0) {
@@ -1665,7 +1671,7 @@ static void search_free(Search *s)
     void *ptrs[] = {s->goal, s->goal_neg, s->goal_facts, s->is_goal, s->sdata, s->recs,
                     s->slots, s->n_state, s->n_parent, s->n_via, s->n_c, s->n_p, s->n_h,
                     s->n_alive, s->n_eval, s->heap.v, s->pref.v, s->help, s->combined,
-                    s->help_stamp, s->succ, s->kids, s->kid_act, s->todo, s->kid_c,
+                    s->help_stamp, s->parent, s->kids, s->kid_act, s->todo, s->kid_c,
                     s->kid_p, s->todo_hc, s->todo_hl, s->todo_at, s->todo_n, s->kid_pref,
                     s->todo_owner};
     for (size_t i = 0; i < sizeof(ptrs) / sizeof(ptrs[0]); i++)
@@ -1684,9 +1690,9 @@ static int search_alloc(Search *s)
     s->is_goal = xcalloc(F, 1);
     s->combined = xcalloc(A, sizeof(double));
     s->help_stamp = xcalloc(A, sizeof(uint32_t));
-    s->succ = xcalloc(2 * W, 8);
+    s->parent = xcalloc(W, 8);
     if (!s->goal || !s->goal_neg || !s->goal_facts || !s->is_goal || !s->combined ||
-        !s->help_stamp || !s->succ || eval_alloc(t, &s->ev[0]))
+        !s->help_stamp || !s->parent || eval_alloc(t, &s->ev[0]))
         return -1;
     return grow_slots(s);
 }

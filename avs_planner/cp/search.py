@@ -54,8 +54,8 @@ class SearchOptions:
     threads: int | None = None
     """Threads the native core evaluates states on (1 or 2; same results either way). None:
     two on a machine with two or more CPUs when the task is large enough for it to pay
-    (about 2,000 precondition entries in the relaxed task, as the 20-place AVS problems);
-    one otherwise. The Python engine always uses one."""
+    (at least 1,000 (class, precondition) entries in the relaxed task, as the 8- to 20-place
+    AVS problems); one otherwise. The Python engine always uses one."""
     patience: float | None = None
     """Once a plan is found, expansions allowed without finding a better one before the best
     is returned. None: DEFAULT_PATIENCE with an inadmissible heuristic, unlimited
