@@ -2,7 +2,7 @@
 
 Run: `.venv/bin/python -m bench.cp_bench [--quick | --full]` (default ~2.5 min here).
 Instances: the AVS problems in domains/avs/problems, generated AVS problems of growing size
-(bench/avs_generator.py, seeds 0-2 of each size) and IPC instances from /work/shared/ipc. Per
+(bench/avs_generator.py, seeds 0-2 of each size) and IPC instances from ../shared/ipc. Per
 instance it prints both times, their ratio (FD / ours, > 1 means we are faster), both plans'
 cost and, for AVS, both plans' true objective c + R(1 - p). FD cannot read probabilities, so
 for it each ground action's cost becomes round(100 (c + R (-ln p))) through a per-action cost
@@ -44,7 +44,7 @@ from avs_planner.up_engine import to_up_plan
 from bench.avs_generator import AvsSize, generate
 
 ROOT = Path(__file__).resolve().parents[1]
-IPC = Path("/work/shared/ipc")
+IPC = Path(__file__).resolve().parents[2] / "shared" / "ipc"  # beside the checkout
 REWARD = 500.0
 TIMEOUT_S = 10.0
 PROHIBITIVE = 10**7

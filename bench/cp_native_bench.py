@@ -28,7 +28,7 @@ from avs_planner.pddl.model import ProbabilisticProblem
 from bench.avs_generator import AvsSize, generate
 
 ROOT = Path(__file__).resolve().parents[1]
-IPC = Path("/work/shared/ipc")
+IPC = Path(__file__).resolve().parents[2] / "shared" / "ipc"  # beside the checkout
 OPTIONS = SearchOptions(reward=500.0, weight=2.0, heuristic="ff", timeout_s=60.0)
 IPC_CASES = (("blocks", 4), ("logistics", 2), ("elevators", 1))
 

@@ -21,7 +21,7 @@ from avs_planner.pddl.probabilistic import translate_domain
 from avs_planner.pddl.sexpr import parse_sexprs
 
 ROOT = Path(__file__).resolve().parents[1]
-IPC = Path("/work/shared/ipc")
+IPC = Path(__file__).resolve().parents[2] / "shared" / "ipc"  # beside the checkout
 
 
 def cases(quick: bool) -> list[tuple[str, Path, Path]]:

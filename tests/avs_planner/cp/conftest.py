@@ -19,16 +19,17 @@ from unified_planning.shortcuts import (
 )
 
 from avs_planner.pddl.model import ProbabilisticProblem
+from tests.ipc import IPC, ipc_domains
 
 ROOT = Path(__file__).resolve().parents[3]
 AVS_DOMAIN = ROOT / "domains" / "avs" / "domain.pddl"
 CORRIDOR = ROOT / "domains" / "avs" / "problems" / "corridor.pddl"
-IPC = Path("/work/shared/ipc") if Path("/work/shared/ipc").is_dir() else ROOT.parent / "shared/ipc"
 
 
 def avs_and_ipc_makers() -> list[tuple[str, object]]:
     """(name, problem maker) of every AVS example problem and of each IPC domain's
-    instance-1, for tests that compare two ways of grounding or planning on them."""
+    instance-1 (the domains it reads and solves today), for tests that compare two ways of
+    grounding or planning on them."""
     from unified_planning.io import PDDLReader
 
     from avs_planner.pddl import read_files
@@ -37,7 +38,8 @@ def avs_and_ipc_makers() -> list[tuple[str, object]]:
         (problem.stem, lambda p=problem: read_files(AVS_DOMAIN, p))
         for problem in sorted((AVS_DOMAIN.parent / "problems").glob("*.pddl"))
     ]
-    for domain in sorted(IPC.glob("*/domain.pddl")):
+    for name in ipc_domains(solvable=True):
+        domain = IPC / name / "domain.pddl"
         instance = domain.parent / "instance-1.pddl"
         if instance.exists():
             cases.append((domain.parent.name, lambda d=domain, i=instance: ProbabilisticProblem(

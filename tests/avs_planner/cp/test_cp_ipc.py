@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 from unified_planning.engines import PlanGenerationResultStatus
 from unified_planning.engines.plan_validator import SequentialPlanValidator
@@ -15,16 +13,14 @@ from avs_planner.cp.planner import plan
 from avs_planner.cp.search import PlanStatus, SearchOptions
 from avs_planner.pddl.model import ProbabilisticProblem
 from avs_planner.up_engine import to_up_plan
+from tests.ipc import require_ipc
 
-IPC = Path("/work/shared/ipc")
 INSTANCES = [("blocks", 1), ("blocks", 4), ("gripper", 1), ("logistics", 1), ("elevators", 1)]
 get_environment().credits_stream = None
 
 
 def _read(domain: str, n: int):
-    folder = IPC / domain
-    if not folder.is_dir():
-        pytest.skip(f"{folder} not present")
+    folder = require_ipc() / domain
     return PDDLReader().parse_problem(str(folder / "domain.pddl"),
                                       str(folder / f"instance-{n}.pddl"))
 

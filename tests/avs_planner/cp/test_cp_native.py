@@ -18,9 +18,9 @@ from avs_planner.cp.search import PlanStatus, SearchOptions, search
 from avs_planner.cp.symmetry import NO_SYMMETRIES, find_symmetries
 from avs_planner.cp.task import GroundAction, GroundTask
 from avs_planner.errors import PlanningError
+from tests.ipc import require_ipc
 
 ROOT = Path(__file__).resolve().parents[3]
-IPC = Path("/work/shared/ipc")
 needs_native = pytest.mark.skipif(not native.AVAILABLE, reason="native core not built")
 
 
@@ -203,9 +203,7 @@ def test_first_ipc_instance(domain):
 
     from avs_planner.pddl.model import ProbabilisticProblem
 
-    folder = IPC / domain
-    if not folder.is_dir():
-        pytest.skip(f"{folder} not present")
+    folder = require_ipc() / domain
     problem = PDDLReader().parse_problem(str(folder / "domain.pddl"),
                                          str(folder / "instance-1.pddl"))
     task = ground(ProbabilisticProblem(problem))

@@ -12,13 +12,14 @@ from avs_planner.pddl import read_files, read_text
 from avs_planner.pddl.probabilistic import translate_domain
 from avs_planner.pddl.reader import _up_parse
 from avs_planner.pddl.sexpr import parse_sexprs
+from tests.ipc import IPC, NOT_READ_YET
 
 ROOT = Path(__file__).resolve().parents[3]
 AVS = ROOT / "domains" / "avs"
-IPC = Path("/work/shared/ipc")
 IPC_PAIRS = [
     (d, p) for d in sorted(IPC.glob("*/domain.pddl")) for p in sorted(d.parent.glob("instance-*"))
 ]
+READ_PAIRS = [(d, p) for d, p in IPC_PAIRS if d.parent.name not in NOT_READ_YET]
 
 TINY_DOMAIN = """(define (domain tiny)
   (:requirements :strips :typing :negative-preconditions :probabilistic-effects)
@@ -81,7 +82,11 @@ def test_translation_keeps_every_offset() -> None:
     assert translation.text.count("(") == text.count("(") - 3
 
 
-FIRST_IPC = [(d, p) for d, p in IPC_PAIRS if p.name == "instance-1.pddl"]
+FIRST_IPC = [
+    pytest.param(d, p, marks=pytest.mark.xfail(strict=True, reason=f"issue 21: {NOT_READ_YET[n]}"))
+    if (n := d.parent.name) in NOT_READ_YET else pytest.param(d, p)
+    for d, p in IPC_PAIRS if p.name == "instance-1.pddl"
+]
 
 
 def _ids(value: object) -> str:
@@ -97,7 +102,7 @@ def test_ipc_first_instance_loads(domain: Path, problem: Path) -> None:
 
 @pytest.mark.slow
 @pytest.mark.skipif(not IPC.exists(), reason="IPC benchmark set not available")
-@pytest.mark.parametrize(("domain", "problem"), IPC_PAIRS, ids=_ids)
+@pytest.mark.parametrize(("domain", "problem"), READ_PAIRS, ids=_ids)
 def test_every_ipc_instance_loads(domain: Path, problem: Path) -> None:
     task = read_files(domain, problem)
     assert task.problem.actions and task.problem.goals and not task.success
