@@ -15,6 +15,7 @@ from pathlib import Path
 
 from matplotlib.path import Path as MplPath
 
+from avs_planner.body import JointRange, RobotBody
 from avs_planner.episode.errors import EpisodeError
 from sim import World, load_world_spec
 from sim.errors import MotionError, SimError
@@ -59,6 +60,20 @@ class SimRobot:
     def camera_height(self) -> float:
         return float(self.robot.camera_view().origin[2])
 
+    def body(self) -> RobotBody:
+        """The robot's own dimensions, limits and speeds (its URDF and specs, not the world)."""
+        m = self.robot.model
+        t = m.time
+        return RobotBody(
+            name=m.name, footprint_radius=m.footprint_radius, holonomic=m.holonomic,
+            camera_height=self.camera_height - self.robot.torso,
+            torso=JointRange(m.torso.low, m.torso.high), pan=JointRange(m.pan.low, m.pan.high),
+            tilt=JointRange(m.tilt.low, m.tilt.high), hfov=m.camera.hfov, vfov=m.camera.vfov,
+            depth_range=m.camera.depth_range, detect_range=m.camera.detect_range,
+            laser_range=m.laser.max_range, linear_speed=t.linear_speed,
+            angular_speed=t.angular_speed, torso_speed=t.torso_speed, pan_speed=t.pan_speed,
+            tilt_speed=t.tilt_speed, scan_time=t.scan_time, sensing_time=t.sensing_time)
+
     # ---- acting -----------------------------------------------------------------------------
 
     def move_along(self, path: Sequence[tuple[float, float]]) -> bool:
@@ -72,6 +87,11 @@ class SimRobot:
     def turn_to(self, yaw: float) -> None:
         self.robot.turn_to(yaw)
 
+    def set_torso(self, height: float) -> None:
+        """Lift the torso (clipped to its range; a no-op on a robot without one)."""
+        torso = self.robot.model.torso
+        self.robot.set_torso(min(max(height, torso.low), torso.high))
+
     def look(self, pan: float, tilt: float) -> None:
         """Point the camera; angles are clipped to the head's limits."""
         model = self.robot.model
@@ -82,6 +102,10 @@ class SimRobot:
 
     def scan(self):  # noqa: ANN201 - a LaserScan (sensor data class of the simulator)
         return self.robot.scan()
+
+    def depth(self, size: tuple[int, int] = (32, 24)):  # noqa: ANN201 - a DepthScan
+        """A depth frame from the head camera (for the 3D map)."""
+        return self.robot.depth(size)
 
     def detect(self, labels: Sequence[str]) -> list[Seen]:
         frame = self.robot.detect(list(labels))

@@ -1,0 +1,66 @@
+"""The robot's own body as the mind knows it: footprint, sensor mounts, joint limits, speeds.
+
+A real robot knows its URDF; these numbers are not ground truth about the world. The episode
+wiring fills a `RobotBody` from the robot model through the robot adapter (`SimRobot.body`);
+planners (view cones, FLAP view sampling, QSR view selection, path planning, time predictions)
+take it as a parameter and never read the simulator.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class JointRange:
+    """A closed range [low, high] of a joint, in metres or radians."""
+
+    low: float
+    high: float
+
+    def clip(self, value: float) -> float:
+        return min(max(value, self.low), self.high)
+
+    def contains(self, value: float) -> bool:
+        return self.low - 1e-9 <= value <= self.high + 1e-9
+
+
+@dataclass(frozen=True)
+class RobotBody:
+    """Geometry, limits and time model of the robot the mind drives."""
+
+    name: str
+    footprint_radius: float  # m: the base's collision circle
+    holonomic: bool
+    camera_height: float  # m: camera above the floor with the torso at its lowest
+    torso: JointRange  # m of lift above `camera_height` (0..0 without a torso)
+    pan: JointRange  # rad, relative to the base heading
+    tilt: JointRange  # rad, negative looks down
+    hfov: float  # rad
+    vfov: float  # rad
+    depth_range: float  # m
+    detect_range: float  # m: objects are recognised up to here
+    laser_range: float  # m
+    linear_speed: float  # m/s
+    angular_speed: float  # rad/s
+    torso_speed: float  # m/s
+    pan_speed: float  # rad/s
+    tilt_speed: float  # rad/s
+    scan_time: float  # s per laser scan or depth frame
+    sensing_time: float  # s per detection or place classification
+
+    def drive_time(self, distance: float) -> float:
+        return abs(distance) / self.linear_speed
+
+    def turn_time(self, angle: float) -> float:
+        """Seconds to turn in place by `angle` the short way round."""
+        wrapped = (angle + math.pi) % (2 * math.pi) - math.pi
+        return abs(wrapped) / self.angular_speed
+
+    def torso_time(self, delta: float) -> float:
+        return 0.0 if delta == 0.0 else abs(delta) / self.torso_speed
+
+    def head_time(self, delta_pan: float, delta_tilt: float) -> float:
+        """Pan and tilt move together: the slower axis decides."""
+        return max(abs(delta_pan) / self.pan_speed, abs(delta_tilt) / self.tilt_speed)
