@@ -91,9 +91,12 @@ class _BranchAndBound:
     def __init__(self, problem: SequencingProblem, options: PlannerOptions):
         self.p, self.o = problem, options
         self.members = problem.members.astype(np.float64)
+        self.by_atom = np.ascontiguousarray(self.members.T)  # row gathers are cheap
+        self.atoms = [np.flatnonzero(row) for row in problem.members]
         self.threshold = survival_threshold(problem, options.omega)
-        off = problem.times[~np.eye(problem.size, dtype=bool)]
-        self.t_min = float(min(off.min(), problem.start.min())) if off.size else 0.0
+        off = np.where(np.eye(problem.size, dtype=bool), np.inf, problem.times)
+        self.row_min = off.min(axis=1)  # fastest way on from each view
+        self.t_min = float(self.row_min.min()) if problem.size > 1 else 0.0
         self.best: tuple[float, tuple[int, ...], float] = (math.inf, (), 0.0)
         self.nodes, self.path = 0, []
 
@@ -123,15 +126,27 @@ class _BranchAndBound:
                 self.best = (cost, tuple(self.path), survive)
             return
         row = self.p.start if last < 0 else self.p.times[last]
+        g_max = float(gain.max())
         for view in self._children(gain, row, len(self.path)):
             step_cost = cost + survive * row[view]
             after = survive * math.exp(-gain[view])
-            bound = step_cost + (after * self.t_min if after >= self.threshold else 0.0)
-            if bound >= self.best[0]:
+            if step_cost + self._still_to_pay(view, after, g_max) >= self.best[0]:
                 continue
             self.path.append(int(view))
             self._visit(*self._apply(gain, rest, view), int(view), step_cost, after)
             self.path.pop()
+
+    def _still_to_pay(self, view: int, survive: float, g_max: float) -> float:
+        """Admissible bound on the rest of E[T]: no view gains more than g_max from now on,
+        so at least K more steps are needed, each costing at least t_min while unfinished."""
+        if survive < self.threshold:
+            return 0.0
+        if g_max <= _EPS:
+            return math.inf
+        steps = math.ceil(math.log(survive / self.threshold) / g_max + 1e-12)
+        decay = math.exp(-g_max)
+        rest = (1.0 - decay ** (steps - 1)) / (1.0 - decay) if steps > 1 and decay < 1 else 0.0
+        return survive * (self.row_min[view] + self.t_min * decay * rest)
 
     def _children(self, gain: np.ndarray, row: np.ndarray, depth: int) -> np.ndarray:
         """Views worth appending, best utility first (eq. 6, 7; psi and phi)."""
@@ -154,8 +169,9 @@ class _BranchAndBound:
         self, gain: np.ndarray, rest: np.ndarray, view: int
     ) -> tuple[np.ndarray, np.ndarray]:
         """Gains and unseen weights after `view` (set difference: only its new atoms)."""
-        new = np.flatnonzero(self.p.members[view] & (rest > 0.0))
-        gain = np.maximum(gain - self.members[:, new] @ rest[new], 0.0)
+        mine = self.atoms[view]
+        new = mine[rest[mine] > 0.0]
+        gain = np.maximum(gain - rest[new] @ self.by_atom[new], 0.0)
         rest = rest.copy()
         rest[new] = 0.0
         return gain, rest

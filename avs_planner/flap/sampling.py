@@ -99,6 +99,17 @@ class ViewSampler:
             views.extend(self._batch(rng)[: count - len(views)])
         return views
 
+    def evaluate(self, views: list[View]) -> list[View]:
+        """The same poses with the cells they would see in the current map (views kept from
+        the last plan are re-evaluated each cycle); views that see nothing are dropped."""
+        if not views:
+            return []
+        poses = [v.pose for v in views]
+        seen = visible_cells(self.cast, _cameras(poses, self.body), (self.body.hfov,
+                             self.body.vfov), self.max_range, self.options.rays, self.options.step)
+        return [View(v.pose, v.target, c) for v, c in zip(views, seen, strict=True)
+                if c.size >= self.options.min_cells]
+
     def _batch(self, rng: np.random.Generator) -> list[View]:
         poses, targets = self.propose(self.options.batch, rng)
         if not poses:
