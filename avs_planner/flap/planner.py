@@ -37,8 +37,8 @@ class PlannerOptions:
     """xi: prune dominated views; psi: branching depth; phi: branch factor; omega: eq. 9."""
 
     xi: bool = True
-    psi: int = 3
-    phi: float = 1.5
+    psi: int = 6
+    phi: float = 3.0
     omega: float = 0.05
     max_nodes: int | None = 200_000
     time_limit: float | None = None
