@@ -21,6 +21,7 @@ from avs_planner.flap.errors import FlapError
 from avs_planner.flap.problem import SequencingProblem, survival_threshold
 
 _EPS = 1e-12
+_MEMO_CAP = 2_000_000  # partial plans remembered for exact duplicate pruning
 
 
 class StopReason(Enum):
@@ -99,6 +100,7 @@ class _BranchAndBound:
         self.t_min = float(self.row_min.min()) if problem.size > 1 else 0.0
         self.best: tuple[float, tuple[int, ...], float] = (math.inf, (), 0.0)
         self.nodes, self.path = 0, []
+        self.memo: dict[tuple[frozenset[int], int], float] = {}
 
     def run(self) -> PlanResult:
         began = time.perf_counter()
@@ -121,6 +123,8 @@ class _BranchAndBound:
         """Extend the partial plan self.path: `gain` per view and `rest` per atom are the
         weights not yet seen, `cost` is E[T] so far and `survive` is 1 - p(L)."""
         self._count()
+        if self._reached_cheaper(last, cost):
+            return
         if survive < self.threshold:
             if cost < self.best[0]:
                 self.best = (cost, tuple(self.path), survive)
@@ -135,6 +139,20 @@ class _BranchAndBound:
             self.path.append(int(view))
             self._visit(*self._apply(gain, rest, view), int(view), step_cost, after)
             self.path.pop()
+
+    def _reached_cheaper(self, last: int, cost: float) -> bool:
+        """True if the same set of views, ending at the same view, was already reached at no
+        more cost: the rest of the search from there is identical (same p(L)), so this
+        ordering cannot win. Exact pruning; the table is capped to bound memory."""
+        if len(self.path) < 2:
+            return False
+        key = (frozenset(self.path), last)
+        seen = self.memo.get(key)
+        if seen is not None and seen <= cost:
+            return True
+        if seen is not None or len(self.memo) < _MEMO_CAP:
+            self.memo[key] = cost
+        return False
 
     def _still_to_pay(self, view: int, survive: float, g_max: float) -> float:
         """Admissible bound on the rest of E[T]: no view gains more than g_max from now on,
