@@ -66,6 +66,9 @@ class PlanResult:
     stop: StopReason
     seconds: float
 
+    # An empty sequence with an infinite expected time: a limit struck before the first
+    # complete plan (the first dive is the greedy one, so give it at least its length).
+
     @property
     def next_view(self) -> int | None:
         """The view to go to now (continual planning executes only this one)."""

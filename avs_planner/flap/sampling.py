@@ -1,10 +1,12 @@
 """Frontier-based view sampling (FLAP §3.1): anytime sampling of views aimed at target cells.
 
 A view is a robot pose (base x, y, yaw; torso lift; head pan, tilt) pointing the camera at a
-random frontier cell of the search region, with the set of region cells it would see. Poses are
-drawn inside the constraint network, not rejected after the fact: the torso lift fixes the
-camera height, which with range and tilt limits bounds the horizontal distance; the azimuth is
-drawn on the known side of the frontier. The base must fit on the 2D grid (footprint clear).
+random frontier cell of the search region, with the set of region cells it would see. Most
+constraints shape the draw (the seed's local consistency, so few samples are rejected): the
+torso lift fixes the camera height, which with the range band and tilt limits bounds the
+horizontal distance, and the azimuth is drawn on the known side of a sideways frontier. The
+frontier-normal test (< 90 degrees) and the footprint test on the 2D grid are then checked for
+the whole batch at once.
 """
 
 from __future__ import annotations
@@ -126,8 +128,7 @@ class ViewSampler:
         b = self.body
         pick = rng.integers(self.targets.shape[0], size=n)
         f, normal = self.targets[pick], self.normals[pick]
-        lift = rng.uniform(b.torso.low, b.torso.high, n) if b.torso.high > b.torso.low \
-            else np.full(n, b.torso.low)
+        lift = rng.uniform(b.torso.low, b.torso.high, n)  # numpy allows low == high
         dz = f[:, 2] - (b.camera_height + lift)
         r_lo, r_hi = self._distance_band(dz)
         r = rng.uniform(0.0, 1.0, n) * (r_hi - r_lo) + r_lo
