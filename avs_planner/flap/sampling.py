@@ -201,8 +201,9 @@ class ViewSampler:
         codes = self.belief.unknown_lookup(self.voxels)
         occupied = self.voxels.states().reshape(-1) == CellState.OCCUPIED
         codes[occupied] = OCCUPIED
-        lo = np.min([v.lo for v in self.belief.volumes], axis=0)
-        hi = np.max([v.hi for v in self.belief.volumes], axis=0)
+        top = self.voxels.origin + np.asarray(self.voxels.shape) * self.voxels.resolution
+        lo = np.maximum(np.min([v.lo for v in self.belief.volumes], axis=0), self.voxels.origin)
+        hi = np.minimum(np.max([v.hi for v in self.belief.volumes], axis=0), top - 1e-6)
         return CastGrid(codes, self.voxels.shape, self.voxels.origin.copy(),
                         self.voxels.resolution, lo, hi)
 

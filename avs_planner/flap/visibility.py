@@ -54,12 +54,12 @@ def visible_cells(
     live = np.nonzero(t_end > 0)[0]
     live = live[np.argsort(t_end[live])]  # similar lengths march together
     width = max(1, int(grid.codes.max()) + 1)
-    keys = [np.zeros(0, dtype=np.int64)]
+    hit = np.zeros(n_views * width, dtype=bool)  # (view, region cell) pairs seen
     for chunk in np.array_split(live, _CHUNKS) if live.size else []:
         codes, seen = _march(grid, cams.origins[view[chunk]], dirs.reshape(-1, 3)[chunk],
                              t_end[chunk], step * grid.resolution)
-        keys.append(view[chunk][:, None].repeat(codes.shape[1], 1)[seen] * width + codes[seen])
-    return _split_by_view(np.unique(np.concatenate(keys)), width, n_views)
+        hit[view[chunk][:, None].repeat(codes.shape[1], 1)[seen] * width + codes[seen]] = True
+    return _split_by_view(np.flatnonzero(hit), width, n_views)
 
 
 def _march(
@@ -68,7 +68,10 @@ def _march(
     """Codes (N, S) sampled every h metres along each ray, and which samples it sees."""
     steps = int(np.ceil(t_end.max() / h)) if t_end.size else 0
     t = (np.arange(steps, dtype=np.float32) + 0.5) * np.float32(h)
-    codes = _sample_codes(grid, origins, dirs, t)
+    if _inside_map(grid, origins):  # then every sample up to the region's exit is too
+        codes = _sample_codes_inside(grid, origins, dirs, np.minimum(t[None, :], t_end[:, None]))
+    else:
+        codes = _sample_codes(grid, origins, dirs, t)
     blocked = np.logical_or.accumulate(codes == OCCUPIED, axis=1)
     return codes, (t[None, :] < t_end[:, None]) & ~blocked & (codes >= 0)
 
@@ -90,7 +93,7 @@ def _ray_directions(
     az = az_lo[:, None] + (az_hi - az_lo)[:, None] * uu[None, :]
     el = el_lo[:, None] + (el_hi - el_lo)[:, None] * vv[None, :]
     local = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=-1)
-    return np.einsum("vij,vrj->vri", _rotations(cams), local).astype(np.float32)
+    return np.matmul(local, _rotations(cams).transpose(0, 2, 1)).astype(np.float32)
 
 
 def _rotations(cams: Cameras) -> np.ndarray:
@@ -115,7 +118,7 @@ def _region_window(
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
                         for z in (lo[2], hi[2])])  # fmt: skip
     rel = corners[None, :, :] - cams.origins[:, None, :]
-    local = np.einsum("vji,vcj->vci", _rotations(cams), rel)  # world -> camera
+    local = np.matmul(rel, _rotations(cams))  # world -> camera
     ahead = local[..., 0] > 1e-3
     az = np.arctan2(local[..., 1], local[..., 0])
     el = np.arctan2(local[..., 2], np.hypot(local[..., 0], local[..., 1]))
@@ -142,6 +145,30 @@ def _exit_distance(
     far = np.maximum(t1, t2).min(axis=2)
     far = np.where(far >= np.maximum(near, 0.0), far, 0.0)  # rays missing the box: nothing
     return np.minimum(far, max_range).astype(np.float32)
+
+
+def _inside_map(grid: CastGrid, points: np.ndarray) -> bool:
+    cells = np.floor((points - grid.origin) / grid.resolution)
+    return bool(np.all((cells >= 0) & (cells < np.asarray(grid.shape))))
+
+
+def _sample_codes_inside(
+    grid: CastGrid, origins: np.ndarray, dirs: np.ndarray, t: np.ndarray
+) -> np.ndarray:
+    """Lookup codes (N, S) at distances t (N, S) along rays whose samples all lie in the map
+    (segments from a camera inside the map to points of the region box, which is too)."""
+    scale = np.float32(1.0 / grid.resolution)
+    start = ((origins - grid.origin) * scale).astype(np.float32)
+    ts = t * scale
+    flat = np.zeros(t.shape, dtype=np.int32)
+    stride = 1
+    for axis in (2, 1, 0):
+        cell = (start[:, None, axis] + dirs[:, None, axis] * ts).astype(np.int32)
+        np.minimum(cell, grid.shape[axis] - 1, out=cell)  # a point on the far face
+        cell *= stride
+        flat += cell
+        stride *= grid.shape[axis]
+    return grid.codes[flat]
 
 
 def _sample_codes(
