@@ -62,6 +62,7 @@ class SamplerOptions:
     step: float = 0.7  # ray marching step in cells
     batch: int = 64
     min_cells: int = 1
+    max_batches: int = 500  # gives up on a region almost nothing can see, even without timeout
 
 
 class ViewSampler:
@@ -96,8 +97,8 @@ class ViewSampler:
             if timeout is not None and time.perf_counter() - began > timeout:
                 break
             attempts += 1
-            if attempts > 50 and not views:
-                break  # nothing can be seen from anywhere the robot fits
+            if attempts > self.options.max_batches or (attempts > 50 and not views):
+                break  # (almost) nothing can be seen from anywhere the robot fits
             views.extend(self._batch(rng)[: count - len(views)])
         return views
 
