@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from enum import Enum
 
 import numpy as np
+from scipy import sparse
 
 from avs_planner.flap.errors import FlapError
 from avs_planner.flap.problem import SequencingProblem, survival_threshold
@@ -95,8 +96,8 @@ class _BranchAndBound:
     def __init__(self, problem: SequencingProblem, options: PlannerOptions):
         self.p, self.o = problem, options
         self.members = problem.members.astype(np.float64)
-        self.by_atom = np.ascontiguousarray(self.members.T)  # row gathers are cheap
         self.atoms = [np.flatnonzero(row) for row in problem.members]
+        self.overlaps: dict[int, sparse.csr_matrix] = {}
         self.threshold = survival_threshold(problem, options.omega)
         off = np.where(np.eye(problem.size, dtype=bool), np.inf, problem.times)
         self.row_min = off.min(axis=1)  # fastest way on from each view
@@ -189,13 +190,19 @@ class _BranchAndBound:
     def _apply(
         self, gain: np.ndarray, rest: np.ndarray, view: int
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Gains and unseen weights after `view` (set difference: only its new atoms)."""
+        """Gains and unseen weights after `view` (set difference: only its atoms count)."""
         mine = self.atoms[view]
-        new = mine[rest[mine] > 0.0]
-        gain = np.maximum(gain - rest[new] @ self.by_atom[new], 0.0)
+        gain = np.maximum(gain - self._overlap(view) @ rest[mine], 0.0)
         rest = rest.copy()
-        rest[new] = 0.0
+        rest[mine] = 0.0
         return gain, rest
+
+    def _overlap(self, view: int) -> sparse.csr_matrix:
+        """Which views share each of `view`'s atoms, sparse (n, atoms of view), built once."""
+        if view not in self.overlaps:
+            self.overlaps[view] = sparse.csr_matrix(self.p.members[:, self.atoms[view]],
+                                                    dtype=np.float64)  # fmt: skip
+        return self.overlaps[view]
 
     def _count(self) -> None:
         self.nodes += 1
