@@ -165,7 +165,7 @@ class _BranchAndBound:
             return 0.0
         if g_max <= _EPS:
             return math.inf
-        steps = math.ceil(math.log(survive / self.threshold) / g_max + 1e-12)
+        steps = math.ceil(math.log(survive / self.threshold) / g_max)  # never too many
         decay = math.exp(-g_max)
         rest = (1.0 - decay ** (steps - 1)) / (1.0 - decay) if steps > 1 and decay < 1 else 0.0
         return survive * (self.row_min[view] + self.t_min * decay * rest)

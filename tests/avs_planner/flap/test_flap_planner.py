@@ -84,6 +84,7 @@ def test_default_planner_within_two_percent_on_room_instances(scene, belief) -> 
     for _ in range(8):
         problem = full.subset(rng.choice(full.size, 7, replace=False))
         best = plan_exhaustive(problem).expected_time
+        assert plan_views(problem, EXACT).expected_time == pytest.approx(best, rel=1e-12)
         gaps.append(plan_views(problem).expected_time / best - 1.0)
     assert min(gaps) >= -1e-12 and np.mean(gaps) <= 0.02
 
