@@ -107,22 +107,21 @@ class ViewSampler:
         the last plan are re-evaluated each cycle); views that see nothing are dropped."""
         if not views:
             return []
-        poses = [v.pose for v in views]
-        seen = visible_cells(self.cast, _cameras(poses, self.body), (self.body.hfov,
-                             self.body.vfov), self.max_range, self.options.rays, self.options.step)
-        return [View(v.pose, v.target, c) for v, c in zip(views, seen, strict=True)
-                if c.size >= self.options.min_cells]
+        return self._views([v.pose for v in views], [v.target for v in views])
 
     def _batch(self, rng: np.random.Generator) -> list[View]:
         poses, targets = self.propose(self.options.batch, rng)
         if not poses:
             return []
-        cams = _cameras(poses, self.body)
+        return self._views(poses, [tuple(t) for t in targets.tolist()])
+
+    def _views(self, poses: list[ViewPose], targets: list[tuple[float, ...]]) -> list[View]:
+        """Ray-cast a batch of poses; keep those that see at least `min_cells` cells."""
         fov = (self.body.hfov, self.body.vfov)
-        seen = visible_cells(self.cast, cams, fov, self.max_range, self.options.rays,
-                             self.options.step)
-        return [View(p, tuple(t), c) for p, t, c in zip(poses, targets.tolist(), seen, strict=True)
-                if c.size >= self.options.min_cells]
+        seen = visible_cells(self.cast, _cameras(poses, self.body), fov, self.max_range,
+                             self.options.rays, self.options.step)  # fmt: skip
+        return [View(p, t, c) for p, t, c in zip(poses, targets, seen, strict=True)
+                if c.size >= self.options.min_cells]  # fmt: skip
 
     def propose(self, n: int, rng: np.random.Generator) -> tuple[list[ViewPose], np.ndarray]:
         """Up to n poses meeting every constraint, and their target points (world)."""
