@@ -7,6 +7,7 @@ A door is closed only if every room stays reachable through open doors from ever
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -114,16 +115,32 @@ def _doors(rng: np.random.Generator, rooms: list[RoomPlan], style: StyleRule) ->
     for room in rooms[1:]:
         host = hosts.get(room.name)
         if host is None:
-            doors += _spine_doors(rng, spine, room, style)
+            two = (room.rect[2] - room.rect[0] >= _SECOND_DOOR_MIN_WIDTH
+                   and rng.random() < style.extra_door_share)
+            doors += _spine_doors(rng, spine, room, two, DOOR_WIDTH[1])
         else:
             doors.append(_side_door(rng, room, host))
     linked = {frozenset(d.rooms) for d in doors}
     pairs = [(a, b) for a, b in _neighbours(rooms) if frozenset((a.name, b.name)) not in linked]
-    extra = [p for p in pairs if rng.random() < style.extra_door_share]
-    if pairs and not extra and not any(_spine_door_count(doors, r) > 1 for r in rooms[1:]):
-        extra = [pairs[int(rng.integers(len(pairs)))]]  # at least one closable door
-    doors += [_side_door(rng, a, b) for a, b in extra]
+    doors += [_side_door(rng, a, b) for a, b in pairs if rng.random() < style.extra_door_share]
+    if len(doors) < len(rooms):  # a tree: add one door, so that one can be closed
+        doors += _extra_door(rng, rooms, pairs, hosts)
     return doors
+
+
+def _extra_door(rng: np.random.Generator, rooms: list[RoomPlan],
+                pairs: list[tuple[RoomPlan, RoomPlan]],
+                hosts: dict[str, RoomPlan]) -> list[DoorPlan]:
+    """A door closing a loop: between two neighbours, or a second one to the spine."""
+    if pairs:
+        return [_side_door(rng, *pairs[int(rng.integers(len(pairs)))])]
+    outer = [r for r in rooms[1:] if r.name not in hosts]
+    widest = max(outer, key=lambda r: r.rect[2] - r.rect[0])
+    half = (widest.rect[2] - widest.rect[0]) / 2
+    if half - 2 * DOOR_END_MARGIN < DOOR_WIDTH[0]:
+        return []
+    return _spine_doors(rng, rooms[0], widest, True, min(DOOR_WIDTH[1],
+                                                          half - 2 * DOOR_END_MARGIN))[1:]
 
 
 def _inner_rooms(rng: np.random.Generator, rooms: list[RoomPlan],
@@ -148,20 +165,16 @@ def _neighbours(rooms: list[RoomPlan]) -> list[tuple[RoomPlan, RoomPlan]]:
             if a.row == b.row and abs(a.rect[2] - b.rect[0]) < 1e-9]
 
 
-def _spine_door_count(doors: list[DoorPlan], room: RoomPlan) -> int:
-    return sum(1 for d in doors if room.name in d.rooms and d.axis == "y")
-
-
-def _spine_doors(rng: np.random.Generator, spine: RoomPlan, room: RoomPlan,
-                 style: StyleRule) -> list[DoorPlan]:
-    """A door (two, for some wide rooms) in the wall a room shares with the spine."""
+def _spine_doors(rng: np.random.Generator, spine: RoomPlan, room: RoomPlan, two: bool,
+                 widest: float) -> list[DoorPlan]:
+    """A door (or two, one in each half) in the wall a room shares with the spine."""
     x0, _, x1, _ = room.rect
     line = room.rect[1] if room.row == 1 else room.rect[3]
-    two = x1 - x0 >= _SECOND_DOOR_MIN_WIDTH and rng.random() < style.extra_door_share
     spans = [(x0, (x0 + x1) / 2), ((x0 + x1) / 2, x1)] if two else [(x0, x1)]
     doors = []
     for lo, hi in spans:
-        width = snap(rng.uniform(*DOOR_WIDTH))
+        width = min(snap(rng.uniform(DOOR_WIDTH[0], widest)),
+                    round(math.floor(widest / GRID + 1e-9) * GRID, 2))
         x = _door_centre(rng, lo, hi, width)
         doors.append(DoorPlan((spine.name, room.name), (x, line), width, "y"))
     return doors
