@@ -92,20 +92,27 @@ def _possible(table: PlacementTable, category: str, unusual: bool, here: list[Pi
 
 def _choose_surprises(rng: np.random.Generator, slots: list[_Slot],
                       share: float) -> list[tuple[_Slot, bool]]:
-    """Mark round(share * slots) slots unusual (random rounding), only where that is possible.
+    """Mark a share of the slots unusual (random rounding, so the mean is exact).
 
-    Slots that allow only an unusual placement count toward the surprises; if there are more of
-    them than surprises wanted, the extra ones are dropped rather than filled.
+    A slot that allows only usual (or only unusual) placements cannot be switched; when there
+    are too many of them for the share, some of them are left empty instead.
     """
-    wanted = math.floor(share * len(slots))
-    wanted += int(rng.random() < share * len(slots) - wanted)
-    forced = [i for i, s in enumerate(slots) if not s.usual]
-    optional = [i for i, s in enumerate(slots) if s.usual and s.unusual]
-    rng.shuffle(forced)
-    rng.shuffle(optional)
-    chosen = set(forced[:wanted]) | set(optional[:max(0, wanted - len(forced))])
-    dropped = set(forced[wanted:])
-    return [(s, i in chosen) for i, s in enumerate(slots) if i not in dropped]
+    order = [int(i) for i in rng.permutation(len(slots))]
+    only_usual = [i for i in order if not slots[i].unusual]
+    only_unusual = [i for i in order if not slots[i].usual]
+    both = [i for i in order if slots[i].usual and slots[i].unusual]
+    fixed = len(only_unusual) + len(both)
+    if share > 0 and share * (len(only_usual) + fixed) > fixed:
+        only_usual = only_usual[:math.floor(fixed * (1 - share) / share + 1e-9)]
+    free = len(only_usual) + len(both)
+    if share < 1 and share * (free + len(only_unusual)) < len(only_unusual):
+        only_unusual = only_unusual[:math.floor(share * free / (1 - share) + 1e-9)]
+    total = len(only_usual) + len(only_unusual) + len(both)
+    wanted = math.floor(share * total)
+    wanted += int(rng.random() < share * total - wanted)
+    chosen = set(only_unusual) | set(both[:max(0, wanted - len(only_unusual))])
+    kept = sorted(only_usual + only_unusual + both)
+    return [(slots[i], i in chosen) for i in kept]
 
 
 def _fits(support: Piece, size: tuple[float, float, float]) -> bool:
