@@ -220,6 +220,7 @@ def _relation(knowledge: Knowledge, label: str, support: str, category: str) -> 
 def test_categories_and_labels_are_the_knowledge_files(
         specs: list[WorldSpec], knowledge: Knowledge) -> None:
     table = placement_table()
+    assert tuple(table.styles) == STYLES
     assert set(CATEGORIES) <= set(knowledge.categories)
     assert set(table.rooms) | {"corridor"} <= set(CATEGORIES)
     furniture = {f.label for rule in table.rooms.values() for f in rule.furniture}
@@ -254,3 +255,12 @@ def test_rooms_differ_in_size_and_aspect(specs: list[WorldSpec]) -> None:
     areas = [(r.rect[2] - r.rect[0]) * (r.rect[3] - r.rect[1]) for r in rooms]
     aspects = [(r.rect[2] - r.rect[0]) / (r.rect[3] - r.rect[1]) for r in rooms]
     assert max(areas) / min(areas) > 3 and min(aspects) < 0.7 and max(aspects) > 1.3
+
+
+def test_the_yaml_header_regenerates_the_world() -> None:
+    world = generate_world(11, "apartment", surprise=0.4)
+    header = world.yaml().splitlines()[0]
+    rooms = len(world.data["rooms"]) - 1
+    assert header.endswith(f"--seed 11 --style apartment --rooms {rooms} --surprise 0.4 "
+                           "--robot pioneer")
+    assert generate_world(11, "apartment", rooms=rooms, surprise=0.4).yaml() == world.yaml()

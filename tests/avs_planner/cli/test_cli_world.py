@@ -7,7 +7,8 @@ from pathlib import Path
 import pytest
 
 from avs_planner.cli import main
-from sim.generate import generate_world
+from avs_planner.cli.world import _STYLES
+from sim.generate import STYLES, generate_world
 from sim.world_file import load_world_spec
 
 
@@ -57,3 +58,7 @@ def test_an_unwritable_output_is_bad_input(
     out = tmp_path / "missing" / "w.yaml"
     assert main(["world", "generate", "--seed", "1", "--out", str(out)]) == 1
     assert "cannot write" in capsys.readouterr().err
+
+
+def test_the_style_choices_are_the_generators() -> None:
+    assert _STYLES == STYLES
