@@ -80,11 +80,14 @@ def plan_layout(rng: np.random.Generator, table: PlacementTable, style: StyleRul
 
 
 def _categories(rng: np.random.Generator, style: StyleRule, count: int) -> list[str]:
-    """The style's required categories (as many as fit), the rest drawn by weight, shuffled."""
+    """The style's required categories (as many as fit), the rest drawn by weight (up to each
+    category's cap), shuffled."""
     chosen = list(style.required[:count])
-    names = list(style.categories)
-    weights = np.array([style.categories[c] for c in names])
-    chosen += [str(c) for c in rng.choice(names, count - len(chosen), p=weights / weights.sum())]
+    while len(chosen) < count:
+        names = [c for c in style.categories
+                 if chosen.count(c) < style.at_most.get(c, count)]
+        weights = np.array([style.categories[c] for c in names])
+        chosen.append(str(rng.choice(names, p=weights / weights.sum())))
     return [chosen[i] for i in rng.permutation(len(chosen))]
 
 

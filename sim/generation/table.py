@@ -36,6 +36,7 @@ class StyleRule:
     row_depth: Range
     categories: dict[str, float]
     required: tuple[str, ...]
+    at_most: dict[str, int]
     inner_share: float
     extra_door_share: float
     closed_share: float
@@ -128,7 +129,9 @@ def _style(name: str, s: dict[str, Any]) -> StyleRule:
         spine=str(s["spine"]), spine_width=_pair(s["spine_width"]),
         row_depth=_pair(s["row_depth"]),
         categories={str(c): float(w) for c, w in s["categories"].items()},
-        required=tuple(s["required"]), inner_share=float(s["inner_share"]),
+        required=tuple(s["required"]),
+        at_most={str(c): int(n) for c, n in s.get("at_most", {}).items()},
+        inner_share=float(s["inner_share"]),
         extra_door_share=float(s["extra_door_share"]), closed_share=float(s["closed_share"]),
     )
 
@@ -163,7 +166,11 @@ def _triple(value: Any) -> tuple[float, float, float]:
 def _validate(table: PlacementTable, source: str) -> None:
     """Categories from the vocabulary, known supports and labels, wall/free placement."""
     for style in table.styles.values():
-        for cat in (*style.categories, *style.required):
+        uncapped = [c for c in style.categories if c not in style.at_most]
+        if not uncapped:
+            raise GenerationError(f"{source}: styles.{style.name}: every category is capped "
+                                  "by at_most; leave one uncapped")
+        for cat in (*style.categories, *style.required, *style.at_most):
             if cat not in table.rooms or cat not in CATEGORIES:
                 raise GenerationError(f"{source}: styles.{style.name}: unknown category {cat!r}")
     for rule in table.rooms.values():

@@ -87,14 +87,18 @@ def test_each_style_has_its_spine_categories_and_room_counts(style: str) -> None
         categories = [r.category for r in rooms]
         assert set(categories) <= set(rule.categories)
         assert set(rule.required[:len(rooms)]) <= set(categories)
+        assert all(categories.count(c) <= n for c, n in rule.at_most.items())
 
 
 @pytest.mark.parametrize(("style", "rooms"),
                          [("office", 3), ("office", 12), ("apartment", 8), ("lab", 10)])
 def test_rooms_k_is_honoured(style: str, rooms: int) -> None:
+    rule = placement_table().styles[style]
     for seed in range(3):
         spec = generate_world(seed, style, rooms=rooms).spec()
         assert len(spec.rooms) == rooms + 1  # the spine is extra
+        categories = [r.category for r in spec.rooms[1:]]
+        assert all(categories.count(c) <= n for c, n in rule.at_most.items())
 
 
 @pytest.mark.parametrize(("kwargs", "message"), [
