@@ -32,6 +32,8 @@ from sim.world_spec import WorldSpec
 
 STYLES = ("office", "apartment", "lab")
 WITHHELD_LABELS = 2  # small-object labels kept out of every world, so some are always absent
+MIN_PRESENT_LABELS = 2  # different small-object labels a world should hold (benchmark targets)
+PLACEMENT_ATTEMPTS = 10
 WALL_HEIGHT = 2.0
 
 
@@ -84,13 +86,24 @@ def generate_world(seed: int, style: str = "office", rooms: int | None = None,
     count = drawn if rooms is None else rooms  # drawn either way: --rooms K of a drawn K agrees
     layout = plan_layout(rng, table, rule, count)
     pieces = furnish(rng, layout, table)
-    withheld = frozenset(str(x) for x in rng.choice(table.object_labels, WITHHELD_LABELS,
-                                                    replace=False))
-    objects = place_objects(rng, table, layout, pieces, surprise, withheld)
+    objects = _small_objects(rng, table, layout, pieces, surprise)
     start = _start(rng, layout, pieces)
     data = world_data(f"{style}_{seed}", layout, pieces, objects, robot, start)
     return GeneratedWorld(data, seed, style, tuple(o.name for o in objects if o.unusual),
                           float(surprise))
+
+
+def _small_objects(rng: np.random.Generator, table: PlacementTable, layout: Layout,
+                   pieces: list[Piece], surprise: float) -> list[SmallObject]:
+    """Small objects with WITHHELD_LABELS labels kept out, drawn again (a few times at most)
+    until at least MIN_PRESENT_LABELS different labels are in the world."""
+    for _ in range(PLACEMENT_ATTEMPTS):
+        withheld = frozenset(str(x) for x in rng.choice(table.object_labels, WITHHELD_LABELS,
+                                                        replace=False))
+        objects = place_objects(rng, table, layout, pieces, surprise, withheld)
+        if len({o.label for o in objects}) >= MIN_PRESENT_LABELS:
+            break
+    return objects
 
 
 def _check_arguments(table: PlacementTable, seed: int, style: str, rooms: int | None,

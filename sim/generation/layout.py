@@ -120,30 +120,42 @@ def _doors(rng: np.random.Generator, rooms: list[RoomPlan], style: StyleRule) ->
         if host is None:
             two = (room.rect[2] - room.rect[0] >= _SECOND_DOOR_MIN_WIDTH
                    and rng.random() < style.extra_door_share)
-            doors += _spine_doors(rng, spine, room, two, DOOR_WIDTH[1])
+            doors += _spine_doors(rng, spine, room, two)
         else:
             doors.append(_side_door(rng, room, host))
     linked = {frozenset(d.rooms) for d in doors}
     pairs = [(a, b) for a, b in _neighbours(rooms) if frozenset((a.name, b.name)) not in linked]
     doors += [_side_door(rng, a, b) for a, b in pairs if rng.random() < style.extra_door_share]
     if len(doors) < len(rooms):  # a tree: add one door, so that one can be closed
-        doors += _extra_door(rng, rooms, pairs, hosts)
+        doors += _extra_door(rng, rooms, pairs, doors)
     return doors
 
 
 def _extra_door(rng: np.random.Generator, rooms: list[RoomPlan],
-                pairs: list[tuple[RoomPlan, RoomPlan]],
-                hosts: dict[str, RoomPlan]) -> list[DoorPlan]:
-    """A door closing a loop: between two neighbours, or a second one to the spine."""
+                pairs: list[tuple[RoomPlan, RoomPlan]], doors: list[DoorPlan]) -> list[DoorPlan]:
+    """A door closing a loop: between two neighbours, or a second one to the spine beside the
+    first (on the longer free stretch of that wall, if a door fits there)."""
     if pairs:
         return [_side_door(rng, *pairs[int(rng.integers(len(pairs)))])]
-    outer = [r for r in rooms[1:] if r.name not in hosts]
-    widest = max(outer, key=lambda r: r.rect[2] - r.rect[0])
-    half = (widest.rect[2] - widest.rect[0]) / 2
-    if half - 2 * DOOR_END_MARGIN < DOOR_WIDTH[0]:
+    options = []
+    for door in (d for d in doors if d.axis == "y"):
+        room = next(r for r in rooms if r.name == door.rooms[1])
+        x0, x1 = room.rect[0], room.rect[2]
+        lo, hi = door.at[0] - door.width / 2, door.at[0] + door.width / 2
+        options += [(room, a, b) for a, b in ((x0, lo), (hi, x1))
+                    if b - a - 2 * DOOR_END_MARGIN >= DOOR_WIDTH[0]]
+    if not options:
         return []
-    return _spine_doors(rng, rooms[0], widest, True, min(DOOR_WIDTH[1],
-                                                          half - 2 * DOOR_END_MARGIN))[1:]
+    room, lo, hi = options[int(rng.integers(len(options)))]
+    widest = min(DOOR_WIDTH[1], hi - lo - 2 * DOOR_END_MARGIN)
+    width = min(snap(rng.uniform(DOOR_WIDTH[0], widest)), _floor_grid(widest))
+    line = room.rect[1] if room.row == 1 else room.rect[3]
+    return [DoorPlan((rooms[0].name, room.name), (_door_centre(rng, lo, hi, width), line),
+                     width, "y")]
+
+
+def _floor_grid(value: float) -> float:
+    return round(math.floor(value / GRID + 1e-9) * GRID, 2)
 
 
 def _inner_rooms(rng: np.random.Generator, rooms: list[RoomPlan],
@@ -168,16 +180,15 @@ def _neighbours(rooms: list[RoomPlan]) -> list[tuple[RoomPlan, RoomPlan]]:
             if a.row == b.row and abs(a.rect[2] - b.rect[0]) < 1e-9]
 
 
-def _spine_doors(rng: np.random.Generator, spine: RoomPlan, room: RoomPlan, two: bool,
-                 widest: float) -> list[DoorPlan]:
+def _spine_doors(rng: np.random.Generator, spine: RoomPlan, room: RoomPlan,
+                 two: bool) -> list[DoorPlan]:
     """A door (or two, one in each half) in the wall a room shares with the spine."""
     x0, _, x1, _ = room.rect
     line = room.rect[1] if room.row == 1 else room.rect[3]
     spans = [(x0, (x0 + x1) / 2), ((x0 + x1) / 2, x1)] if two else [(x0, x1)]
     doors = []
     for lo, hi in spans:
-        width = min(snap(rng.uniform(DOOR_WIDTH[0], widest)),
-                    round(math.floor(widest / GRID + 1e-9) * GRID, 2))
+        width = snap(rng.uniform(*DOOR_WIDTH))
         x = _door_centre(rng, lo, hi, width)
         doors.append(DoorPlan((spine.name, room.name), (x, line), width, "y"))
     return doors

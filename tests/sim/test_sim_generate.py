@@ -14,6 +14,7 @@ from sim.generate import STYLES, GeneratedWorld, generate_world
 from sim.generation.table import CATEGORIES, placement_table
 from sim.render import render_world
 from sim.scene import World
+from sim.world_checks import shared_wall
 from sim.world_spec import DoorSpec, RobotSpec, RoomSpec, WorldSpec
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -146,6 +147,24 @@ def test_some_doors_are_closed_and_some_rooms_are_entered_through_others(
             {spine, r.name} == set(d.rooms) for d in spec.doors)]
         assert inner, spec.name
         assert all(0.8 - 1e-9 <= d.width <= 1.2 + 1e-9 for d in spec.doors)
+
+
+def test_doors_keep_apart_and_clear_of_wall_ends(specs: list[WorldSpec]) -> None:
+    for spec in specs:
+        spans = [_span(spec, d) for d in spec.doors]
+        for i, (line, lo, hi) in enumerate(spans):
+            for other_line, other_lo, other_hi in spans[:i]:
+                assert line != other_line or hi <= other_lo or other_hi <= lo, spec.name
+        for door, (_, lo, hi) in zip(spec.doors, spans, strict=True):
+            _, _, wall_lo, wall_hi = shared_wall(*(spec.room(n) for n in door.rooms))
+            assert lo >= wall_lo + 0.3 - 1e-6 and hi <= wall_hi - 0.3 + 1e-6, spec.name
+
+
+def _span(spec: WorldSpec, door: DoorSpec) -> tuple[tuple[str, float], float, float]:
+    """(wall line, low end, high end) of a door opening."""
+    axis, line, _, _ = shared_wall(*(spec.room(n) for n in door.rooms))
+    along = door.at[1] if axis == "x" else door.at[0]
+    return (axis, round(line, 6)), along - door.width / 2, along + door.width / 2
 
 
 def test_furniture_leaves_the_way_through_every_door_free(specs: list[WorldSpec]) -> None:
