@@ -6,7 +6,9 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
+from scipy import ndimage
 
 from conceptual_map.knowledge import Knowledge, load_knowledge
 from sim.errors import GenerationError
@@ -14,6 +16,7 @@ from sim.generate import STYLES, GeneratedWorld, generate_world
 from sim.generation.table import CATEGORIES, placement_table
 from sim.render import render_world
 from sim.scene import World
+from sim.walls import door_openings, wall_segments
 from sim.world_checks import shared_wall
 from sim.world_spec import DoorSpec, RobotSpec, RoomSpec, WorldSpec
 
@@ -131,6 +134,67 @@ def test_every_room_is_reachable_from_the_start_through_open_doors(
                         reached.add(other)
                         frontier.append(other)
         assert reached == {r.name for r in spec.rooms}, spec.name
+
+
+def test_the_pr2_can_drive_from_the_start_into_every_room_and_up_to_every_object(
+        specs: list[WorldSpec]) -> None:
+    """On a 5 cm grid of where the pr2's centre may stand (walls, closed doors, furniture)."""
+    for spec in specs[:30]:
+        gx, gy, reached = _reached(spec)
+        assert len(_entered(spec, gx, gy, reached)) == len(spec.rooms), spec.name
+        for obj in spec.objects:
+            near = _box_distance(gx, gy, _bbox(spec.furniture_named(obj.on))) <= PR2_RADIUS + 0.6
+            assert np.any(reached & near), f"{spec.name}: {obj.name} out of reach"
+
+
+def test_the_free_cell_check_sees_closed_doors(specs: list[WorldSpec]) -> None:
+    spec = specs[0]
+    shut = replace(spec, doors=tuple(replace(d, open=False) for d in spec.doors))
+    for world, rooms in ((spec, len(spec.rooms)), (shut, 1)):
+        assert len(_entered(world, *_reached(world))) == rooms
+
+
+def _reached(spec: WorldSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Grid x, grid y, and the cells the pr2's centre reaches from the start."""
+    xs, ys, free = _pr2_free_cells(spec)
+    labels, _ = ndimage.label(free)
+    sx, sy, _ = spec.robot.start
+    gx, gy = np.meshgrid(xs, ys)
+    return gx, gy, labels == labels[np.abs(ys - sy).argmin(), np.abs(xs - sx).argmin()]
+
+
+def _entered(spec: WorldSpec, gx: np.ndarray, gy: np.ndarray,
+             reached: np.ndarray) -> list[str]:
+    return [r.name for r in spec.rooms if np.any(reached & (gx > r.rect[0]) & (gx < r.rect[2])
+                                                  & (gy > r.rect[1]) & (gy < r.rect[3]))]
+
+
+def _pr2_free_cells(spec: WorldSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    xs = np.arange(0.025, spec.size[0], 0.05)
+    ys = np.arange(0.025, spec.size[1], 0.05)
+    gx, gy = np.meshgrid(xs, ys)
+    half = spec.wall_thickness / 2
+    boxes = [(s.line - half, s.lo, s.line + half, s.hi) if s.axis == "x"
+             else (s.lo, s.line - half, s.hi, s.line + half) for s in wall_segments(spec)]
+    boxes += [(s.line - 0.02, s.lo, s.line + 0.02, s.hi) if s.axis == "x"
+              else (s.lo, s.line - 0.02, s.hi, s.line + 0.02)
+              for s in (o.segment for o in door_openings(spec) if not o.open)]
+    boxes += [_bbox(item) for item in spec.furniture]
+    free = np.ones(gx.shape, dtype=bool)
+    for box in boxes:
+        free &= _box_distance(gx, gy, box) >= PR2_RADIUS
+    return xs, ys, free
+
+
+def _bbox(item: object) -> tuple[float, float, float, float]:
+    xs, ys = zip(*item.footprint(), strict=True)
+    return (min(xs), min(ys), max(xs), max(ys))
+
+
+def _box_distance(gx: np.ndarray, gy: np.ndarray, box: tuple[float, ...]) -> np.ndarray:
+    dx = np.maximum(np.maximum(box[0] - gx, 0.0), gx - box[2])
+    dy = np.maximum(np.maximum(box[1] - gy, 0.0), gy - box[3])
+    return np.hypot(dx, dy)
 
 
 def _rooms_at(spec: WorldSpec, point: tuple[float, float]) -> set[str]:
