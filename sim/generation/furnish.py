@@ -13,7 +13,7 @@ import numpy as np
 
 from sim.generation.freespace import approach_point, door_zone, free_space, passable
 from sim.generation.layout import DoorPlan, Layout, Rect, RoomPlan
-from sim.generation.table import FurnitureRule, PlacementTable, RoomRule
+from sim.generation.table import FurnitureRule, PlacementTable, RoomRule, area_scale
 
 WALL_GAP = 0.08  # room border (wall centre line) to a piece: half a wall plus 3 cm
 PIECE_GAP = 0.05  # between two pieces
@@ -51,8 +51,10 @@ def _furnish_room(rng: np.random.Generator, room: RoomPlan, rule: RoomRule,
     zones = [door_zone(room.rect, d) for d in doors]
     entries = [approach_point(room.rect, d) for d in doors]
     placed: list[Piece] = []
+    scale = area_scale(room.rect)
     for furniture in rule.furniture:
-        for _ in range(int(rng.integers(furniture.count[0], furniture.count[1] + 1))):
+        low, high = furniture.count
+        for _ in range(sum(int(rng.integers(low, high + 1)) for _ in range(scale))):
             fit = _place(rng, room, furniture, zones, entries, placed)
             if fit is None:
                 continue

@@ -15,7 +15,7 @@ import numpy as np
 
 from sim.generation.furnish import Piece
 from sim.generation.layout import Layout, Rect, RoomPlan
-from sim.generation.table import Placement, PlacementTable
+from sim.generation.table import Placement, PlacementTable, area_scale
 
 EDGE = 0.02  # an object keeps this far inside the edge of its support's top
 OBJECT_GAP = 0.02  # between two objects on one top
@@ -79,7 +79,8 @@ def _slots(rng: np.random.Generator, table: PlacementTable, layout: Layout, piec
         if not usual and not unusual:
             continue
         low, high = table.rooms[room.category].objects
-        slots += [_Slot(room, usual, unusual)] * int(rng.integers(low, high + 1))
+        count = sum(int(rng.integers(low, high + 1)) for _ in range(area_scale(room.rect)))
+        slots += [_Slot(room, usual, unusual)] * count
     return slots
 
 

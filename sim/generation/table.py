@@ -22,6 +22,13 @@ CATEGORIES = ("corridor", "kitchen", "office", "meeting_room", "living_room", "b
 `sim` imports nothing of ours; a test checks it against the knowledge file)."""
 
 Range = tuple[float, float]
+AREA_UNIT = 20.0  # m^2: count ranges are per this much floor (a 40 m^2 lab draws twice)
+
+
+def area_scale(rect: tuple[float, float, float, float]) -> int:
+    """How many times a room draws its count ranges: its area in AREA_UNITs, at least once."""
+    area = (rect[2] - rect[0]) * (rect[3] - rect[1])
+    return max(1, round(area / AREA_UNIT))
 
 
 @dataclass(frozen=True)
