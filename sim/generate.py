@@ -50,7 +50,7 @@ class GeneratedWorld:
     def yaml(self) -> str:
         """The world file as YAML text (the format of ARCHITECTURE.md), headed by its command."""
         command = (f"avs world generate --seed {self.seed} --style {self.style} --rooms "
-                   f"{len(self.data['rooms']) - 1} --surprise {self.surprise:g} --robot "
+                   f"{len(self.data['rooms']) - 1} --surprise {self.surprise!r} --robot "
                    f"{self.data['robot']['model']}")
         return world_yaml(self.data, command)
 
