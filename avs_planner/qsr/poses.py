@@ -1,0 +1,56 @@
+"""Navigable view poses for QSR search (Algorithm 1's NavigatablePoses): free cells where the
+robot's footprint fits, within sensing range of a supporting plane, facing one of its voxels."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import ndimage
+
+from conceptual_map.metric import OccupancyGrid
+
+
+def candidate_cells(
+    grid: OccupancyGrid, points: np.ndarray, radius: float, max_range: float
+) -> np.ndarray:
+    """Cells (k, 2) traversable with `radius` whose distance to a plane voxel's column is at
+    most `max_range` (one distance transform over the window around the planes)."""
+    res = grid.resolution
+    cells = grid.to_cell(points[:, :2])
+    reach = int(math.ceil(max_range / res))
+    lo = np.maximum(cells.min(axis=0) - reach, 0)
+    hi = np.minimum(cells.max(axis=0) + reach + 1, np.asarray(grid.shape))
+    if np.any(hi <= lo):
+        return np.zeros((0, 2), dtype=np.int64)
+    plane = np.zeros(tuple(hi - lo), dtype=bool)
+    local = cells - lo
+    ok = np.all((local >= 0) & (local < hi - lo), axis=1)
+    plane[local[ok, 0], local[ok, 1]] = True
+    near = ndimage.distance_transform_edt(~plane) * res <= max_range - res
+    free = grid.traversable(radius)[lo[0] : hi[0], lo[1] : hi[1]]
+    return np.argwhere(free & near) + lo
+
+
+def sample_poses(
+    grid: OccupancyGrid,
+    points: np.ndarray,
+    n: int,
+    radius: float,
+    max_range: float,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """Up to n poses (x, y, yaw) at distinct candidate cells, each facing a plane voxel within
+    `max_range` chosen at random (so every pose looks at some support)."""
+    cells = candidate_cells(grid, points, radius, max_range)
+    if cells.shape[0] == 0:
+        return np.zeros((0, 3))
+    chosen = cells[rng.choice(cells.shape[0], size=min(n, cells.shape[0]), replace=False)]
+    xy = grid.to_world(chosen)
+    d = points[None, :, :2] - xy[:, None, :]
+    within = np.hypot(d[..., 0], d[..., 1]) <= max_range
+    counts = within.sum(axis=1)
+    pick = np.argmax(np.cumsum(within, axis=1) > (rng.random(len(xy)) * counts)[:, None], axis=1)
+    target = d[np.arange(len(xy)), pick]
+    yaw = np.arctan2(target[:, 1], target[:, 0])
+    return np.column_stack([xy, yaw])
