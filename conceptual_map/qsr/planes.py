@@ -13,7 +13,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from conceptual_map.metric.logodds import CellState
 from conceptual_map.metric.voxels import VoxelMap
 from conceptual_map.qsr.mixture import GaussianMixture
 
@@ -79,30 +78,42 @@ def extract_supporting_planes(
     k0 = max(0, math.ceil((z_range[0] - voxels.origin[2]) / res) - 1)
     k1 = min(voxels.shape[2], math.floor((z_range[1] - voxels.origin[2]) / res))
     above = max(1, math.ceil(clearance / res))
-    states = voxels.states()[:, :, k0 : min(voxels.shape[2], k1 + above)]
-    top = _surface(states, above)[:, :, : max(0, k1 - k0)]
-    labels, count = ndimage.label(top, structure=_CONNECTED)
-    return _segments(voxels, labels, count, k0, min_area)
+    slab = voxels.logodds[:, :, k0 : min(voxels.shape[2], k1 + above)]
+    occupied, free = slab >= voxels.model.occupied_at, slab <= voxels.model.free_at
+    top = _surface(occupied, free, above)[:, :, : max(0, k1 - k0)]
+    lo, hi = _bounding_box(top)
+    labels, count = ndimage.label(top[lo[0] : hi[0], lo[1] : hi[1], lo[2] : hi[2]],
+                                  structure=_CONNECTED)  # fmt: skip
+    return _segments(voxels, labels, count, lo + [0, 0, k0], min_area)
 
 
-def _surface(states: np.ndarray, above: int) -> np.ndarray:
-    """Occupied cells with a free cell on top and no occupied cell within `above` cells."""
-    occupied = states == CellState.OCCUPIED
+def _bounding_box(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Smallest index box [lo, hi) holding every True cell (empty box when there is none)."""
+    spans = []
+    for axis in range(mask.ndim):
+        hit = np.flatnonzero(mask.any(axis=tuple(a for a in range(mask.ndim) if a != axis)))
+        spans.append((hit[0], hit[-1] + 1) if hit.size else (0, 0))
+    return np.array([a for a, _ in spans]), np.array([b for _, b in spans])
+
+
+def _surface(occupied: np.ndarray, free: np.ndarray, above: int) -> np.ndarray:
+    """Occupied cells with a free cell on top and no occupied cell within `above` cells
+    (the voxel map's own thresholds: occupied and free as `VoxelMap.states` classifies)."""
     top = occupied.copy()
     top[:, :, -1] = False
-    top[:, :, :-1] &= states[:, :, 1:] == CellState.FREE
+    top[:, :, :-1] &= free[:, :, 1:]
     for k in range(2, above + 1):
         top[:, :, :-k] &= ~occupied[:, :, k:]
     return top
 
 
 def _segments(
-    voxels: VoxelMap, labels: np.ndarray, count: int, k0: int, min_area: float
+    voxels: VoxelMap, labels: np.ndarray, count: int, offset: np.ndarray, min_area: float
 ) -> SupportingPlanes:
     res = voxels.resolution
-    cells_all = np.argwhere(labels > 0)
-    cells_all[:, 2] += k0
-    ids = labels[labels > 0]
+    flat = np.flatnonzero(labels)
+    cells_all = np.column_stack(np.unravel_index(flat, labels.shape)) + offset
+    ids = labels.reshape(-1)[flat]
     order = np.argsort(ids, kind="stable")
     cells_all, ids = cells_all[order], ids[order]
     sizes = np.bincount(ids, minlength=count + 1)
