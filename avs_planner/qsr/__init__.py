@@ -1,7 +1,7 @@
 """QSR view selection (Kunze et al., eq. 2 and Algorithm 1): where to stand and where to look."""
 
 from avs_planner.qsr.geometry import in_frustums, in_view_cones
-from avs_planner.qsr.poses import candidate_cells, sample_poses
+from avs_planner.qsr.poses import candidate_cells, reachable, sample_poses
 from avs_planner.qsr.select import (
     Frustum,
     ScoredPose,
@@ -27,6 +27,7 @@ __all__ = [
     "in_frustums",
     "in_view_cones",
     "rank_frustums",
+    "reachable",
     "sample_poses",
     "score_cones",
     "select_view",

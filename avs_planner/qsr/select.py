@@ -60,12 +60,14 @@ class Frustum:
 
 @dataclass(frozen=True)
 class ViewOptions:
-    """Knobs of the selection; None means the body's value (hfov / 2, detect range)."""
+    """Knobs of the selection; None means the body's value (hfov / 2, detect range), and no
+    `start` means any traversable cell counts as navigable."""
 
     n_poses: int = 20
     cone_half_angle: float | None = None
     max_range: float | None = None
     torso: float = 0.0  # m of torso lift used for the frustums' camera height
+    start: tuple[float, float] | None = None  # the robot's position: only poses reachable from it
 
 
 @dataclass(frozen=True)
@@ -129,7 +131,8 @@ def _select(
 ) -> ViewSelection:
     half = options.cone_half_angle or body.hfov / 2.0
     reach = options.max_range or body.detect_range
-    poses = sample_poses(grid, points, options.n_poses, body.footprint_radius, reach, rng)
+    poses = sample_poses(grid, points, options.n_poses, body.footprint_radius, reach, rng,
+                         options.start)  # fmt: skip
     if poses.shape[0] == 0:
         return ViewSelection(SelectionStatus.NO_POSES, method, None, (), ())
     scores = score_cones(poses, points, weights, half, reach)

@@ -10,6 +10,7 @@ from avs_planner.errors import AvsError
 from avs_planner.qsr import (
     SelectionStatus,
     ViewMethod,
+    ViewOptions,
     ViewSelectionError,
     in_frustums,
     in_view_cones,
@@ -171,3 +172,21 @@ def test_desk_scene_qsr_view_sees_a_cup_region():
         k = [p.x for p in other.poses].index(other.best.x)
         assert qsr.poses[k].score <= qsr.best.score
         assert qsr.best.score > 0.2
+
+
+def test_poses_reachable_from_the_robot_only():
+    grid = qsr_scene.occupancy_grid()
+    grid.logodds[70:90, 28:32] = grid.model.clamp_max  # close the door at y = 1.5
+    grid._touch()
+    planes = extract_supporting_planes(qsr_scene.voxel_map())
+    rng = np.random.default_rng(0)
+    anywhere = sample_poses(grid, planes.points, 200, 0.25, 4.0, rng)
+    assert (anywhere[:, 1] < 1.5).any()  # some in the corridor, behind the wall
+    lab = sample_poses(grid, planes.points, 200, 0.25, 4.0, rng, start=(2.0, 3.0))
+    assert (lab[:, 1] > 1.5).all()
+    corridor = select_view(grid, planes.points, None, BODY, "random", rng=1,
+                           options=ViewOptions(start=(1.0, 0.75)))  # fmt: skip
+    assert corridor.selected and all(p.y < 1.5 for p in corridor.poses)
+    # a start inside the inflation zone (brushing a desk) still finds its room
+    near_desk = sample_poses(grid, planes.points, 50, 0.25, 4.0, rng, start=(1.5, 5.05))
+    assert len(near_desk) == 50 and (near_desk[:, 1] > 1.5).all()
