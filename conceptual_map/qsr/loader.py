@@ -40,8 +40,9 @@ class _Reader:
     def fail(self, entry: str, message: str) -> KnowledgeError:
         return KnowledgeError(f"{self.source}: {entry}: {message}")
 
-    def mapping(self, value: Any, entry: str, required: set[str], optional: set[str] = frozenset()
-                ) -> Mapping[str, Any]:  # fmt: skip
+    def mapping(
+        self, value: Any, entry: str, required: set[str], optional: frozenset[str] = frozenset()
+    ) -> Mapping[str, Any]:
         if not isinstance(value, Mapping):
             raise self.fail(entry, f"expected a mapping, got {type(value).__name__}")
         missing = sorted(required - set(value))
@@ -52,14 +53,14 @@ class _Reader:
             raise self.fail(entry, f"unknown key(s) {', '.join(unknown)}")
         return value
 
-    def number(self, value: Any, entry: str, low: float = -math.inf, positive: bool = False
-               ) -> float:  # fmt: skip
-        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(
-            value
-        ):
+    def number(self, value: Any, entry: str, positive: bool = False) -> float:
+        """A finite number (bools are not numbers here), > 0 when `positive`."""
+        if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.fail(entry, f"expected a finite number, got {value!r}")
-        if value < low or (positive and value <= 0):
-            raise self.fail(entry, f"must be {'> 0' if positive else f'>= {low}'}, got {value!r}")
+        if not math.isfinite(value):
+            raise self.fail(entry, f"expected a finite number, got {value!r}")
+        if positive and value <= 0:
+            raise self.fail(entry, f"must be > 0, got {value!r}")
         return float(value)
 
     def name(self, value: Any, entry: str) -> str:
@@ -85,7 +86,7 @@ def load_qsr(path: str | Path | None = None) -> QsrKnowledge:
 def parse_qsr(data: Any, source: str = "<qsr>") -> QsrKnowledge:
     """Validate already-parsed YAML data (`source` names it in errors)."""
     reader = _Reader(source)
-    root = reader.mapping(data, "top level", _TOP, {"version"})
+    root = reader.mapping(data, "top level", _TOP, frozenset({"version"}))
     relations = _relations(reader, root["relations"])
     parameters = _parameters(reader, root["model"])
     fronts = _landmarks(reader, root["landmarks"])
@@ -130,23 +131,24 @@ def _relations(reader: _Reader, value: Any) -> dict[str, RelationModel]:
 
 
 def _parameters(reader: _Reader, value: Any) -> QsrParameters:
-    keys = {"origin_distance", "close_ratio", "default_distance", "samples", "learn_radius"}
+    lengths = ("origin_distance", "close_ratio", "learn_radius")
+    keys = frozenset({*lengths, "default_distance", "samples"})
     spec = reader.mapping(value, "model", set(), keys)
-    default = QsrParameters()
-    number = {
-        key: reader.number(spec[key], f"model.{key}", positive=True)
-        for key in ("origin_distance", "close_ratio", "learn_radius", "samples")
+    given: dict[str, Any] = {
+        key: reader.number(spec[key], f"model.{key}", positive=True) for key in lengths
         if key in spec
-    }
-    if "samples" in number and (number["samples"] != int(number["samples"]) or
-                                number["samples"] < 2):  # fmt: skip
-        raise reader.fail("model.samples", f"expected an integer >= 2, got {spec['samples']!r}")
-    distance = spec.get("default_distance", default.default_distance)
-    if distance not in DISTANCES:
-        raise reader.fail("model.default_distance", f"{distance!r} is not one of {DISTANCES}")
-    if "samples" in number:
-        number["samples"] = int(number["samples"])
-    return QsrParameters(**{**number, "default_distance": distance})  # type: ignore[arg-type]
+    }  # fmt: skip
+    if "samples" in spec:
+        samples = spec["samples"]
+        if isinstance(samples, bool) or not isinstance(samples, int) or samples < 2:
+            raise reader.fail("model.samples", f"expected an integer >= 2, got {samples!r}")
+        given["samples"] = samples
+    if "default_distance" in spec:
+        distance = spec["default_distance"]
+        if distance not in DISTANCES:
+            raise reader.fail("model.default_distance", f"{distance!r} is not one of {DISTANCES}")
+        given["default_distance"] = distance
+    return QsrParameters(**given)
 
 
 def _landmarks(reader: _Reader, value: Any) -> dict[str, float]:
@@ -165,7 +167,7 @@ def _landmarks(reader: _Reader, value: Any) -> dict[str, float]:
 def _description(
     reader: _Reader, item: Any, entry: str, knowledge: QsrKnowledge
 ) -> QsrDescription:
-    spec = reader.mapping(item, entry, {"target", "relations", "of", "count"}, {"via"})
+    spec = reader.mapping(item, entry, {"target", "relations", "of", "count"}, frozenset({"via"}))
     target = reader.name(spec["target"], f"{entry}.target")
     count = reader.number(spec["count"], f"{entry}.count", positive=True)
     steps = [_step(reader, spec, entry)]
