@@ -65,6 +65,7 @@ class ViewOptions:
 
     n_poses: int = 20
     cone_half_angle: float | None = None
+    pan_sweep: float = 0.0  # rad the head may pan each way to widen the 2D cone (body-limited)
     max_range: float | None = None
     torso: float = 0.0  # m of torso lift used for the frustums' camera height
     start: tuple[float, float] | None = None  # the robot's position: only poses reachable from it
@@ -129,7 +130,7 @@ def _select(
     rng: np.random.Generator,
     options: ViewOptions,
 ) -> ViewSelection:
-    half = options.cone_half_angle or body.hfov / 2.0
+    half = options.cone_half_angle or cone_half_angle(body, options.pan_sweep)
     reach = options.max_range or body.detect_range
     poses = sample_poses(grid, points, options.n_poses, body.footprint_radius, reach, rng,
                          options.start)  # fmt: skip
@@ -140,6 +141,13 @@ def _select(
     scored = tuple(ScoredPose(*map(float, p), float(s)) for p, s in zip(poses, scores, strict=True))
     frustums = rank_frustums(poses[k], points, weights, body, reach, options.torso)
     return ViewSelection(SelectionStatus.SELECTED, method, scored[k], scored, frustums)
+
+
+def cone_half_angle(body: RobotBody, pan_sweep: float = 0.0) -> float:
+    """Half-angle of the 2D view cone: half the camera's hfov, widened by a pan sweep that the
+    head can make both ways (the seed's 60 degree cone "as the pan-tilt unit can cover more")."""
+    sweep = max(0.0, min(pan_sweep, body.pan.high, -body.pan.low))
+    return min(math.pi, body.hfov / 2.0 + sweep)
 
 
 def score_cones(

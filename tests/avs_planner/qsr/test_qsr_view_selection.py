@@ -12,6 +12,7 @@ from avs_planner.qsr import (
     ViewMethod,
     ViewOptions,
     ViewSelectionError,
+    cone_half_angle,
     in_frustums,
     in_view_cones,
     rank_frustums,
@@ -190,3 +191,18 @@ def test_poses_reachable_from_the_robot_only():
     # a start inside the inflation zone (brushing a desk) still finds its room
     near_desk = sample_poses(grid, planes.points, 50, 0.25, 4.0, rng, start=(1.5, 5.05))
     assert len(near_desk) == 50 and (near_desk[:, 1] > 1.5).all()
+
+
+def test_pan_sweep_widens_the_cone_within_the_head_limits():
+    assert cone_half_angle(BODY) == pytest.approx(math.radians(30))
+    assert cone_half_angle(BODY, math.radians(15)) == pytest.approx(math.radians(45))
+    fixed = RobotBody(**{**BODY.__dict__, "pan": JointRange(-0.1, 0.1)})
+    assert cone_half_angle(fixed, 1.0) == pytest.approx(math.radians(30) + 0.1)
+    grid = _open_grid()
+    points = _patch(4.0, 4.0, 5.0, 5.0)
+    wide = select_view(grid, points, None, BODY, "supporting-planes", rng=2,
+                       options=ViewOptions(pan_sweep=math.radians(30)))  # fmt: skip
+    narrow = select_view(grid, points, None, BODY, "supporting-planes", rng=2)
+    assert [p.x for p in wide.poses] == [p.x for p in narrow.poses]
+    assert all(w.score >= n.score for w, n in zip(wide.poses, narrow.poses, strict=True))
+    assert sum(w.score for w in wide.poses) > sum(n.score for n in narrow.poses)
