@@ -12,12 +12,16 @@ import numpy as np
 def in_view_cones(
     poses: np.ndarray, points: np.ndarray, half_angle: float, max_range: float
 ) -> np.ndarray:
-    """(n, m) mask: point j lies in the 2D cone of pose i (x, y, yaw), within `max_range`."""
-    d = points[None, :, :2] - poses[:, None, :2]
-    dist = np.hypot(d[..., 0], d[..., 1])
-    bearing = np.arctan2(d[..., 1], d[..., 0]) - poses[:, 2:3]
-    off = np.abs((bearing + np.pi) % (2.0 * np.pi) - np.pi)
-    return (dist <= max_range) & (off <= half_angle)
+    """(n, m) mask: point j lies in the 2D cone of pose i (x, y, yaw), within `max_range`.
+
+    The angle test is a dot product: the offset along the heading is at least distance times
+    cos(half_angle) (no arctangent per pair).
+    """
+    dx = points[None, :, 0] - poses[:, 0:1]
+    dy = points[None, :, 1] - poses[:, 1:2]
+    along = dx * np.cos(poses[:, 2:3]) + dy * np.sin(poses[:, 2:3])
+    dist = np.sqrt(dx * dx + dy * dy)
+    return (dist <= max_range) & (along >= dist * np.cos(half_angle) - 1e-12)
 
 
 def in_frustums(

@@ -66,10 +66,11 @@ def sample_poses(
         return np.zeros((0, 3))
     chosen = cells[rng.choice(cells.shape[0], size=min(n, cells.shape[0]), replace=False)]
     xy = grid.to_world(chosen)
-    d = points[None, :, :2] - xy[:, None, :]
-    within = np.hypot(d[..., 0], d[..., 1]) <= max_range
-    counts = within.sum(axis=1)
-    pick = np.argmax(np.cumsum(within, axis=1) > (rng.random(len(xy)) * counts)[:, None], axis=1)
-    target = d[np.arange(len(xy)), pick]
-    yaw = np.arctan2(target[:, 1], target[:, 0])
+    dx = points[None, :, 0] - xy[:, 0:1]
+    dy = points[None, :, 1] - xy[:, 1:2]
+    within = dx * dx + dy * dy <= max_range * max_range
+    running = np.cumsum(within, axis=1, dtype=np.int32)
+    pick = np.argmax(running > (rng.random(len(xy)) * running[:, -1])[:, None], axis=1)
+    rows = np.arange(len(xy))
+    yaw = np.arctan2(dy[rows, pick], dx[rows, pick])
     return np.column_stack([xy, yaw])
