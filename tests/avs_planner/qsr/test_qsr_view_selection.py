@@ -53,6 +53,9 @@ def test_view_cone_membership_by_hand():
     mask = in_view_cones(poses, points, math.radians(30), 4.0)
     # 45 deg off axis is outside a 30 deg half-angle; 5 m is beyond range; 28.8 deg is in
     assert mask.tolist() == [[True, False, False, False, True], [False, False, False, True, False]]
+    side = np.array([[math.cos(math.radians(95)), math.sin(math.radians(95))]])
+    assert in_view_cones(poses[:1], side, math.radians(100), 4.0).tolist() == [[True]]
+    assert in_view_cones(poses[:1], side, math.radians(90), 4.0).tolist() == [[False]]
 
 
 def test_frustum_membership_by_hand():

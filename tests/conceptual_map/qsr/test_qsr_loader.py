@@ -102,3 +102,11 @@ def test_user_file_and_task_descriptions(tmp_path, data):
     assert carried.relations is knowledge.relations
     with pytest.raises(KnowledgeError, match=r"^task: descriptions\[0\]\.of: unknown landmark"):
         parse_descriptions([{**task[0], "via": [], "of": "mug"}], knowledge, "task")
+
+
+def test_landmark_pose_turns_yaw_into_the_facing_direction():
+    knowledge = load_qsr()
+    monitor = knowledge.landmark("monitor", 1.0, 2.0, math.pi / 2, "monitor7")
+    assert monitor.facing == pytest.approx(0.0) and monitor.name == "monitor7"
+    with pytest.raises(KeyError, match="'cup' is not a landmark label"):
+        knowledge.landmark("cup", 0.0, 0.0, 0.0)
