@@ -9,9 +9,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from matplotlib.path import Path as MplPath
 
@@ -130,6 +131,31 @@ def load_spec(world: str | Path, robot: str | None = None, start: Sequence[float
         spec = load_world_spec(world)
     except SimError as exc:
         raise EpisodeError(str(exc)) from exc
+    return _with_robot(spec, robot, start, start_room, closed_doors)
+
+
+def generated_spec(generate: Mapping[str, Any], robot: str | None = None,
+                   start: Sequence[float] | None = None,
+                   start_room: str | None = None) -> WorldSpec:
+    """A generated world (`{seed, style, rooms, surprise}`, see `sim.generate`)."""
+    from sim.generate import generate_world
+
+    unknown = set(generate) - {"seed", "style", "rooms", "surprise"}
+    if unknown or "seed" not in generate:
+        raise EpisodeError(f"generate: expected keys seed (required), style, rooms, surprise; "
+                           f"got {sorted(generate)}")
+    try:
+        world = generate_world(int(generate["seed"]), str(generate.get("style", "office")),
+                               generate.get("rooms"), float(generate.get("surprise", 0.25)))
+        spec = world.spec()
+    except (SimError, TypeError, ValueError) as exc:
+        raise EpisodeError(f"generate: {exc}") from exc
+    return _with_robot(spec, robot, start, start_room, ())
+
+
+def _with_robot(spec: WorldSpec, robot: str | None, start: Sequence[float] | None,
+                start_room: str | None, closed_doors: Sequence[int]) -> WorldSpec:
+    """The spec with the robot model, start pose and door states an episode asks for."""
     pose = tuple(spec.robot.start)
     if start_room is not None:
         room = spec.room(start_room)
