@@ -198,9 +198,21 @@ def free_spot(spec: WorldSpec, room: RoomSpec, model: str,
     raise EpisodeError(f"room {room.name!r} has no spot free for the robot to start in")
 
 
-def open_world(spec: WorldSpec, seed: int) -> SimRobot:
-    """Build the PyBullet world (close it with `robot.world.close()`)."""
+def check_categories(spec: WorldSpec, known: Sequence[str]) -> None:
+    """Every room's category must be one of the conceptual map's (`known`), else the robot's
+    readings there could not be used; the error names the room and the known categories."""
+    for i, room in enumerate(spec.rooms):
+        if room.category not in known:
+            raise EpisodeError(f"{spec.source}: rooms[{i}] ({room.name}): category "
+                               f"{room.category!r} is not in the knowledge base (known: "
+                               f"{', '.join(known)}; case, spaces and hyphens do not matter)")
+
+
+def open_world(spec: WorldSpec, seed: int, categories: Sequence[str] | None = None
+               ) -> SimRobot:
+    """Build the PyBullet world (close it with `robot.world.close()`); the place classifier
+    confuses among `categories` (the conceptual map's vocabulary), not the building's."""
     try:
-        return SimRobot(World(spec, seed))
+        return SimRobot(World(spec, seed, categories))
     except SimError as exc:
         raise EpisodeError(str(exc)) from exc

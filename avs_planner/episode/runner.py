@@ -17,7 +17,13 @@ from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.executor import Executor, ExecutorConfig
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import SearchResult
-from avs_planner.episode.robot import SimRobot, generated_spec, load_spec, open_world
+from avs_planner.episode.robot import (
+    SimRobot,
+    check_categories,
+    generated_spec,
+    load_spec,
+    open_world,
+)
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.trace import Trace, write_summary
 from avs_planner.episode.viewcones import CameraModel
@@ -110,12 +116,14 @@ class Episode:
         self.spec = spec
         self.out = Path(spec.output_dir) if spec.output_dir else None
         self.world_spec = self._world_spec()
-        self.robot: SimRobot = open_world(self.world_spec, spec.seed)
+        self.mind = Mind()
+        categories = self.mind.cmap.knowledge.categories
+        check_categories(self.world_spec, categories)
+        self.robot: SimRobot = open_world(self.world_spec, spec.seed, categories)
         if self.out is not None:
             self.out.mkdir(parents=True, exist_ok=True)
         self.trace = Trace(lambda: self.robot.clock, self.out / "trace.jsonl" if self.out
                            else None, emit)
-        self.mind = Mind()
         self.builder = StateBuilder(self.mind, SearchTask(spec.target, spec.category))
         camera = self.robot.robot.model.camera
         self.camera = CameraModel(self.robot.camera_height, camera.hfov, camera.detect_range)
