@@ -63,18 +63,28 @@ class Mind:
         place-map update after several scans from one spot gives the same places)."""
         self.grid.integrate_scan(scan)
 
-    def observe_appearance(self, observed: str) -> bool:
-        """The place classifier said `observed` at the current place; False if not usable."""
+    def observe_appearance(self, observed: str) -> str | None:
+        """The place classifier said `observed` at the current place: None when the reading
+        became evidence, else why it could not be used (the caller reports it)."""
         place = self.place_map.current_place
         if place is None or not self.cmap.graph.has_place(place):
-            return False
+            return f"no place to credit the reading {observed!r} to yet"
         value = f"{observed}_like"
         model = self.cmap.knowledge.properties.get("appearance")
-        if model is None or value not in model.values:
-            return False
+        if model is None:
+            return "the knowledge base has no 'appearance' property"
+        if value not in model.values:
+            return (f"the knowledge base has no appearance value {value!r} (known: "
+                    f"{', '.join(model.values)})")
         self.cmap.observe_property(place, "appearance", value)
         self.classified.add(place)
-        return True
+        return None
+
+    def near_door(self, position: tuple[float, float], clearance: float) -> bool:
+        """Whether `position` is within `clearance` of a door the robot has mapped (a reading
+        taken in a doorway may see the room on the other side)."""
+        return any(math.dist(d.centre, position) < clearance
+                   for d in self.place_map.doors.values())
 
     def room_at(self, position: tuple[float, float]) -> str | None:
         """The room of the place nearest to `position` (None before any room exists)."""
