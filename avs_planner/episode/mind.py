@@ -10,10 +10,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from conceptual_map.conceptual import ConceptualMap, RelatedSpace
 from conceptual_map.conceptual.place_events import PlaceMapFeed
-from conceptual_map.metric import OccupancyGrid
-from conceptual_map.metric.sensors import LaserScanLike
+from conceptual_map.metric import OccupancyGrid, VoxelMap
+from conceptual_map.metric.sensors import DepthFrameLike, LaserScanLike
 from conceptual_map.places import MapEvent, PlaceMap, PlaceMapConfig
 
 Pose = tuple[float, float, float]
@@ -43,6 +45,9 @@ class Mind:
     cones_made: set[tuple[str, str, str]] = field(default_factory=set)
     tried_placeholders: dict[str, int] = field(default_factory=dict)
     classified: set[str] = field(default_factory=set)
+    voxel_resolution: float = 0.05
+    voxel_heights: tuple[float, float] = (-0.1, 2.5)  # m: the band the 3D map covers
+    voxels: VoxelMap | None = field(default=None, init=False)
 
     def __post_init__(self) -> None:
         self.grid = OccupancyGrid(resolution=self.resolution)
@@ -62,6 +67,22 @@ class Mind:
         """Integrate a scan into the grid only (the next `sense` grows the place map; one
         place-map update after several scans from one spot gives the same places)."""
         self.grid.integrate_scan(scan)
+
+    def integrate_depth(self, frame: DepthFrameLike) -> VoxelMap:
+        """Add a depth frame to the 3D map, which covers the 2D grid's extent (grown with it)
+        over `voxel_heights`; rays leaving that band are cut at its border."""
+        lo = np.asarray(self.grid.origin, dtype=float)
+        hi = lo + np.asarray(self.grid.shape) * self.grid.resolution
+        z0, z1 = self.voxel_heights
+        if self.voxels is None:
+            self.voxels = VoxelMap(origin=(lo[0], lo[1], z0),
+                                   size=(hi[0] - lo[0], hi[1] - lo[1], z1 - z0),
+                                   resolution=self.voxel_resolution)
+        else:
+            mid = (z0 + z1) / 2
+            self.voxels.ensure_contains(np.array([[lo[0], lo[1], mid], [hi[0], hi[1], mid]]))
+        self.voxels.integrate_depth(frame)
+        return self.voxels
 
     def observe_appearance(self, observed: str) -> str | None:
         """The place classifier said `observed` at the current place: None when the reading
