@@ -18,7 +18,7 @@ from sim.render import render_world
 from sim.scene import World
 from sim.walls import door_openings, wall_segments
 from sim.world_checks import shared_wall
-from sim.world_spec import DoorSpec, RobotSpec, RoomSpec, WorldSpec
+from sim.world_spec import DoorSpec, FurnitureSpec, RobotSpec, RoomSpec, WorldSpec
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 LIKELY, UNLIKELY = 0.1, 0.05  # relation lambdas: usual placements at least, unusual at most
@@ -186,7 +186,7 @@ def _pr2_free_cells(spec: WorldSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray
     return xs, ys, free
 
 
-def _bbox(item: object) -> tuple[float, float, float, float]:
+def _bbox(item: FurnitureSpec) -> tuple[float, float, float, float]:
     xs, ys = zip(*item.footprint(), strict=True)
     return (min(xs), min(ys), max(xs), max(ys))
 
