@@ -16,7 +16,15 @@ import yaml
 
 from sim.errors import WorldFileError
 from sim.world_checks import check_world
-from sim.world_spec import DoorSpec, FurnitureSpec, ObjectSpec, RobotSpec, RoomSpec, WorldSpec
+from sim.world_spec import (
+    DoorSpec,
+    FurnitureSpec,
+    ObjectSpec,
+    RobotSpec,
+    RoomSpec,
+    WorldSpec,
+    normalise_category,
+)
 
 WORLDS_DIR = Path(__file__).parent / "worlds"
 ROBOT_MODELS = ("pioneer", "pr2")
@@ -71,13 +79,20 @@ def load_world_spec(source: str | Path) -> WorldSpec:
     path = resolve_world(source)
     label = path.name if path.parent == WORLDS_DIR else str(path)
     try:
-        data = yaml.load(path.read_text(encoding="utf-8"), Loader=_WorldLoader)
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise WorldFileError(f"{label}: cannot read: {exc}") from None
+    return load_world_text(text, label)
+
+
+def load_world_text(text: str, label: str) -> WorldSpec:
+    """Read and validate a world file's YAML text; errors name `label` and the entry."""
+    try:
+        data = yaml.load(text, Loader=_WorldLoader)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark
         where = f":{mark.line + 1}:{mark.column + 1}" if mark is not None else ""
         raise WorldFileError(f"{label}{where}: YAML error: {exc.problem}") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise WorldFileError(f"{label}: cannot read: {exc}") from None
     spec = parse_world(data, label)
     check_world(spec)
     return spec
@@ -107,7 +122,8 @@ def _room(entry: Any, label: str, where: str) -> RoomSpec:
     m = _mapping(entry, label, where, {"name", "category", "rect"}, {"name", "category", "rect"})
     where = f"{where} ({m['name']})"
     rect = _vector(m["rect"], 4, label, f"{where}.rect")
-    return RoomSpec(_string(m["name"], label, where), _string(m["category"], label, where), rect)
+    category = normalise_category(_string(m["category"], label, where))
+    return RoomSpec(_string(m["name"], label, where), category, rect)
 
 
 def _door(entry: Any, label: str, where: str) -> DoorSpec:
