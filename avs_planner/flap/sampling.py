@@ -202,8 +202,8 @@ class ViewSampler:
         occupied = self.voxels.states().reshape(-1) == CellState.OCCUPIED
         codes[occupied] = OCCUPIED
         top = self.voxels.origin + np.asarray(self.voxels.shape) * self.voxels.resolution
-        lo = np.maximum(np.min([v.lo for v in self.belief.volumes], axis=0), self.voxels.origin)
-        hi = np.minimum(np.max([v.hi for v in self.belief.volumes], axis=0), top - 1e-6)
+        lo = np.maximum(np.array([v.lo for v in self.belief.volumes]), self.voxels.origin)
+        hi = np.minimum(np.array([v.hi for v in self.belief.volumes]), top - 1e-6)
         return CastGrid(codes, self.voxels.shape, self.voxels.origin.copy(),
                         self.voxels.resolution, lo, hi)
 

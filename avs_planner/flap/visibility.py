@@ -2,8 +2,9 @@
 
 Rays pass through free and unknown cells and stop at the first occupied one; unknown region
 cells they cross are "expected visible". Rays are cast only into the part of the field of view
-that the region's bounding box covers, so a fixed ray count gives dense rays on the region.
-All views of a batch are marched at once with numpy.
+that the region's boxes within range cover, so a fixed ray count gives dense rays on the
+region, and each ray is marched only until it leaves the last box it crosses. All views of a
+batch are marched at once with numpy.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import numpy as np
 
 _SHIFT = 4096  # cells; makes integer truncation a floor for any point near the map
 _CHUNKS = 4  # rays are marched in this many groups of similar length
+_CORNERS = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], dtype=bool)
 OCCUPIED = -2  # lookup code of an occupied map cell; region cells carry their index >= 0
 
 
@@ -34,7 +36,7 @@ class CastGrid:
     shape: tuple[int, int, int]
     origin: np.ndarray
     resolution: float
-    region_lo: np.ndarray  # bounding box of the region (world)
+    region_lo: np.ndarray  # (k, 3) world corners of the region's boxes (the target volumes)
     region_hi: np.ndarray
 
 
@@ -48,7 +50,7 @@ def visible_cells(
 ) -> list[np.ndarray]:
     """Sorted region indices each camera would see (optimistic); `step` is in cells."""
     n_views = cams.origins.shape[0]
-    dirs = _ray_directions(grid, cams, fov, rays)  # (V, R, 3)
+    dirs = _ray_directions(grid, cams, fov, rays, max_range)  # (V, R, 3)
     t_end = _exit_distance(grid, cams.origins, dirs, max_range).reshape(-1)
     view = np.repeat(np.arange(n_views), dirs.shape[1])
     live = np.nonzero(t_end > 0)[0]
@@ -83,10 +85,14 @@ def _split_by_view(keys: np.ndarray, width: int, n_views: int) -> list[np.ndarra
 
 
 def _ray_directions(
-    grid: CastGrid, cams: Cameras, fov: tuple[float, float], rays: tuple[int, int]
+    grid: CastGrid,
+    cams: Cameras,
+    fov: tuple[float, float],
+    rays: tuple[int, int],
+    max_range: float,
 ) -> np.ndarray:
     """Unit ray directions (V, R, 3) over the part of the field of view the region covers."""
-    az_lo, az_hi, el_lo, el_hi = _region_window(grid, cams, fov)
+    az_lo, az_hi, el_lo, el_hi = _region_window(grid, cams, fov, max_range)
     u = np.linspace(0.0, 1.0, rays[0], dtype=np.float32)
     v = np.linspace(0.0, 1.0, rays[1], dtype=np.float32)
     uu, vv = (a.ravel() for a in np.meshgrid(u, v))
@@ -108,42 +114,46 @@ def _rotations(cams: Cameras) -> np.ndarray:
 
 
 def _region_window(
-    grid: CastGrid, cams: Cameras, fov: tuple[float, float]
+    grid: CastGrid, cams: Cameras, fov: tuple[float, float], max_range: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Azimuth and elevation limits (camera frame) of the region's box, clipped to the fov.
-
-    A camera whose view of the box reaches behind it (x <= 0 in its frame) keeps the full fov.
+    """Azimuth and elevation limits (camera frame) of the boxes within range, clipped to the
+    fov. A camera that has such a box partly behind it (x <= 0 in its frame) keeps the full fov.
     """
-    lo, hi = grid.region_lo, grid.region_hi
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
-                        for z in (lo[2], hi[2])])  # fmt: skip
-    rel = corners[None, :, :] - cams.origins[:, None, :]
-    local = np.matmul(rel, _rotations(cams))  # world -> camera
-    ahead = local[..., 0] > 1e-3
+    lo, hi = grid.region_lo, grid.region_hi  # (k, 3)
+    corners = np.where(_CORNERS[None, :, :], hi[:, None, :], lo[:, None, :])  # (k, 8, 3)
+    rel = corners[None] - cams.origins[:, None, None, :]
+    local = np.matmul(rel, _rotations(cams)[:, None])  # world -> camera, (V, k, 8, 3)
+    nearest = np.clip(cams.origins[:, None, :], lo[None], hi[None])
+    near = np.linalg.norm(nearest - cams.origins[:, None, :], axis=2) <= max_range  # (V, k)
+    whole = np.any(near & ~np.all(local[..., 0] > 1e-3, axis=2), axis=1)
     az = np.arctan2(local[..., 1], local[..., 0])
     el = np.arctan2(local[..., 2], np.hypot(local[..., 0], local[..., 1]))
     half_h, half_v = fov[0] / 2, fov[1] / 2
-    whole = ~ahead.all(axis=1)
-    az_lo = np.where(whole, -half_h, np.clip(az.min(axis=1), -half_h, half_h))
-    az_hi = np.where(whole, half_h, np.clip(az.max(axis=1), -half_h, half_h))
-    el_lo = np.where(whole, -half_v, np.clip(el.min(axis=1), -half_v, half_v))
-    el_hi = np.where(whole, half_v, np.clip(el.max(axis=1), -half_v, half_v))
-    return az_lo, az_hi, el_lo, el_hi
+
+    def span(angle: np.ndarray, half: float) -> tuple[np.ndarray, np.ndarray]:
+        low = np.where(near[..., None], angle, np.inf).min(axis=(1, 2))
+        high = np.where(near[..., None], angle, -np.inf).max(axis=(1, 2))
+        low = np.where(whole | ~near.any(axis=1), -half, np.clip(low, -half, half))
+        high = np.where(whole | ~near.any(axis=1), half, np.clip(high, -half, half))
+        return low, high
+
+    return *span(az, half_h), *span(el, half_v)
 
 
 def _exit_distance(
     grid: CastGrid, origins: np.ndarray, dirs: np.ndarray, max_range: float
 ) -> np.ndarray:
-    """Distance (V, R) along each ray to where it leaves the region's box, capped at range."""
+    """Distance (V, R) along each ray to where it leaves the last box it crosses (0 if it
+    crosses none), capped at range."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        inv = 1.0 / dirs
-        t1 = (grid.region_lo[None, None, :] - origins[:, None, :]) * inv
-        t2 = (grid.region_hi[None, None, :] - origins[:, None, :]) * inv
+        inv = 1.0 / dirs[:, :, None, :]
+        t1 = (grid.region_lo[None, None] - origins[:, None, None, :]) * inv
+        t2 = (grid.region_hi[None, None] - origins[:, None, None, :]) * inv
     t1 = np.where(np.isnan(t1), -np.inf, t1)
     t2 = np.where(np.isnan(t2), np.inf, t2)
-    near = np.minimum(t1, t2).max(axis=2)
-    far = np.maximum(t1, t2).min(axis=2)
-    far = np.where(far >= np.maximum(near, 0.0), far, 0.0)  # rays missing the box: nothing
+    near = np.minimum(t1, t2).max(axis=3)
+    far = np.maximum(t1, t2).min(axis=3)  # (V, R, k)
+    far = np.where(far >= np.maximum(near, 0.0), far, 0.0).max(axis=2)
     return np.minimum(far, max_range).astype(np.float32)
 
 

@@ -111,7 +111,7 @@ def _corridor(wall_at: float | None) -> list[np.ndarray]:
         cells = voxels.cells_in_box((wall_at, 0.0, 0.0), (wall_at + 0.05, 1.0, 1.0))
         codes[np.ravel_multi_index(tuple(cells.T), voxels.shape)] = OCCUPIED
     grid = CastGrid(codes, voxels.shape, voxels.origin, voxels.resolution,
-                    np.array([1.0, 0.4, 0.4]), np.array([1.5, 0.6, 0.6]))
+                    np.array([[1.0, 0.4, 0.4]]), np.array([[1.5, 0.6, 0.6]]))
     cams = Cameras(np.array([[0.21, 0.5, 0.5]]), np.array([0.0]), np.array([0.0]))
     return visible_cells(grid, cams, (1.0, 1.0), 3.0, rays=(12, 12), step=0.5)
 
