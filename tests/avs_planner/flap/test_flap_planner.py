@@ -81,12 +81,12 @@ def test_default_planner_within_two_percent_on_room_instances(scene, belief) -> 
                                    table.start, table.times)  # fmt: skip
     rng = np.random.default_rng(0)
     gaps = []
-    for _ in range(8):
-        problem = full.subset(rng.choice(full.size, 7, replace=False))
+    for k in range(24):  # a single instance can be far off (xi prunes the view on the way)
+        problem = full.subset(rng.choice(full.size, 6 + k % 2, replace=False))
         best = plan_exhaustive(problem).expected_time
         assert plan_views(problem, EXACT).expected_time == pytest.approx(best, rel=1e-12)
         gaps.append(plan_views(problem).expected_time / best - 1.0)
-    assert min(gaps) >= -1e-12 and np.mean(gaps) <= 0.02
+    assert min(gaps) >= -1e-12 and np.mean(gaps) <= 0.02, gaps
 
 
 def test_greedy_is_one_dive_by_utility() -> None:
