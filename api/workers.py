@@ -55,6 +55,7 @@ class Job:
     on_event: Callable[[dict[str, Any]], None] = lambda event: None
     cancel: threading.Event = field(default_factory=threading.Event)
     future: Future[JobResult] = field(default_factory=Future)
+    grace_s: float | None = None  # after a cancel, time to stop before a kill; None: the pool's
 
 
 class _Slot:
@@ -110,7 +111,8 @@ class _Slot:
             if job.cancel.is_set() and stop_sent_at is None:
                 stop_sent_at = time.monotonic()
                 _send_quietly(conn, STOP)
-            if stop_sent_at is not None and time.monotonic() - stop_sent_at > self.pool.grace_s:
+            grace = self.pool.grace_s if job.grace_s is None else job.grace_s
+            if stop_sent_at is not None and time.monotonic() - stop_sent_at >= grace:
                 self.kill()
                 return JobResult(JobOutcome.CANCELLED, error="cancelled; worker killed")
             if time.monotonic() > deadline:
@@ -152,6 +154,9 @@ class _Slot:
                     job.future.set_result(JobResult(JobOutcome.SHUTDOWN, error="service stopped"))
                 return
             if not job.future.set_running_or_notify_cancel():
+                continue
+            if job.cancel.is_set():  # cancelled while it waited: never started
+                job.future.set_result(JobResult(JobOutcome.CANCELLED, error="cancelled"))
                 continue
             if not job.on_start():
                 job.future.set_result(JobResult(JobOutcome.SKIPPED))
