@@ -10,6 +10,7 @@ from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 DEFAULT_EPISODE_RUNNER = "avs_planner.jobs:run_episode"
+DEFAULT_PLAN_RUNNER = "avs_planner.jobs:plan"
 DEFAULT_TASK_CHECKER = "avs_planner.episode.validate:check_task"
 
 
@@ -38,6 +39,8 @@ class Settings(BaseSettings):
     episode_runner: str = Field(
         DEFAULT_EPISODE_RUNNER, description="'module:function' or '/path/file.py:function'"
     )
+    plan_runner: str = Field(DEFAULT_PLAN_RUNNER, description="the plan job's function "
+                             "('module:function' or '/path/file.py:function')")
     warm_workers: bool = Field(True, description="start episode workers before the first task")
     preload_planner: bool = Field(True, description="import the planner in job workers at start")
     worlds_dir: Path | None = Field(None, description="built-in worlds; default: sim/worlds")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import re
 import threading
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
@@ -12,7 +13,6 @@ from fastapi.exception_handlers import http_exception_handler
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
-from starlette.routing import Match
 
 from api import lock
 from api.config import Settings
@@ -101,14 +101,15 @@ def _add_error_handlers(app: FastAPI) -> None:
 
 
 def _method_not_allowed(request: Request) -> Response:
-    """405 with every method the path has in `Allow` (Starlette names only the first route's);
-    OPTIONS gets 204 with the same header."""
+    """405 with every method the path has in `Allow` (Starlette names only the first route's),
+    read from the OpenAPI paths; OPTIONS gets 204 with the same header."""
     methods: set[str] = {"OPTIONS"}
-    for route in request.app.router.routes:
-        match, _ = route.matches({**request.scope, "method": "GET"})
-        route_methods = getattr(route, "methods", None)
-        if match is not Match.NONE and route_methods:
-            methods |= set(route_methods)
+    for template, operations in request.app.openapi()["paths"].items():
+        pattern = re.sub(r"\\{[^/]+?\\}", "[^/]+", re.escape(template))
+        if re.fullmatch(pattern, request.url.path):
+            methods |= {m.upper() for m in operations}
+    if "GET" in methods:
+        methods.add("HEAD")
     headers = {"Allow": ", ".join(sorted(methods))}
     if request.method == "OPTIONS":
         return Response(status_code=status.HTTP_204_NO_CONTENT, headers=headers)

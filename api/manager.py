@@ -72,11 +72,12 @@ class TaskManager:
         self.settings = settings
         self.store = store
         self.episodes = WorkerPool(
-            "episodes", settings.workers, settings.memory_limit_mb, settings.episode_runner,
+            "episodes", settings.workers, settings.memory_limit_mb,
+            {"episode": settings.episode_runner},
             settings.cancel_grace_s, nice=settings.worker_nice, warm=settings.warm_workers,
         )
         self.jobs = WorkerPool(
-            "jobs", settings.plan_workers, settings.memory_limit_mb, settings.episode_runner,
+            "jobs", settings.plan_workers, settings.memory_limit_mb, {"plan": settings.plan_runner},
             settings.cancel_grace_s, preload=PRELOAD_JOBS if settings.preload_planner else (),
             nice=settings.worker_nice, warm=settings.preload_planner,
         )

@@ -75,7 +75,7 @@ class _Slot:
         parent, child = ctx.Pipe(duplex=True)
         self.process = ctx.Process(
             target=worker_main,
-            args=(child, self.pool.memory_limit_mb, self.pool.episode_runner, self.pool.preload,
+            args=(child, self.pool.memory_limit_mb, self.pool.runners, self.pool.preload,
                   self.pool.nice),
             name=f"avs-{self.pool.name}-{self.index}",
             daemon=True,
@@ -187,7 +187,7 @@ class WorkerPool:
     """N worker processes fed from one FIFO of jobs."""
 
     def __init__(
-        self, name: str, size: int, memory_limit_mb: int, episode_runner: str, grace_s: float,
+        self, name: str, size: int, memory_limit_mb: int, runners: dict[str, str], grace_s: float,
         preload: tuple[str, ...] = (), nice: int = 0, warm: bool = True,
     ):
         self.name = name
@@ -195,7 +195,7 @@ class WorkerPool:
         self.preload = preload
         self.nice = nice
         self.memory_limit_mb = memory_limit_mb
-        self.episode_runner = episode_runner
+        self.runners = runners  # job kind -> 'module:function' (defaults: JOB_FUNCTIONS)
         self.grace_s = grace_s
         self.jobs: queue.Queue[Job | None] = queue.Queue()
         self.stopping = threading.Event()
