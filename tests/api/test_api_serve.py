@@ -61,15 +61,21 @@ def _call(url: str, body: dict | None = None) -> dict:
         return json.loads(response.read())
 
 
-@contextmanager
-def _server(data_dir: Path, port: int) -> Iterator[subprocess.Popen[bytes]]:
-    env = {**os.environ, "AVS_EPISODE_RUNNER": FAKE_RUNNER, "AVS_PRELOAD_PLANNER": "false",
-           "AVS_WORLDS_DIR": str(data_dir / "worlds"),
-           "AVS_WORKERS": "1", "AVS_PLAN_WORKERS": "1"}
-    env.pop("AVS_API_KEY", None)
+def serve_command(data_dir: Path, port: int, **env: str) -> tuple[list[str], dict[str, str]]:
+    """`avs serve` on `data_dir` with the fake runner and no task checker, and its environment."""
+    environ = {**os.environ, "AVS_EPISODE_RUNNER": FAKE_RUNNER, "AVS_PRELOAD_PLANNER": "false",
+               "AVS_WORLDS_DIR": str(data_dir / "worlds"), "AVS_TASK_CHECKER": "",
+               "AVS_WORKERS": "1", "AVS_PLAN_WORKERS": "1", **env}
+    environ.pop("AVS_API_KEY", None)
     command = [sys.executable, "-m", "avs_planner", "serve", "--port", str(port),
                "--data-dir", str(data_dir), "--log-level", "warning"]
-    process = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL,
+    return command, environ
+
+
+@contextmanager
+def _server(data_dir: Path, port: int, **env: str) -> Iterator[subprocess.Popen[bytes]]:
+    command, environ = serve_command(data_dir, port, **env)
+    process = subprocess.Popen(command, env=environ, stdout=subprocess.DEVNULL,
                                stderr=subprocess.DEVNULL)
     try:
         deadline = time.monotonic() + 30
