@@ -22,11 +22,9 @@ def read_worlds(settings: SettingsDep) -> WorldsPublic:
 @router.get("/strategies")
 def read_strategies() -> StrategiesPublic:
     """The search strategies a task may name, with their options and defaults."""
-    from avs_planner.strategies import get_strategy, strategy_names
+    from avs_planner.episode.validate import strategies
 
-    found = [get_strategy(name) for name in strategy_names()]
-    data = [StrategyPublic(name=s.name, summary=s.summary, options=dict(s.options))
-            for s in found]
+    data = [StrategyPublic.model_validate(s) for s in strategies()]
     return StrategiesPublic(data=data, count=len(data))
 
 

@@ -19,7 +19,7 @@ from matplotlib.path import Path as MplPath
 
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.robot import check_categories, free_spot
-from avs_planner.strategies import get_strategy
+from avs_planner.strategies import get_strategy, strategy_names
 from conceptual_map.knowledge.loader import load_knowledge
 from conceptual_map.knowledge.model import Knowledge
 from sim.errors import SimError
@@ -47,6 +47,12 @@ def check_task(task: Mapping[str, Any], world_path: Path | None = None) -> list[
     except (SimError, EpisodeError, OSError) as exc:
         return [*problems, FieldProblem(field, str(exc))]
     return problems + _check_start(task, spec)
+
+
+def strategies() -> list[dict[str, Any]]:
+    """The strategies a task may name: name, summary, options with their defaults."""
+    found = [get_strategy(name) for name in strategy_names()]
+    return [{"name": s.name, "summary": s.summary, "options": dict(s.options)} for s in found]
 
 
 @cache
