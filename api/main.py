@@ -42,7 +42,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
         held = lock.acquire(settings.data_dir)  # before the store: no recovery under a live one
         store = TaskStore(settings.db_path)
-        manager = TaskManager(settings, store)
+        manager = TaskManager(settings, store, app.state.draining)
         manager.start()
         app.state.manager = manager
         app.state.plan_jobs = PlanJobs(manager, settings.plan_results_kept)

@@ -56,6 +56,10 @@ class ClientGoneError(Exception):
     """The client of a synchronous plan/check disconnected; its job was cancelled."""
 
 
+class StoppingError(Exception):
+    """The service is stopping; the job was cancelled (HTTP 503, retry after the restart)."""
+
+
 _DISCONNECT_POLL_S = 0.25
 
 
@@ -68,9 +72,11 @@ class Submission:
 class TaskManager:
     """Owns the store and both worker pools; every route goes through it."""
 
-    def __init__(self, settings: Settings, store: TaskStore):
+    def __init__(self, settings: Settings, store: TaskStore,
+                 draining: threading.Event | None = None):
         self.settings = settings
         self.store = store
+        self.draining = draining or threading.Event()  # set when the service begins to stop
         self.episodes = WorkerPool(
             "episodes", settings.workers, settings.memory_limit_mb,
             {"episode": settings.episode_runner},
@@ -214,7 +220,8 @@ class TaskManager:
         """Run a plan/check job in the job pool and wait for it without blocking the loop.
 
         The job is cancelled (its process killed at once) when the waiting coroutine is
-        cancelled or `disconnected()` turns true; the latter raises `ClientGoneError`."""
+        cancelled, `disconnected()` turns true (`ClientGoneError`) or the service begins to stop
+        (`StoppingError`)."""
         self.check_job_room()
         job = Job(kind=kind, payload=payload, time_limit_s=self.settings.plan_time_limit_s,
                   on_start=on_start, grace_s=0.0)
@@ -224,9 +231,11 @@ class TaskManager:
                 done, _ = await asyncio.wait({waiting}, timeout=_DISCONNECT_POLL_S)
                 if done:
                     return waiting.result()
+                if self.draining.is_set():
+                    raise StoppingError(kind)
                 if disconnected is not None and await disconnected():
                     raise ClientGoneError(kind)
-        except (asyncio.CancelledError, ClientGoneError):
+        except (asyncio.CancelledError, ClientGoneError, StoppingError):
             job.cancel.set()  # the client went away: free the worker too
             raise
 

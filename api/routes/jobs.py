@@ -7,7 +7,7 @@ from typing import Any
 
 from fastapi import HTTPException, status
 
-from api.manager import ClientGoneError, QueueFullError, TaskManager
+from api.manager import ClientGoneError, QueueFullError, StoppingError, TaskManager
 from api.workers import JobOutcome
 
 UNAVAILABLE = "JobUnavailableError"
@@ -34,6 +34,11 @@ async def run_job(
         raise queue_full(exc) from exc
     except ClientGoneError as exc:
         raise HTTPException(CLIENT_CLOSED, detail="client disconnected") from exc
+    except StoppingError as exc:
+        raise HTTPException(
+            status.HTTP_503_SERVICE_UNAVAILABLE, detail="the service is stopping; retry",
+            headers={"Retry-After": "5"},
+        ) from exc
     if result.outcome is JobOutcome.DONE:
         return result.value
     if result.outcome is JobOutcome.CANCELLED:
