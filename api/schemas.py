@@ -200,3 +200,8 @@ class Health(BaseModel):
 
 class Message(BaseModel):
     detail: Any
+
+
+TOO_LARGE: dict[int | str, dict[str, Any]] = {
+    413: {"model": Message, "description": "body larger than AVS_MAX_BODY_BYTES"},
+}

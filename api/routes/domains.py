@@ -6,14 +6,15 @@ from fastapi import APIRouter, Request
 
 from api.deps import ManagerDep, WriteAccess
 from api.routes.jobs import run_job
-from api.schemas import Diagnostic, DomainCheckCreate, DomainCheckPublic, Message
+from api.schemas import TOO_LARGE, Diagnostic, DomainCheckCreate, DomainCheckPublic, Message
 
 router = APIRouter(prefix="/domains", tags=["domains"])
 
 
 @router.post(
     "/check",
-    responses={401: {"model": Message}, 429: {"model": Message}, 503: {"model": Message}},
+    responses={401: {"model": Message}, 429: {"model": Message}, 503: {"model": Message},
+               **TOO_LARGE},
 )
 async def check_domain(
     body: DomainCheckCreate, owner: WriteAccess, manager: ManagerDep, request: Request

@@ -12,7 +12,7 @@ from api.deps import ManagerDep, SettingsDep, WriteAccess
 from api.manager import QueueFullError, TaskManager
 from api.plan_jobs import PlanJobs
 from api.routes.jobs import pddl_422, queue_full, run_job
-from api.schemas import Message, PlanCreate, PlanJobPublic, PlanPublic
+from api.schemas import TOO_LARGE, Message, PlanCreate, PlanJobPublic, PlanPublic
 
 router = APIRouter(prefix="/plans", tags=["plans"])
 
@@ -46,7 +46,8 @@ async def _plan(manager: TaskManager, payload: dict[str, Any], request: Request 
 @router.post(
     "",
     responses={
-        **_ERRORS, 202: {"model": PlanJobPublic, "description": "wait=false: the job, queued"},
+        **_ERRORS, **TOO_LARGE,
+        202: {"model": PlanJobPublic, "description": "wait=false: the job, queued"},
         422: {"model": Message, "description": "bad input or PDDL"}, 504: {"model": Message},
     },
 )

@@ -22,7 +22,7 @@ from api.deps import (
     WriteAccess,
 )
 from api.manager import IdempotencyConflictError, NotCancellableError, QueueFullError
-from api.schemas import Message, TaskCreate, TaskPublic, TasksPublic, TaskState
+from api.schemas import TOO_LARGE, Message, TaskCreate, TaskPublic, TasksPublic, TaskState
 from api.store import TaskRecord
 from api.worlds import world_file_problem, world_files, world_path
 
@@ -79,7 +79,7 @@ def _check_task(body: TaskCreate, request: dict, settings: SettingsDep,
 @router.post(
     "",
     status_code=status.HTTP_202_ACCEPTED,
-    responses={**_ERRORS, 503: {"model": Message, "description": "queue full"}},
+    responses={**_ERRORS, **TOO_LARGE, 503: {"model": Message, "description": "queue full"}},
 )
 def create_task(
     body: TaskCreate,
