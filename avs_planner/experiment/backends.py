@@ -170,13 +170,17 @@ def _await(reader: Connection, process: multiprocessing.process.BaseProcess,
     ready = wait([reader], timeout=deadline_s)
     if not ready:
         process.kill()
-        return {"status": "timeout", "summary": None,
-                "error": f"killed after the wall-clock limit of {deadline_s:g} s"}
+        return timeout_record(deadline_s)
     try:
         return reader.recv()
     except (EOFError, OSError):
         process.join(5)
         return {"status": "crashed", "summary": None, "error": _crash(process.exitcode)}
+
+
+def timeout_record(deadline_s: float) -> Record:
+    return {"status": "timeout", "summary": None,
+            "error": f"killed after the wall-clock limit of {deadline_s:g} s"}
 
 
 def _crash(code: int | None) -> str:

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from avs_planner.experiment.backends import Job, Record, make_backend
+from avs_planner.experiment.backends import Backend, Job, Record, make_backend
 from avs_planner.experiment.campaign import Campaign, RunSpec
 from avs_planner.experiment.errors import CampaignError
 from avs_planner.experiment.results import RESULTS_FILE, write_results
@@ -79,13 +79,21 @@ class CampaignResult:
 def run_campaign(campaign: Campaign, options: RunOptions,
                  on_progress: Callable[[Progress], None] | None = None) -> CampaignResult:
     runs = campaign.runs()
+    backend = make_backend(options.backend, options.workers, options.address,
+                           options.episode_runner)
+    try:
+        return _run(campaign, runs, options, backend, on_progress)
+    finally:
+        backend.close()
+
+
+def _run(campaign: Campaign, runs: list[RunSpec], options: RunOptions, backend: Backend,
+         on_progress: Callable[[Progress], None] | None) -> CampaignResult:
     _claim(options.out, campaign, len(runs))
     todo = [run for run in runs if not _done(options.out, run, options.retry_failed)]
     skipped = len(runs) - len(todo)
     if options.limit is not None:
         todo = todo[:options.limit]
-    backend = make_backend(options.backend, options.workers, options.address,
-                           options.episode_runner)
     progress = Progress(len(runs), skipped, _failed_before(options.out, runs, todo), skipped,
                         backend.slots)
     jobs = [Job(run, run_dir(options.out, run), _deadline(run, options)) for run in todo]
@@ -105,7 +113,6 @@ def run_campaign(campaign: Campaign, options: RunOptions,
     try:
         backend.run(jobs, on_done)
     finally:
-        backend.close()
         results = write_results(options.out, runs, load_records(options.out, runs))
     return CampaignResult(progress, results, time.monotonic() - started, backend.name,
                           backend.slots)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import sys
+import tempfile
 import time
 import traceback
 from collections.abc import Callable, Mapping
@@ -25,7 +26,8 @@ def execute(spec: Mapping[str, Any], out_dir: str | None, runner: str = DEFAULT_
     """Run one episode into `out_dir`; a record with status ok or error and its timing."""
     start = time.perf_counter()
     try:
-        function = resolve(runner)
+        function = resolve(runner)  # imported already in a warm worker; else not episode time
+        start = time.perf_counter()
         summary = function({**spec, "output_dir": out_dir}, None, None)
     except Exception as exc:  # noqa: BLE001 - recorded with the run, never fatal
         return {"status": "error", "error": _describe(exc), "summary": None,
@@ -65,3 +67,12 @@ def preload(runner: str = DEFAULT_RUNNER) -> None:
     for name in PRELOAD:
         importlib.import_module(name)
     resolve(runner)
+
+
+def execute_collect(spec: Mapping[str, Any], runner: str = DEFAULT_RUNNER) -> dict[str, Any]:
+    """`execute` into a temporary directory, with the files it wrote in the record (`files`:
+    name -> bytes), for a worker on another machine than the one that keeps the results."""
+    with tempfile.TemporaryDirectory(prefix="avs-run-") as tmp:
+        record = execute(spec, tmp, runner)
+        record["files"] = {p.name: p.read_bytes() for p in Path(tmp).iterdir() if p.is_file()}
+    return record

@@ -1,0 +1,166 @@
+"""Campaign files: each kind of mistake is refused naming its entry; expansion is the product."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from avs_planner.experiment import CampaignError, load_campaign
+from avs_planner.experiment import campaign as campaign_module
+from avs_planner.experiment import subjects as subjects_module
+from avs_planner.experiment.campaign import parse_campaign
+from avs_planner.experiment.report import PAPER_OUTCOME
+
+STRATEGIES = ["switching", "exhaustive", "most-likely-room"]
+
+
+@pytest.fixture(autouse=True)
+def registry(monkeypatch):
+    monkeypatch.setattr(campaign_module, "strategy_names", lambda: list(STRATEGIES))
+
+
+def parse(data, base: Path = Path(".")):
+    return parse_campaign(data, "c.yaml", base)
+
+
+def refused(data, *fragments: str) -> str:
+    with pytest.raises(CampaignError) as info:
+        parse(data).runs()
+    message = str(info.value)
+    assert message.startswith("c.yaml: "), message
+    for fragment in fragments:
+        assert fragment in message, message
+    return message
+
+
+WORLD = {"worlds": ["office"], "targets": ["cerealbox"]}
+
+
+@pytest.mark.parametrize(("data", "fragments"), [
+    ([1, 2], ["a campaign is a mapping"]),
+    ({**WORLD, "seed": 3}, ["unknown keys ['seed']"]),
+    ({"targets": ["cup"]}, ["either 'worlds'"]),
+    ({**WORLD, "scenarios": ["a"]}, ["either 'worlds'"]),
+    ({"scenarios": ["a"], "targets": ["cup"]}, ["targets: scenarios bring their own"]),
+    ({"scenarios": ["a", "zz"]}, ["scenarios[1]: ", "unknown scenario 'zz'"]),
+    ({"worlds": ["office", "atlantis"], "targets": ["cup"]}, ["worlds[1]: "]),
+    ({"worlds": [{"world": "office", "color": 1}], "targets": ["cup"]},
+     ["worlds[0]: unknown keys ['color']"]),
+    ({"worlds": [3], "targets": ["cup"]}, ["worlds[0]: a world name or path"]),
+    ({**WORLD, "strategies": ["switching", "flap"]},
+     ["strategies[1]: unknown strategy 'flap'", "switching, exhaustive, most-likely-room"]),
+    ({**WORLD, "strategies": ["switching", "switching"]},
+     ["strategies[1]: label 'switching' is used twice"]),
+    ({**WORLD, "strategies": [{"name": "switching", "options": [1]}]},
+     ["strategies[0].options: "]),
+    ({**WORLD, "seeds": "5-2"}, ["seeds: range '5-2' is empty"]),
+    ({**WORLD, "seeds": "0-3,x"}, ["seeds: 'x' is not a seed"]),
+    ({**WORLD, "seeds": [1, "a"]}, ["seeds[1]: a seed is an integer"]),
+    ({**WORLD, "seeds": "0-3,2"}, ["seeds: seed(s) [2] listed twice"]),
+    ({**WORLD, "time_budget_s": -5}, ["time_budget_s: must be a positive"]),
+    ({**WORLD, "wall_budget_s": "long"}, ["wall_budget_s: must be a number"]),
+    ({**WORLD, "robots": ["pioneer", "r2d2"]}, ["robots[1]: unknown robot 'r2d2'", "pr2"]),
+    ({"worlds": ["office"]}, ["worlds[0]: no targets"]),
+    ({"worlds": ["office", "office_no_tables"], "targets": {"office": ["cup"]}},
+     ["targets: no targets for world 'office_no_tables'"]),
+    ({"worlds": ["office"], "targets": "auto"}, ["targets: 'auto' targets are for generated"]),
+    ({"worlds": ["office"], "targets": [{"label": "cup", "expected": "maybe"}]},
+     ["targets[0].expected: found or gave_up"]),
+    ({"worlds": ["office"], "targets": [["cup"]]}, ["targets[0]: a label or"]),
+    ({"worlds": [{"generate": {"style": "office"}}], "targets": "auto"},
+     ["worlds[0].generate: a mapping with 'seeds'"]),
+    ({"worlds": [{"generate": {"seeds": "0-2", "rooms": 0}}], "targets": "auto"},
+     ["worlds[0].generate.rooms: a positive number"]),
+    ({"worlds": ["office", "office"], "targets": ["cup"]}, ["share the id 'office-cup"]),
+])
+def test_a_bad_campaign_is_refused_naming_the_entry(data, fragments):
+    refused(data, *fragments)
+
+
+def test_an_unknown_built_in_lists_the_built_ins():
+    with pytest.raises(CampaignError, match="built-in campaigns are .*seed003-fig3"):
+        load_campaign("seed004-fig9")
+
+
+def test_a_broken_yaml_file_is_named(tmp_path):
+    path = tmp_path / "broken.yaml"
+    path.write_text("worlds: [office\n", encoding="utf-8")
+    with pytest.raises(CampaignError, match=r"broken\.yaml: cannot read campaign"):
+        load_campaign(path)
+
+
+def test_worlds_targets_strategies_robots_and_seeds_multiply():
+    campaign = parse({"worlds": ["office", "office_no_tables"],
+                      "targets": ["cerealbox", {"label": "stapler", "expected": "found"}],
+                      "strategies": ["switching", {"name": "exhaustive", "label": "ex-fast",
+                                                   "options": {"step": 2}}],
+                      "robots": ["pioneer", "pr2"], "seeds": "0-2", "time_budget_s": 300})
+    runs = campaign.runs()
+    assert len(runs) == 2 * 2 * 2 * 2 * 3
+    assert len({r.run_id for r in runs}) == len(runs)
+    first = runs[0]
+    assert first.run_id == "office-cerealbox-switching-pioneer-s0"
+    assert dict(first.episode) == {"world": "office", "target": "cerealbox", "seed": 0,
+                                   "robot": "pioneer", "time_budget_s": 300.0}
+    ex = next(r for r in runs if r.strategy.label == "ex-fast")
+    assert ex.episode["strategy"] == "exhaustive" and ex.episode["strategy_options"] == {"step": 2}
+    expected = {(r.subject.world, r.subject.target): r.subject.expected for r in runs}
+    assert expected[("office", "cerealbox")] == "found"  # on the kitchen table
+    assert expected[("office_no_tables", "cerealbox")] == "gave_up"  # Fig. 3e: none anywhere
+    assert expected[("office_no_tables", "stapler")] == "found"  # as the entry says
+
+
+def test_targets_per_world_and_world_files_relative_to_the_campaign(tmp_path):
+    world = Path(subjects_module.__file__).parents[2] / "sim" / "worlds" / "office.yaml"
+    (tmp_path / "mine.yaml").write_text(world.read_text(encoding="utf-8"), encoding="utf-8")
+    campaign = parse({"worlds": ["office", {"world": "mine.yaml", "targets": ["cup"],
+                                            "start_room": "kitchen"}],
+                      "targets": {"office": ["stapler", "banana"]}}, tmp_path)
+    runs = campaign.runs()
+    assert [(r.subject.world, r.subject.target, r.subject.expected) for r in runs] == [
+        ("office", "stapler", "found"), ("office", "banana", "gave_up"),
+        ("mine", "cup", "found")]  # office.yaml has a cup
+    assert runs[2].episode["world"] == str(tmp_path / "mine.yaml")
+    assert runs[2].episode["start_room"] == "kitchen"
+
+
+def test_generated_worlds_with_auto_targets(monkeypatch):
+    calls = []
+
+    def fake(seed, style, rooms):
+        calls.append((seed, style, rooms))
+        return [("cup", True), (f"thing{seed}", True), ("banana", False)]
+
+    monkeypatch.setattr(subjects_module, "generated_targets", fake)
+    campaign = parse({"worlds": [{"generate": {"seeds": "3-6", "style": "office", "rooms": 6}}],
+                      "targets": "auto", "strategies": STRATEGIES})
+    runs = campaign.runs()
+    assert calls == [(s, "office", 6) for s in range(3, 7)]
+    assert len(runs) == 4 * 3 * 3
+    run = runs[0]
+    assert run.run_id == "gen-office-r6-3-cup-switching-s0"
+    assert run.episode["generate"] == {"seed": 3, "style": "office", "rooms": 6}
+    assert "world" not in run.episode
+    assert run.subject.group == "gen-office-r6"
+    assert {(r.subject.target, r.subject.expected) for r in runs if r.subject.world.endswith(
+        "-4")} == {("cup", "found"), ("thing4", "found"), ("banana", "gave_up")}
+
+
+def test_the_built_in_seed003_campaign_is_fig3_a_to_f_times_20_seeds():
+    campaign = load_campaign("seed003-fig3")
+    runs = campaign.runs()
+    assert len(runs) == 120
+    assert {r.subject.scenario: r.subject.expected for r in runs} == PAPER_OUTCOME
+    assert sorted({r.seed for r in runs}) == list(range(20))
+    f = next(r for r in runs if r.subject.scenario == "f")
+    assert f.episode["pre_explore"] is True and f.episode["target"] == "whiteboardmarker"
+
+
+def test_the_built_in_generated_campaign_is_50_worlds_times_3_strategies(monkeypatch):
+    monkeypatch.setattr(subjects_module, "generated_targets",
+                        lambda seed, style, rooms: [("cup", True), ("mug", True), ("x", False)])
+    runs = load_campaign("generated-50").runs()
+    assert len(runs) == 50 * 3 * 3
+    assert {r.strategy.name for r in runs} == set(STRATEGIES)
+    assert {r.subject.spec["generate"]["rooms"] for r in runs} == {6}
