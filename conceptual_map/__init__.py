@@ -1,4 +1,5 @@
-"""The robot's spatial knowledge: metric maps, place map, conceptual layer (chain graph), QSR.
+"""The robot's spatial knowledge: metric maps, place map, conceptual layer (chain graph), and
+QSR models (`conceptual_map.qsr`: relation mixtures and supporting planes, seed 002).
 
 Never imports `sim`: everything it knows comes from sensor data handed over by the executor.
 The conceptual layer's facade is `conceptual_map.ConceptualMap` (imported on first use, so

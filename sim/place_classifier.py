@@ -16,6 +16,9 @@ from sim.errors import SimError
 from sim.sensor_data import PlaceObservation
 
 DEFAULT_ACCURACY = 0.7  # a model parameter, not a measurement
+# The categories a classifier knows when the caller gives none: a vocabulary of its own, never
+# the categories of the building at hand (a one-category building would get a perfect one)
+DEFAULT_CATEGORIES = ("corridor", "kitchen", "office", "meeting_room", "living_room", "bathroom")
 
 
 @dataclass(frozen=True)

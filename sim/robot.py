@@ -17,7 +17,7 @@ import numpy as np
 from sim.camera import DetectorConfig, depth_frame, detect_objects
 from sim.errors import JointLimitError, MotionError, PathBlockedError, SimError, WorldFileError
 from sim.laser import laser_scan
-from sim.place_classifier import PlaceClassifier
+from sim.place_classifier import DEFAULT_CATEGORIES, PlaceClassifier
 from sim.robot_models import ROBOT_MODELS, Limits, RobotModel
 from sim.scene import ROBOT_GROUP, WORLD_GROUP
 from sim.sensor_data import CameraView, DepthScan, DetectionFrame, LaserScan, PlaceObservation
@@ -42,7 +42,8 @@ class MotionResult:
 class Robot:
     """A robot standing in a `World`; every call advances `clock` (simulated seconds)."""
 
-    def __init__(self, world: World, model: str, start: Sequence[float]):
+    def __init__(self, world: World, model: str, start: Sequence[float],
+                 categories: Sequence[str] | None = None):
         if model not in ROBOT_MODELS:
             raise SimError(f"unknown robot model {model!r} (known: {', '.join(ROBOT_MODELS)})")
         self.world = world
@@ -50,8 +51,7 @@ class Robot:
         self.clock = 0.0
         self.odometry = 0.0
         self.detector_config = DetectorConfig()
-        categories = [room.category for room in world.spec.rooms]
-        self.place_classifier = PlaceClassifier.with_accuracy(categories)
+        self.place_classifier = _classifier(world, categories)
         self._rng = world.rng(f"robot-{model}-sensors")
         self._pose = (float(start[0]), float(start[1]), float(start[2]))
         self._torso = self._pan = self._tilt = 0.0
@@ -251,6 +251,18 @@ class Robot:
         state = self.world.client.getLinkState(self.body, link, computeForwardKinematics=True)
         matrix = np.array(self.world.client.getMatrixFromQuaternion(state[5])).reshape(3, 3)
         return matrix[:, 0]
+
+
+def _classifier(world: World, categories: Sequence[str] | None) -> PlaceClassifier:
+    """A classifier that confuses among `categories` (its own default vocabulary when None);
+    every room of the world must have a category it knows."""
+    known = tuple(categories) if categories is not None else DEFAULT_CATEGORIES
+    for i, room in enumerate(world.spec.rooms):
+        if room.category not in known:
+            raise WorldFileError(f"{world.spec.source}: rooms[{i}] ({room.name}): category "
+                                 f"{room.category!r} is not one the place classifier knows "
+                                 f"({', '.join(known)})")
+    return PlaceClassifier.with_accuracy(known)
 
 
 def _waypoint(point: Sequence[float], index: int) -> tuple[float, float]:

@@ -10,7 +10,7 @@ import contextlib
 import os
 import sys
 import zlib
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,7 +44,9 @@ class Detectable:
 class World:
     """A loaded world: its spec, physics client, bodies, and seeded random streams."""
 
-    def __init__(self, spec: WorldSpec, seed: int = 0):
+    def __init__(self, spec: WorldSpec, seed: int = 0,
+                 categories: Sequence[str] | None = None):
+        """`categories`: the place classifier's vocabulary (its default when None)."""
         from sim.robot import Robot  # the robot adapter needs a built world to stand in
 
         self.spec = spec
@@ -57,7 +59,7 @@ class World:
         self.detectables: list[Detectable] = []
         try:
             self._build()
-            self.robot = Robot(self, spec.robot.model, spec.robot.start)
+            self.robot = Robot(self, spec.robot.model, spec.robot.start, categories)
         except BaseException:
             self.close()  # a refused world must not leak its physics client
             raise

@@ -16,7 +16,15 @@ import yaml
 
 from sim.errors import WorldFileError
 from sim.world_checks import check_world
-from sim.world_spec import DoorSpec, FurnitureSpec, ObjectSpec, RobotSpec, RoomSpec, WorldSpec
+from sim.world_spec import (
+    DoorSpec,
+    FurnitureSpec,
+    ObjectSpec,
+    RobotSpec,
+    RoomSpec,
+    WorldSpec,
+    normalise_category,
+)
 
 WORLDS_DIR = Path(__file__).parent / "worlds"
 ROBOT_MODELS = ("pioneer", "pr2")
@@ -107,7 +115,8 @@ def _room(entry: Any, label: str, where: str) -> RoomSpec:
     m = _mapping(entry, label, where, {"name", "category", "rect"}, {"name", "category", "rect"})
     where = f"{where} ({m['name']})"
     rect = _vector(m["rect"], 4, label, f"{where}.rect")
-    return RoomSpec(_string(m["name"], label, where), _string(m["category"], label, where), rect)
+    category = normalise_category(_string(m["category"], label, where))
+    return RoomSpec(_string(m["name"], label, where), category, rect)
 
 
 def _door(entry: Any, label: str, where: str) -> DoorSpec:

@@ -14,6 +14,12 @@ Vec3 = tuple[float, float, float]
 Rect = tuple[float, float, float, float]
 
 
+def normalise_category(name: str) -> str:
+    """One spelling per room category: case, spaces and hyphens do not matter
+    (`Meeting room` = `meeting-room` = `meeting_room`)."""
+    return "_".join(name.strip().lower().replace("-", " ").split())
+
+
 @dataclass(frozen=True)
 class RoomSpec:
     """An axis-aligned room; walls are built on its border."""

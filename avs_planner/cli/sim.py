@@ -71,14 +71,16 @@ def run_check(args: argparse.Namespace) -> int:
 
 
 def _load(world: str) -> WorldSpec | None:
-    """Parse, validate, and build the world once (which also checks the robot's start)."""
+    """Parse, validate, and build the world once (which also checks the robot's start and
+    that every room category is one of the knowledge base's)."""
+    from conceptual_map.knowledge import load_knowledge
     from sim.errors import SimError
     from sim.scene import World
     from sim.world_file import load_world_spec
 
     try:
         spec = load_world_spec(world)
-        World(spec).close()
+        World(spec, categories=load_knowledge().categories).close()
     except SimError as exc:
         print(f"avs: error: {exc}", file=sys.stderr)
         return None

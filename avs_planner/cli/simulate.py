@@ -24,11 +24,21 @@ def register(subparsers: Any) -> None:
                     "Exit codes: 0 found, 1 bad input, 2 gave up, 3 timeout.")
     parser.add_argument("--world", help="built-in world name or world YAML path (default: "
                         "office, or the scenario's)")
+    parser.add_argument("--generated", type=int, metavar="SEED",
+                        help="a generated world (see `avs world generate`) instead of --world")
+    parser.add_argument("--style", default="office", help="generated world style "
+                        "(office, apartment, lab; default office)")
+    parser.add_argument("--rooms", type=int, help="generated world: number of rooms")
     parser.add_argument("--target", help="object label to find, e.g. cerealbox")
     parser.add_argument("--scenario", help="a seed run a-f (or a scenario YAML path); "
                         "other options override it")
     parser.add_argument("--category", help="only an object in a room of this category")
     parser.add_argument("--robot", choices=["pioneer", "pr2"])
+    parser.add_argument("--strategy", default=None, help="search strategy: switching (the "
+                        "default), exhaustive, most-likely-room, ... (an unknown name lists "
+                        "them all)")
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+                        help="a strategy option, e.g. --option reward=800 (repeatable)")
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--start-room", help="start at the centre of this room")
     where.add_argument("--start", help="start pose x,y,yaw (metres, radians)")
@@ -74,10 +84,24 @@ def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
     if args.start:
         spec.pop("start_room", None)
         spec["start"] = _pose(args.start)
+    if args.generated is not None:
+        spec.pop("world", None)
+        spec["generate"] = {"seed": args.generated, "style": args.style, "rooms": args.rooms}
+    if args.strategy:
+        spec["strategy"] = args.strategy
+    if args.option:
+        spec["strategy_options"] = dict(_option(text) for text in args.option)
     if not spec.get("target"):
         raise ValueError("--target LABEL (or --scenario) is required")
     spec["output_dir"] = args.out
     return spec
+
+
+def _option(text: str) -> tuple[str, str]:
+    key, sep, value = text.partition("=")
+    if not sep or not key:
+        raise ValueError(f"--option {text!r}: expected KEY=VALUE, e.g. reward=800")
+    return key.strip(), value.strip()
 
 
 def _pose(text: str) -> list[float]:

@@ -50,6 +50,7 @@ class ExecutorConfig:
     support_radius: float = 0.9  # m: a detection this near a support is "on" it
     same_object: float = 1.0  # m: a detection this near a known object of its label is it
     above_support: tuple[float, float] = (-0.15, 0.45)  # m around the support's top
+    doorway_clearance: float = 0.6  # m from a mapped door: no place classification there
 
 
 @dataclass
@@ -90,9 +91,7 @@ class Executor:
         events = self.mind.sense(self.robot.scan(), poses, self.robot.clock)
         place = self.mind.place_map.current_place
         if place is not None and (place != before or place not in self.mind.classified):
-            observed = self.robot.classify_place()
-            if observed is not None:
-                self.mind.observe_appearance(observed)
+            self._classify()
         if events:
             kinds: dict[str, int] = {}
             for e in events:
@@ -100,6 +99,20 @@ class Executor:
                 kinds[key] = kinds.get(key, 0) + 1
             self.emit("belief", map_events=kinds)
         self._record_pose()
+
+    def _classify(self) -> None:
+        """Ask the place classifier, unless the robot stands in a doorway (it would see the
+        room beyond and credit it to this place); a reading that cannot be used is a warning
+        in the trace, never dropped silently."""
+        if self.mind.near_door(self.robot.pose[:2], self.config.doorway_clearance):
+            return
+        observed = self.robot.classify_place()
+        if observed is None:
+            self.emit("warning", source="place_classifier", detail="no reading here")
+            return
+        unused = self.mind.observe_appearance(observed)
+        if unused is not None:
+            self.emit("warning", source="place_classifier", observed=observed, detail=unused)
 
     def _record_pose(self) -> None:
         x, y, yaw = self.robot.pose

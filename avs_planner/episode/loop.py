@@ -8,24 +8,16 @@ episode gives up when no plan reaches the success threshold.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
-from enum import Enum
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 from avs_planner.cp.continual import ContinualPlanner, Decision
 from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep, SearchOptions
 from avs_planner.episode.executor import Executor
-from avs_planner.episode.mind import KnownObject
-from avs_planner.episode.outcome import StepOutcome, StepStatus
+from avs_planner.episode.outcome import Outcome, SearchResult, StepOutcome, StepStatus
 from avs_planner.episode.state_builder import AvsState, StateBuilder
 from avs_planner.episode.trace import Trace
-
-
-class Outcome(Enum):
-    FOUND = "found"
-    GAVE_UP = "gave_up"
-    TIMEOUT = "timeout"
 
 
 @dataclass(frozen=True)
@@ -55,16 +47,6 @@ class LoopConfig:
     doubt_category: float = 0.999
 
 
-@dataclass
-class LoopResult:
-    outcome: Outcome
-    reason: str
-    found: KnownObject | None = None
-    plans: int = 0
-    replans: int = 0
-    cp_times: list[float] = field(default_factory=list)
-
-
 class SwitchingLoop:
     """Owns the continual planner; asks the executor to run each non-assumptive step."""
 
@@ -73,12 +55,12 @@ class SwitchingLoop:
         self.builder, self.executor, self.trace = builder, executor, trace
         self.config = config or LoopConfig()
         self.should_stop = should_stop or (lambda: False)
-        self.result = LoopResult(Outcome.GAVE_UP, "")
+        self.result = SearchResult(Outcome.GAVE_UP, "")
         self.planner: ContinualPlanner | None = None
         self.start_clock = executor.robot.clock
         self.visited_rooms: set[str] = set()
 
-    def run(self) -> LoopResult:
+    def run(self) -> SearchResult:
         self.executor.look_around()
         state = self.builder.build()
         self.planner = ContinualPlanner(state.skeleton(), self._options(),
@@ -269,7 +251,7 @@ class SwitchingLoop:
             return f"wall time budget {cfg.wall_budget_s:g} s spent"
         return None
 
-    def _end(self, outcome: Outcome, reason: str) -> LoopResult:
+    def _end(self, outcome: Outcome, reason: str) -> SearchResult:
         self.result.outcome, self.result.reason = outcome, reason
         self.trace.emit("done", outcome=outcome.value, reason=reason)
         return self.result

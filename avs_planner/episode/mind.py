@@ -10,10 +10,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from conceptual_map.conceptual import ConceptualMap, RelatedSpace
 from conceptual_map.conceptual.place_events import PlaceMapFeed
-from conceptual_map.metric import OccupancyGrid
-from conceptual_map.metric.sensors import LaserScanLike
+from conceptual_map.metric import OccupancyGrid, VoxelMap
+from conceptual_map.metric.sensors import DepthFrameLike, LaserScanLike
 from conceptual_map.places import MapEvent, PlaceMap, PlaceMapConfig
 
 Pose = tuple[float, float, float]
@@ -43,6 +45,9 @@ class Mind:
     cones_made: set[tuple[str, str, str]] = field(default_factory=set)
     tried_placeholders: dict[str, int] = field(default_factory=dict)
     classified: set[str] = field(default_factory=set)
+    voxel_resolution: float = 0.05
+    voxel_heights: tuple[float, float] = (-0.1, 2.5)  # m: the band the 3D map covers
+    voxels: VoxelMap | None = field(default=None, init=False)
 
     def __post_init__(self) -> None:
         self.grid = OccupancyGrid(resolution=self.resolution)
@@ -63,18 +68,44 @@ class Mind:
         place-map update after several scans from one spot gives the same places)."""
         self.grid.integrate_scan(scan)
 
-    def observe_appearance(self, observed: str) -> bool:
-        """The place classifier said `observed` at the current place; False if not usable."""
+    def integrate_depth(self, frame: DepthFrameLike) -> VoxelMap:
+        """Add a depth frame to the 3D map, which covers the 2D grid's extent (grown with it)
+        over `voxel_heights`; rays leaving that band are cut at its border."""
+        lo = np.asarray(self.grid.origin, dtype=float)
+        hi = lo + np.asarray(self.grid.shape) * self.grid.resolution
+        z0, z1 = self.voxel_heights
+        if self.voxels is None:
+            self.voxels = VoxelMap(origin=(lo[0], lo[1], z0),
+                                   size=(hi[0] - lo[0], hi[1] - lo[1], z1 - z0),
+                                   resolution=self.voxel_resolution)
+        else:
+            mid = (z0 + z1) / 2
+            self.voxels.ensure_contains(np.array([[lo[0], lo[1], mid], [hi[0], hi[1], mid]]))
+        self.voxels.integrate_depth(frame)
+        return self.voxels
+
+    def observe_appearance(self, observed: str) -> str | None:
+        """The place classifier said `observed` at the current place: None when the reading
+        became evidence, else why it could not be used (the caller reports it)."""
         place = self.place_map.current_place
         if place is None or not self.cmap.graph.has_place(place):
-            return False
+            return f"no place to credit the reading {observed!r} to yet"
         value = f"{observed}_like"
         model = self.cmap.knowledge.properties.get("appearance")
-        if model is None or value not in model.values:
-            return False
+        if model is None:
+            return "the knowledge base has no 'appearance' property"
+        if value not in model.values:
+            return (f"the knowledge base has no appearance value {value!r} (known: "
+                    f"{', '.join(model.values)})")
         self.cmap.observe_property(place, "appearance", value)
         self.classified.add(place)
-        return True
+        return None
+
+    def near_door(self, position: tuple[float, float], clearance: float) -> bool:
+        """Whether `position` is within `clearance` of a door the robot has mapped (a reading
+        taken in a doorway may see the room on the other side)."""
+        return any(math.dist(d.centre, position) < clearance
+                   for d in self.place_map.doors.values())
 
     def room_at(self, position: tuple[float, float]) -> str | None:
         """The room of the place nearest to `position` (None before any room exists)."""

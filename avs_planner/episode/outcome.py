@@ -1,4 +1,5 @@
-"""What executing one plan step produced: status, detail, observed atoms, reported object."""
+"""What a step produced (status, detail, observed atoms, reported object) and how a whole
+search ended (`Outcome`, `SearchResult`: every strategy returns one)."""
 
 from __future__ import annotations
 
@@ -14,6 +15,25 @@ class SeenLike(Protocol):
     label: str
     position: tuple[float, float, float]
     id: int
+
+
+class Outcome(Enum):
+    FOUND = "found"
+    GAVE_UP = "gave_up"
+    TIMEOUT = "timeout"
+
+
+@dataclass
+class SearchResult:
+    """How a search ended; `plans`, `replans` and `cp_times` stay empty for strategies that
+    do not plan with the CP."""
+
+    outcome: Outcome
+    reason: str
+    found: KnownObject | None = None
+    plans: int = 0
+    replans: int = 0
+    cp_times: list[float] = field(default_factory=list)
 
 
 class StepStatus(Enum):

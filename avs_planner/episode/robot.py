@@ -9,9 +9,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from matplotlib.path import Path as MplPath
 
@@ -130,6 +131,31 @@ def load_spec(world: str | Path, robot: str | None = None, start: Sequence[float
         spec = load_world_spec(world)
     except SimError as exc:
         raise EpisodeError(str(exc)) from exc
+    return _with_robot(spec, robot, start, start_room, closed_doors)
+
+
+def generated_spec(generate: Mapping[str, Any], robot: str | None = None,
+                   start: Sequence[float] | None = None,
+                   start_room: str | None = None) -> WorldSpec:
+    """A generated world (`{seed, style, rooms, surprise}`, see `sim.generate`)."""
+    from sim.generate import generate_world
+
+    unknown = set(generate) - {"seed", "style", "rooms", "surprise"}
+    if unknown or "seed" not in generate:
+        raise EpisodeError(f"generate: expected keys seed (required), style, rooms, surprise; "
+                           f"got {sorted(generate)}")
+    try:
+        world = generate_world(int(generate["seed"]), str(generate.get("style", "office")),
+                               generate.get("rooms"), float(generate.get("surprise", 0.25)))
+        spec = world.spec()
+    except (SimError, TypeError, ValueError) as exc:
+        raise EpisodeError(f"generate: {exc}") from exc
+    return _with_robot(spec, robot, start, start_room, ())
+
+
+def _with_robot(spec: WorldSpec, robot: str | None, start: Sequence[float] | None,
+                start_room: str | None, closed_doors: Sequence[int]) -> WorldSpec:
+    """The spec with the robot model, start pose and door states an episode asks for."""
     pose = tuple(spec.robot.start)
     if start_room is not None:
         room = spec.room(start_room)
@@ -172,9 +198,21 @@ def free_spot(spec: WorldSpec, room: RoomSpec, model: str,
     raise EpisodeError(f"room {room.name!r} has no spot free for the robot to start in")
 
 
-def open_world(spec: WorldSpec, seed: int) -> SimRobot:
-    """Build the PyBullet world (close it with `robot.world.close()`)."""
+def check_categories(spec: WorldSpec, known: Sequence[str]) -> None:
+    """Every room's category must be one of the conceptual map's (`known`), else the robot's
+    readings there could not be used; the error names the room and the known categories."""
+    for i, room in enumerate(spec.rooms):
+        if room.category not in known:
+            raise EpisodeError(f"{spec.source}: rooms[{i}] ({room.name}): category "
+                               f"{room.category!r} is not in the knowledge base (known: "
+                               f"{', '.join(known)}; case, spaces and hyphens do not matter)")
+
+
+def open_world(spec: WorldSpec, seed: int, categories: Sequence[str] | None = None
+               ) -> SimRobot:
+    """Build the PyBullet world (close it with `robot.world.close()`); the place classifier
+    confuses among `categories` (the conceptual map's vocabulary), not the building's."""
     try:
-        return SimRobot(World(spec, seed))
+        return SimRobot(World(spec, seed, categories))
     except SimError as exc:
         raise EpisodeError(str(exc)) from exc

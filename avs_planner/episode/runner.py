@@ -15,17 +15,25 @@ from typing import Any
 
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.executor import Executor, ExecutorConfig
-from avs_planner.episode.loop import LoopConfig, LoopResult, SwitchingLoop
 from avs_planner.episode.mind import Mind
-from avs_planner.episode.robot import SimRobot, load_spec, open_world
+from avs_planner.episode.outcome import SearchResult
+from avs_planner.episode.robot import (
+    SimRobot,
+    check_categories,
+    generated_spec,
+    load_spec,
+    open_world,
+)
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.trace import Trace, write_summary
 from avs_planner.episode.viewcones import CameraModel
+from avs_planner.strategies import SearchContext, get_strategy
 
 Emit = Callable[[dict[str, Any]], None]
 
 _KEYS = {"target", "category", "world", "world_file", "robot", "start_room", "start", "seed",
-         "time_budget_s", "wall_budget_s", "task_id", "output_dir", "pre_explore", "dt_policy"}
+         "time_budget_s", "wall_budget_s", "task_id", "output_dir", "pre_explore", "dt_policy",
+         "strategy", "strategy_options", "generate"}
 
 
 @dataclass(frozen=True)
@@ -44,6 +52,9 @@ class EpisodeSpec:
     output_dir: str | None = None
     pre_explore: bool = False
     dt_policy: str = "pouct"
+    strategy: str = "switching"
+    strategy_options: Mapping[str, Any] = field(default_factory=dict)
+    generate: Mapping[str, Any] | None = None  # {seed, style, rooms}: a generated world
     world_text: str | None = field(default=None, repr=False)
 
     @classmethod
@@ -53,6 +64,16 @@ class EpisodeSpec:
             raise EpisodeError(f"episode spec: unknown keys {sorted(unknown)}")
         if not isinstance(spec.get("target"), str) or not spec["target"]:
             raise EpisodeError("episode spec: 'target' (an object label) is required")
+        options = spec.get("strategy_options") or {}
+        if not isinstance(options, Mapping):
+            raise EpisodeError(f"episode spec: 'strategy_options' must be a mapping, got "
+                               f"{options!r}")
+        strategy = get_strategy(str(spec.get("strategy") or "switching"))
+        options = strategy.check_options(options)
+        generate = spec.get("generate")
+        if generate is not None and not isinstance(generate, Mapping):
+            raise EpisodeError(f"episode spec: 'generate' must be a mapping like "
+                               f"{{seed: 3, style: office}}, got {generate!r}")
         start = spec.get("start")
         if start is not None:
             if not isinstance(start, list | tuple) or len(start) != 3:
@@ -65,7 +86,8 @@ class EpisodeSpec:
             time_budget_s=_number(spec.get("time_budget_s", 1200.0), "time_budget_s"),
             wall_budget_s=_number(spec.get("wall_budget_s", 600.0), "wall_budget_s"),
             output_dir=spec.get("output_dir"), pre_explore=bool(spec.get("pre_explore")),
-            dt_policy=str(spec.get("dt_policy") or "pouct"), world_text=spec.get("world_file"),
+            dt_policy=str(spec.get("dt_policy") or "pouct"), strategy=strategy.name,
+            strategy_options=options, generate=generate, world_text=spec.get("world_file"),
         )
 
 
@@ -94,25 +116,31 @@ class Episode:
         self.spec = spec
         self.out = Path(spec.output_dir) if spec.output_dir else None
         self.world_spec = self._world_spec()
-        self.robot: SimRobot = open_world(self.world_spec, spec.seed)
+        self.mind = Mind()
+        categories = self.mind.cmap.knowledge.categories
+        check_categories(self.world_spec, categories)
+        self.robot: SimRobot = open_world(self.world_spec, spec.seed, categories)
         if self.out is not None:
             self.out.mkdir(parents=True, exist_ok=True)
         self.trace = Trace(lambda: self.robot.clock, self.out / "trace.jsonl" if self.out
                            else None, emit)
-        self.mind = Mind()
         self.builder = StateBuilder(self.mind, SearchTask(spec.target, spec.category))
         camera = self.robot.robot.model.camera
         self.camera = CameraModel(self.robot.camera_height, camera.hfov, camera.detect_range)
         self.executor = Executor(self.robot, self.mind, self.builder, self.camera,
                                  self._emit, ExecutorConfig(dt_policy=spec.dt_policy),
                                  seed=spec.seed)
-        self.loop = SwitchingLoop(self.builder, self.executor, self.trace,
-                                  LoopConfig(time_budget_s=spec.time_budget_s,
-                                             wall_budget_s=spec.wall_budget_s,
-                                             dump_dir=spec.output_dir), should_stop)
+        self.context = SearchContext(
+            robot=self.robot, body=self.robot.body(), mind=self.mind, builder=self.builder,
+            executor=self.executor, trace=self.trace, target=spec.target,
+            category=spec.category, time_budget_s=spec.time_budget_s,
+            wall_budget_s=spec.wall_budget_s, options=spec.strategy_options,
+            should_stop=should_stop or (lambda: False), dump_dir=spec.output_dir)
 
     def _world_spec(self):  # noqa: ANN202 - sim.WorldSpec
         spec = self.spec
+        if spec.generate is not None:
+            return generated_spec(spec.generate, spec.robot, spec.start, spec.start_room)
         if spec.world_text is None:
             return load_spec(spec.world, spec.robot, spec.start, spec.start_room)
         with tempfile.TemporaryDirectory() as tmp:
@@ -130,9 +158,9 @@ class Episode:
         try:
             self.trace.emit("start", target=self.spec.target, world=self.world_spec.name,
                             robot=self.robot.model, pose=list(self.robot.pose),
-                            seed=self.spec.seed)
+                            seed=self.spec.seed, strategy=self.spec.strategy)
             start_clock, start_distance = self._pre_explore()
-            result = self.loop.run()
+            result = get_strategy(self.spec.strategy).load()(self.context)
             summary = self.summary(result, start_clock, start_distance)
             if self.out is not None:
                 write_summary(self.out / "summary.json", summary)
@@ -150,10 +178,10 @@ class Episode:
             explore(self.executor)
             self.trace.emit("belief", pre_explored=True, places=len(self.mind.place_map.places),
                             rooms=len(self.mind.place_map.rooms))
-        self.loop.start_clock = self.robot.clock
+        self.context.start_clock = self.robot.clock
         return self.robot.clock, self.executor.stats.distance
 
-    def summary(self, result: LoopResult, start_clock: float, start_distance: float
+    def summary(self, result: SearchResult, start_clock: float, start_distance: float
                 ) -> dict[str, Any]:
         stats = self.executor.stats
         found = result.found
@@ -176,6 +204,7 @@ class Episode:
             "dt_decision_time_s": [round(t, 4) for t in stats.dt_decisions],
             "views_processed": stats.views, "seed": self.spec.seed,
             "world": self.world_spec.name, "robot": self.robot.model,
+            "strategy": self.spec.strategy,
             "wall_time_s": round(self.trace.wall, 2),
         }
 

@@ -32,6 +32,12 @@ class OccupancyGrid(LogOddsGrid):
         self._touch()
         return summary
 
+    def reset_cells(self, flat_indices: np.ndarray) -> UpdateSummary:
+        """Forget cells (back to unknown); derived grids are recomputed."""
+        summary = super().reset_cells(flat_indices)
+        self._touch()
+        return summary
+
     def _touch(self) -> None:
         self.version += 1
         self._cache.clear()

@@ -109,13 +109,18 @@ def _why_blocked(grid: OccupancyGrid, cell: tuple[int, int], radius: float) -> s
 
 
 def _escape_zone(grid: OccupancyGrid, start: tuple[int, int], radius: float) -> np.ndarray:
-    """Free cells near the start no closer to obstacles than the start itself."""
+    """Free cells near the start no closer to obstacles than the start itself, and the
+    cells under the robot's own base that are not occupied: the robot stands there (its laser
+    never sees them, so they stay unknown and would wall the start in)."""
     clearance = grid.clearance()
     reach = int(math.ceil(radius / grid.resolution)) + 1
     ii, jj = np.ogrid[: grid.shape[0], : grid.shape[1]]
-    near = (ii - start[0]) ** 2 + (jj - start[1]) ** 2 <= reach**2
-    free = grid.state_grid() == CellState.FREE
-    zone = near & free & (clearance >= min(clearance[start], radius) - 1e-9)
+    d2 = (ii - start[0]) ** 2 + (jj - start[1]) ** 2
+    states = grid.state_grid()
+    free = states == CellState.FREE
+    zone = (d2 <= reach**2) & free & (clearance >= min(clearance[start], radius) - 1e-9)
+    under = d2 <= (radius / grid.resolution) ** 2
+    zone |= under & (states != CellState.OCCUPIED)
     zone[start] = True
     return zone
 

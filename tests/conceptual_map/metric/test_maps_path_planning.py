@@ -106,3 +106,20 @@ def test_distance_field_is_inf_where_unreachable(grid: OccupancyGrid) -> None:
     assert field[grid.cell_of((1.0, 1.0))] == 0.0
     assert np.isinf(field[grid.cell_of((-0.5, -0.5))])  # outside the building
     assert field[grid.cell_of((5.0, 3.0))] > math.dist((1.0, 1.0), (5.0, 3.0))
+
+
+def test_unknown_cells_under_the_robot_do_not_wall_it_in(world: BoxWorld) -> None:
+    """A laser never sees the floor under its own base: those cells stay unknown, but the
+    robot stands there, so paths and distances start from it."""
+    blind = OccupancyGrid(origin=(-1.0, -1.0), size=(8.0, 6.0))
+    blind.integrate_scan(world.laser((1.5, 2.0, 0.0), beams=1440))
+    blind.integrate_scan(world.laser((1.5, 2.0, math.pi), beams=1440))
+    c = blind.cell_of((1.5, 2.0))
+    ii, jj = np.mgrid[c[0] - 3:c[0] + 4, c[1] - 3:c[1] + 4]  # what the base hides
+    blind.reset_cells(np.ravel_multi_index((ii.ravel(), jj.ravel()), blind.shape))
+    start = (1.5, 2.0)
+    field = distance_field(blind, start, robot_radius=0.25)
+    assert np.isfinite(field[blind.cell_of((2.3, 2.0))])
+    assert plan_path(blind, start, (2.3, 2.0), robot_radius=0.25).status is PathStatus.FOUND
+    # an obstacle under the base is still an obstacle: only unknown cells are assumed free
+    assert np.isinf(field[blind.cell_of((-0.5, -0.5))])

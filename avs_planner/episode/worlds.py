@@ -1,0 +1,32 @@
+"""Generated worlds as the planning side may see them: names and benchmark targets only.
+
+Campaigns and benchmarks ask which labels to search for in a generated world (two present, one
+absent); the answer comes from the generator's own record of what it placed, which is the
+experimenter's knowledge, never the robot's.
+"""
+
+from __future__ import annotations
+
+from avs_planner.episode.errors import EpisodeError
+
+
+def generated_targets(seed: int, style: str = "office", rooms: int | None = None,
+                      present: int = 2, absent: int = 1, surprise: float = 0.25
+                      ) -> list[tuple[str, bool]]:
+    """(label, present in the world) for a benchmark on the generated world `seed`."""
+    from sim.generate import generate_world
+
+    from sim.errors import SimError
+
+    try:
+        world = generate_world(seed, style, rooms, surprise)
+        labels = world.targets(seed, present, absent)
+    except SimError as exc:
+        raise EpisodeError(f"generate: {exc}") from exc
+    there = set(world.labels_present())
+    return [(label, label in there) for label in labels]
+
+
+def generated_name(seed: int, style: str = "office", rooms: int | None = None) -> str:
+    """The name a generated world is known by in tables and run ids."""
+    return f"gen-{style}-{seed}" + (f"-r{rooms}" if rooms is not None else "")

@@ -1,0 +1,36 @@
+"""QSR view selection (Kunze et al., eq. 2 and Algorithm 1): where to stand and where to look."""
+
+from avs_planner.qsr.geometry import in_frustums, in_view_cones
+from avs_planner.qsr.poses import candidate_cells, reachable, sample_poses
+from avs_planner.qsr.select import (
+    Frustum,
+    ScoredPose,
+    SelectionStatus,
+    ViewMethod,
+    ViewOptions,
+    ViewSelection,
+    ViewSelectionError,
+    cone_half_angle,
+    rank_frustums,
+    score_cones,
+    select_view,
+)
+
+__all__ = [
+    "Frustum",
+    "ScoredPose",
+    "SelectionStatus",
+    "ViewMethod",
+    "ViewOptions",
+    "ViewSelection",
+    "ViewSelectionError",
+    "candidate_cells",
+    "cone_half_angle",
+    "in_frustums",
+    "in_view_cones",
+    "rank_frustums",
+    "reachable",
+    "sample_poses",
+    "score_cones",
+    "select_view",
+]

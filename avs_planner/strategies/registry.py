@@ -1,0 +1,101 @@
+"""The registry: strategy name -> where its `run` function lives, what it does, its options."""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, fields
+from typing import Any
+
+from avs_planner.episode.errors import EpisodeError
+from avs_planner.episode.loop import LoopConfig
+from avs_planner.episode.outcome import SearchResult
+from avs_planner.strategies.context import SearchContext
+
+Run = Callable[[SearchContext], SearchResult]
+
+
+class StrategyError(EpisodeError):
+    """An unknown strategy name or a bad strategy option."""
+
+
+@dataclass(frozen=True)
+class Strategy:
+    """A registered strategy: `entry` is "module:function"; `options` name its settings and
+    their defaults (types are taken from the defaults)."""
+
+    name: str
+    summary: str
+    entry: str
+    options: Mapping[str, Any]
+
+    def load(self) -> Run:
+        module, function = self.entry.split(":")
+        return getattr(importlib.import_module(module), function)
+
+    def check_options(self, given: Mapping[str, Any] | None) -> dict[str, Any]:
+        """The defaults overridden by `given`, each converted to its default's type."""
+        given = dict(given or {})
+        unknown = sorted(set(given) - set(self.options))
+        if unknown:
+            known = ", ".join(sorted(self.options)) or "none"
+            raise StrategyError(f"strategy {self.name!r}: unknown option(s) "
+                                f"{', '.join(unknown)} (known: {known})")
+        return {key: _convert(self.name, key, given.get(key, default), default)
+                for key, default in self.options.items()}
+
+
+def _convert(strategy: str, key: str, value: Any, default: Any) -> Any:
+    kind = type(default)
+    if value is None or isinstance(value, kind) and not (kind is int and isinstance(value, bool)):
+        return value
+    try:
+        if kind is bool:
+            if isinstance(value, str) and value.lower() in ("true", "false", "1", "0"):
+                return value.lower() in ("true", "1")
+            raise ValueError
+        if kind in (int, float) and not isinstance(value, bool):
+            converted = kind(value)
+            if kind is int and converted != float(value):
+                raise ValueError
+            return converted
+        if kind is str:
+            return str(value)
+    except (TypeError, ValueError):
+        pass
+    raise StrategyError(f"strategy {strategy!r}: option {key!r} must be {_article(kind.__name__)} "
+                        f"(default {default!r}), got {value!r}")
+
+
+# the loop's settings, less what the episode spec gives (budgets, where to dump problems)
+_SWITCHING_OPTIONS = {f.name: f.default for f in fields(LoopConfig)
+                      if f.name not in ("time_budget_s", "wall_budget_s", "dump_dir")}
+
+STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
+    Strategy("switching", "the switching planner: continual PDDL planner with assumptions + "
+             "POMDP view-cone search (Goebelbecker et al.)",
+             "avs_planner.strategies.switching:run", _SWITCHING_OPTIONS),
+    Strategy("exhaustive", "baseline: frontier exploration, nearest placeholder first, "
+             "looking all round at every stop; no priors",
+             "avs_planner.strategies.baselines:run_exhaustive",
+             {"headings": 6, "max_stops": 400}),
+    Strategy("most-likely-room", "baseline: rooms in order of P(object in room), each swept "
+             "fully; unexplored space competes as a hypothetical room",
+             "avs_planner.strategies.baselines:run_most_likely_room",
+             {"headings": 6, "sweep_spacing": 1.5, "max_stops": 400}),
+)}
+
+
+def strategy_names() -> list[str]:
+    return sorted(STRATEGIES)
+
+
+def get_strategy(name: str) -> Strategy:
+    strategy = STRATEGIES.get(name)
+    if strategy is None:
+        raise StrategyError(f"unknown strategy {name!r} (known: {', '.join(strategy_names())})")
+    return strategy
+
+
+def _article(noun: str) -> str:
+    return f"an {noun}" if noun[0] in "aeiou" else f"a {noun}"
