@@ -16,6 +16,7 @@ from typing import Any
 
 import yaml
 
+from avs_planner.errors import AvsError
 from avs_planner.experiment.errors import CampaignError
 from avs_planner.experiment.subjects import Subject, scenario_subjects, world_subjects
 from avs_planner.experiment.values import Where, parse_seeds, positive_number
@@ -179,6 +180,7 @@ def _strategy(item: Any, where: Where, known: list[str]) -> Strategy:
     options = item.get("options") or {}
     if not isinstance(options, dict):
         raise where.at("options").error("strategy options are a mapping")
+    _check_options(name, options, where.at("options"))
     label = str(item.get("label") or name)
     if not re.fullmatch(r"[A-Za-z0-9_.-]+", label):
         raise where.at("label").error(f"{label!r}: use letters, digits, '-', '_' or '.'")
@@ -186,12 +188,20 @@ def _strategy(item: Any, where: Where, known: list[str]) -> Strategy:
 
 
 def strategy_names() -> list[str]:
-    """The registered strategies (only the default before the registry exists)."""
-    try:
-        from avs_planner.strategies import strategy_names as registered
-    except ImportError:
-        return [DEFAULT_STRATEGY]
+    """The registered strategies."""
+    from avs_planner.strategies import strategy_names as registered
+
     return list(registered())
+
+
+def _check_options(name: str, options: dict[str, Any], where: Where) -> None:
+    """The strategy's own check of its options (names and types), at load time."""
+    from avs_planner.strategies import get_strategy
+
+    try:
+        get_strategy(name).check_options(options)
+    except AvsError as exc:
+        raise where.error(str(exc)) from None
 
 
 def _robots(value: Any, where: Where) -> tuple[str | None, ...]:

@@ -134,8 +134,9 @@ def _generated(entry: dict[str, Any], targets: tuple[Any, Where], at: Where
         spec = {"generate": {"seed": seed, "style": style, "rooms": rooms}}
         pairs = (_auto(seed, style, rooms, t_at) if value == AUTO
                  else list(_labels(value, t_at)))
+        name = generated_name(seed, style, rooms)
         for label, expected in pairs:
-            yield Subject(f"{group}-{seed}", group, label, expected, None, spec)
+            yield Subject(name, group, label, expected, None, spec)
 
 
 def _auto(seed: int, style: str, rooms: int | None, where: Where
@@ -147,14 +148,20 @@ def _auto(seed: int, style: str, rooms: int | None, where: Where
     return [(label, _EXPECTED[not present]) for label, present in pairs]
 
 
+def generated_name(seed: int, style: str, rooms: int | None) -> str:
+    from avs_planner.episode.worlds import generated_name as name
+
+    return name(seed, style, rooms)
+
+
 def generated_targets(seed: int, style: str, rooms: int | None) -> list[tuple[str, bool]]:
     """The generator's (label, present in the world) targets for one generated world."""
+    from avs_planner.episode.worlds import generated_targets as targets
+
     try:
-        from avs_planner.episode.worlds import generated_targets as targets
-    except ImportError:
-        raise CampaignError("generated worlds are not available in this build "
-                            "(avs_planner.episode.worlds is missing)") from None
-    return list(targets(seed, style, rooms))
+        return list(targets(seed, style, rooms))
+    except ImportError as exc:
+        raise CampaignError(f"generated worlds are not available in this build: {exc}") from None
 
 
 def _labels(value: Any, where: Where) -> Iterator[tuple[str, str | None]]:

@@ -7,17 +7,11 @@ from pathlib import Path
 import pytest
 
 from avs_planner.experiment import CampaignError, load_campaign
-from avs_planner.experiment import campaign as campaign_module
 from avs_planner.experiment import subjects as subjects_module
 from avs_planner.experiment.campaign import parse_campaign
 from avs_planner.experiment.report import PAPER_OUTCOME
 
-STRATEGIES = ["switching", "exhaustive", "most-likely-room"]
-
-
-@pytest.fixture(autouse=True)
-def registry(monkeypatch):
-    monkeypatch.setattr(campaign_module, "strategy_names", lambda: list(STRATEGIES))
+STRATEGIES = ["switching", "exhaustive", "most-likely-room"]  # registered in main
 
 
 def parse(data, base: Path = Path(".")):
@@ -49,7 +43,11 @@ WORLD = {"worlds": ["office"], "targets": ["cerealbox"]}
      ["worlds[0]: unknown keys ['color']"]),
     ({"worlds": [3], "targets": ["cup"]}, ["worlds[0]: a world name or path"]),
     ({**WORLD, "strategies": ["switching", "flap"]},
-     ["strategies[1]: unknown strategy 'flap'", "switching, exhaustive, most-likely-room"]),
+     ["strategies[1]: unknown strategy 'flap'", "exhaustive, most-likely-room, switching"]),
+    ({**WORLD, "strategies": [{"name": "exhaustive", "options": {"headings": "many"}}]},
+     ["strategies[0].options: strategy 'exhaustive': option 'headings' must be an int"]),
+    ({**WORLD, "strategies": [{"name": "exhaustive", "options": {"speed": 2}}]},
+     ["strategies[0].options: strategy 'exhaustive': unknown option(s) speed"]),
     ({**WORLD, "strategies": ["switching", "switching"]},
      ["strategies[1]: label 'switching' is used twice"]),
     ({**WORLD, "strategies": [{"name": "switching", "options": [1]}]},
@@ -94,7 +92,7 @@ def test_worlds_targets_strategies_robots_and_seeds_multiply():
     campaign = parse({"worlds": ["office", "office_no_tables"],
                       "targets": ["cerealbox", {"label": "stapler", "expected": "found"}],
                       "strategies": ["switching", {"name": "exhaustive", "label": "ex-fast",
-                                                   "options": {"step": 2}}],
+                                                   "options": {"headings": 8}}],
                       "robots": ["pioneer", "pr2"], "seeds": "0-2", "time_budget_s": 300})
     runs = campaign.runs()
     assert len(runs) == 2 * 2 * 2 * 2 * 3
@@ -104,7 +102,8 @@ def test_worlds_targets_strategies_robots_and_seeds_multiply():
     assert dict(first.episode) == {"world": "office", "target": "cerealbox", "seed": 0,
                                    "robot": "pioneer", "time_budget_s": 300.0}
     ex = next(r for r in runs if r.strategy.label == "ex-fast")
-    assert ex.episode["strategy"] == "exhaustive" and ex.episode["strategy_options"] == {"step": 2}
+    assert ex.episode["strategy"] == "exhaustive"
+    assert ex.episode["strategy_options"] == {"headings": 8}
     expected = {(r.subject.world, r.subject.target): r.subject.expected for r in runs}
     assert expected[("office", "cerealbox")] == "found"  # on the kitchen table
     assert expected[("office_no_tables", "cerealbox")] == "gave_up"  # Fig. 3e: none anywhere
@@ -139,12 +138,13 @@ def test_generated_worlds_with_auto_targets(monkeypatch):
     assert calls == [(s, "office", 6) for s in range(3, 7)]
     assert len(runs) == 4 * 3 * 3
     run = runs[0]
-    assert run.run_id == "gen-office-r6-3-cup-switching-s0"
+    assert run.run_id == "gen-office-3-r6-cup-switching-s0"
     assert run.episode["generate"] == {"seed": 3, "style": "office", "rooms": 6}
     assert "world" not in run.episode
     assert run.subject.group == "gen-office-r6"
-    assert {(r.subject.target, r.subject.expected) for r in runs if r.subject.world.endswith(
-        "-4")} == {("cup", "found"), ("thing4", "found"), ("banana", "gave_up")}
+    in_4 = {(r.subject.target, r.subject.expected) for r in runs
+            if r.subject.world == "gen-office-4-r6"}
+    assert in_4 == {("cup", "found"), ("thing4", "found"), ("banana", "gave_up")}
 
 
 def test_the_built_in_seed003_campaign_is_fig3_a_to_f_times_20_seeds():
@@ -155,6 +155,16 @@ def test_the_built_in_seed003_campaign_is_fig3_a_to_f_times_20_seeds():
     assert sorted({r.seed for r in runs}) == list(range(20))
     f = next(r for r in runs if r.subject.scenario == "f")
     assert f.episode["pre_explore"] is True and f.episode["target"] == "whiteboardmarker"
+
+
+def test_generated_worlds_with_the_generators_own_targets():
+    pytest.importorskip("sim.generate", reason="the world generator is not in this build")
+    runs = parse({"worlds": [{"generate": {"seeds": "0-1", "style": "office", "rooms": 6}}],
+                  "targets": "auto"}).runs()
+    assert len(runs) == 2 * 3
+    for world in ("gen-office-0-r6", "gen-office-1-r6"):
+        expected = sorted(r.subject.expected for r in runs if r.subject.world == world)
+        assert expected == ["found", "found", "gave_up"], world
 
 
 def test_the_built_in_generated_campaign_is_50_worlds_times_3_strategies(monkeypatch):
