@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -175,7 +176,7 @@ def _labels(value: Any, where: Where) -> Iterator[tuple[str, str | None]]:
 
 def _label(item: Any, where: Where) -> tuple[str, str | None]:
     if isinstance(item, str) and item and item != AUTO:
-        return item, None
+        return _known(item, where), None
     if not isinstance(item, dict) or not isinstance(item.get("label"), str):
         raise where.error(f"a label or {{label, expected}}, got {item!r}")
     if set(item) - _TARGET_KEYS:
@@ -183,4 +184,20 @@ def _label(item: Any, where: Where) -> tuple[str, str | None]:
     expected = item.get("expected")
     if expected is not None and expected not in _EXPECTED:
         raise where.at("expected").error(f"found or gave_up, got {expected!r}")
-    return item["label"], expected
+    return _known(item["label"], where.at("label")), expected
+
+
+def _known(label: str, where: Where) -> str:
+    """A label the robot's knowledge has priors for (else no strategy can search for it)."""
+    labels = _knowledge_labels()
+    if label not in labels:
+        raise where.error(f"unknown target label {label!r}; the knowledge knows "
+                          f"{', '.join(sorted(labels))}")
+    return label
+
+
+@cache
+def _knowledge_labels() -> frozenset[str]:
+    from conceptual_map.knowledge.loader import load_knowledge
+
+    return frozenset(load_knowledge().labels)

@@ -66,6 +66,10 @@ WORLD = {"worlds": ["office"], "targets": ["cerealbox"]}
     ({"worlds": ["office"], "targets": [{"label": "cup", "expected": "maybe"}]},
      ["targets[0].expected: found or gave_up"]),
     ({"worlds": ["office"], "targets": [["cup"]]}, ["targets[0]: a label or"]),
+    ({"worlds": ["office"], "targets": ["cup", "banana"]},
+     ["targets[1]: unknown target label 'banana'; the knowledge knows book, cerealbox"]),
+    ({"worlds": ["office"], "targets": {"office": [{"label": "bananas"}]}},
+     ["targets.office[0].label: unknown target label 'bananas'"]),
     ({"worlds": [{"generate": {"style": "office"}}], "targets": "auto"},
      ["worlds[0].generate: a mapping with 'seeds'"]),
     ({"worlds": [{"generate": {"seeds": "0-2", "rooms": 0}}], "targets": "auto"},
@@ -115,10 +119,10 @@ def test_targets_per_world_and_world_files_relative_to_the_campaign(tmp_path):
     (tmp_path / "mine.yaml").write_text(world.read_text(encoding="utf-8"), encoding="utf-8")
     campaign = parse({"worlds": ["office", {"world": "mine.yaml", "targets": ["cup"],
                                             "start_room": "kitchen"}],
-                      "targets": {"office": ["stapler", "banana"]}}, tmp_path)
+                      "targets": {"office": ["stapler", "toilet"]}}, tmp_path)
     runs = campaign.runs()
     assert [(r.subject.world, r.subject.target, r.subject.expected) for r in runs] == [
-        ("office", "stapler", "found"), ("office", "banana", "gave_up"),
+        ("office", "stapler", "found"), ("office", "toilet", "gave_up"),
         ("mine", "cup", "found")]  # office.yaml has a cup
     assert runs[2].episode["world"] == str(tmp_path / "mine.yaml")
     assert runs[2].episode["start_room"] == "kitchen"
