@@ -40,6 +40,10 @@ class Settings(BaseSettings):
     warm_workers: bool = Field(True, description="start episode workers before the first task")
     preload_planner: bool = Field(True, description="import the planner in job workers at start")
     worlds_dir: Path | None = Field(None, description="built-in worlds; default: sim/worlds")
+    ray_address: str | None = Field(
+        None, description="run episode tasks as Ray tasks on this cluster ('local': start Ray "
+        "on this machine); default: local worker processes"
+    )
 
     @property
     def db_path(self) -> Path:

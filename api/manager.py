@@ -59,10 +59,7 @@ class TaskManager:
     def __init__(self, settings: Settings, store: TaskStore):
         self.settings = settings
         self.store = store
-        self.episodes = WorkerPool(
-            "episodes", settings.workers, settings.memory_limit_mb, settings.episode_runner,
-            settings.cancel_grace_s, nice=settings.worker_nice, warm=settings.warm_workers,
-        )
+        self.episodes = _episode_pool(settings)
         self.jobs = WorkerPool(
             "jobs", settings.plan_workers, settings.memory_limit_mb, settings.episode_runner,
             settings.cancel_grace_s, preload=PRELOAD_JOBS if settings.preload_planner else (),
@@ -192,6 +189,19 @@ class TaskManager:
 
     def counts(self) -> tuple[int, int]:
         return self.store.count_state(TaskState.QUEUED), self.store.count_state(TaskState.RUNNING)
+
+
+def _episode_pool(settings: Settings) -> WorkerPool:
+    """Local worker processes, or Ray tasks when the settings name a Ray cluster."""
+    if settings.ray_address:
+        from api.ray_pool import RayWorkerPool
+
+        return RayWorkerPool("episodes", settings.workers, settings.ray_address,
+                             settings.episode_runner, settings.cancel_grace_s)
+    return WorkerPool(
+        "episodes", settings.workers, settings.memory_limit_mb, settings.episode_runner,
+        settings.cancel_grace_s, nice=settings.worker_nice, warm=settings.warm_workers,
+    )
 
 
 def _task_outcome(result: JobResult) -> tuple[TaskState, dict[str, Any] | None, str | None]:
