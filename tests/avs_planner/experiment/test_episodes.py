@@ -73,3 +73,15 @@ def test_the_cli_lists_the_built_in_campaigns(capsys):
     assert main(["experiment", "list"]) == 0
     out = capsys.readouterr().out
     assert "seed003-fig3" in out and "120 runs" in out
+
+
+def test_the_cli_runs_a_campaign_and_prints_its_counts(tmp_path, capsys):
+    campaign = tmp_path / "c.yaml"
+    campaign.write_text("name: c\nscenarios: [a, c]\nseeds: 0-2\n")
+    out = tmp_path / "out"
+    assert main(["experiment", "run", str(campaign), "--out", str(out), "--limit", "0",
+                 "--json"]) == 0
+    counts = json.loads(capsys.readouterr().out)
+    assert (counts["total"], counts["done"], counts["ran_now"]) == (6, 0, 0)
+    assert (out / "results.csv").read_text().startswith("run_id,scenario,world,")
+    assert json.loads((out / "campaign.json").read_text())["runs"] == 6

@@ -105,3 +105,13 @@ def test_a_directory_of_another_campaign_is_refused(tmp_path):
     (tmp_path / "campaign.json").write_text(json.dumps({"name": "other"}))
     with pytest.raises(CampaignError, match="holds campaign 'other', not 'tiny'"):
         run(tmp_path)
+
+
+def test_the_progress_line_counts_and_estimates():
+    from avs_planner.experiment.runner import Progress
+
+    progress = Progress(total=10, done=4, failed=1, skipped=2)
+    assert progress.line().startswith("4/10 done (2 before), 1 failed, elapsed 0m00s, ETA ")
+    progress.started -= 20  # 2 runs in 20 s: 6 to go take 60 s
+    assert progress.eta_s() == pytest.approx(60, abs=1)
+    assert Progress(total=3, done=0, failed=0, skipped=0).line().endswith("ETA --")
