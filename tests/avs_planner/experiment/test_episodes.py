@@ -85,3 +85,17 @@ def test_the_cli_runs_a_campaign_and_prints_its_counts(tmp_path, capsys):
     assert (counts["total"], counts["done"], counts["ran_now"]) == (6, 0, 0)
     assert (out / "results.csv").read_text().startswith("run_id,scenario,world,")
     assert json.loads((out / "campaign.json").read_text())["runs"] == 6
+
+
+def test_a_generated_world_with_auto_targets_end_to_end(tmp_path):
+    data = {"name": "gen", "worlds": [{"generate": {"seeds": 0, "style": "office",
+                                                    "rooms": 4}}],
+            "targets": "auto", "strategies": ["exhaustive"], "time_budget_s": 40,
+            "wall_budget_s": 120}
+    run_campaign(parse_campaign(data, "gen.yaml", Path(".")), RunOptions(tmp_path, workers=2))
+    rows = read_results(tmp_path / "results.csv")
+    assert len(rows) == 3 and {r["status"] for r in rows} == {"ok"}
+    assert sorted(r["expected"] for r in rows) == ["found", "found", "gave_up"]
+    assert {r["world"] for r in rows} == {"gen-office-0-r4"}
+    summary = json.loads((tmp_path / "runs" / rows[0]["run_id"] / "summary.json").read_text())
+    assert summary["strategy"] == "exhaustive" and summary["target"] == rows[0]["target"]
