@@ -90,17 +90,20 @@ def run_campaign(campaign: Campaign, options: RunOptions,
 def _run(campaign: Campaign, runs: list[RunSpec], options: RunOptions, backend: Backend,
          on_progress: Callable[[Progress], None] | None) -> CampaignResult:
     _claim(options.out, campaign, len(runs))
-    todo = [run for run in runs if not _done(options.out, run, options.retry_failed)]
+    records = load_records(options.out, runs)
+    todo = [run for run in runs if not _done(records.get(run.run_id), options.retry_failed)]
     skipped = len(runs) - len(todo)
     if options.limit is not None:
         todo = todo[:options.limit]
-    progress = Progress(len(runs), skipped, _failed_before(options.out, runs, todo), skipped,
-                        backend.slots)
+    pending = {run.run_id for run in todo}
+    failed = sum(r["status"] != "ok" for k, r in records.items() if k not in pending)
+    progress = Progress(len(runs), skipped, failed, skipped, backend.slots)
     jobs = [Job(run, run_dir(options.out, run), _deadline(run, options)) for run in todo]
-    started = time.monotonic()
+    table = _Table(options.out, runs, records)
 
     def on_done(job: Job, record: Record) -> None:
         record = _write_record(job, record, backend.name)
+        table.add(record)
         progress.done += 1
         progress.failed += record["status"] != "ok"
         if record.get("overhead_s") is not None:
@@ -113,9 +116,28 @@ def _run(campaign: Campaign, runs: list[RunSpec], options: RunOptions, backend: 
     try:
         backend.run(jobs, on_done)
     finally:
-        results = write_results(options.out, runs, load_records(options.out, runs))
-    return CampaignResult(progress, results, time.monotonic() - started, backend.name,
-                          backend.slots)
+        results = table.write()
+    return CampaignResult(progress, results, time.monotonic() - progress.started,
+                          backend.name, backend.slots)
+
+
+class _Table:
+    """results.csv, kept in memory and rewritten at most every `every_s` while runs finish,
+    so a report made mid-campaign (or after a hard kill) sees nearly every finished run."""
+
+    def __init__(self, out: Path, runs: list[RunSpec], records: dict[str, Record],
+                 every_s: float = 30.0):
+        self.out, self.runs, self.records, self.every_s = out, runs, dict(records), every_s
+        self.written = time.monotonic()
+
+    def add(self, record: Record) -> None:
+        self.records[record["run_id"]] = record
+        if time.monotonic() - self.written > self.every_s:
+            self.write()
+
+    def write(self) -> Path:
+        self.written = time.monotonic()
+        return write_results(self.out, self.runs, self.records)
 
 
 def run_dir(out: Path, run: RunSpec) -> Path:
@@ -132,15 +154,8 @@ def load_records(out: Path, runs: list[RunSpec]) -> dict[str, Record]:
     return records
 
 
-def _done(out: Path, run: RunSpec, retry_failed: bool) -> bool:
-    record = load_records(out, [run]).get(run.run_id)
+def _done(record: Record | None, retry_failed: bool) -> bool:
     return record is not None and (record["status"] == "ok" or not retry_failed)
-
-
-def _failed_before(out: Path, runs: list[RunSpec], todo: list[RunSpec]) -> int:
-    pending = {run.run_id for run in todo}
-    records = load_records(out, [run for run in runs if run.run_id not in pending])
-    return sum(r["status"] != "ok" for r in records.values())
 
 
 def _deadline(run: RunSpec, options: RunOptions) -> float:

@@ -101,8 +101,12 @@ def _from_file(entry: dict[str, Any], top: Any, at: Where, where: Where, base: P
     if not isinstance(text, str) or not text:
         raise at.at("world").error(f"a built-in world name or a world file path, got {text!r}")
     ref = str((base / text).resolve()) if text.endswith((".yaml", ".yml")) else text
+    start = entry.get("start")
+    if start is not None and (not isinstance(start, list) or len(start) != 3 or not all(
+            isinstance(v, int | float) and not isinstance(v, bool) for v in start)):
+        raise at.at("start").error(f"a start pose is [x, y, yaw], got {start!r}")
     try:
-        world = load_spec(ref, None, entry.get("start"), entry.get("start_room"))
+        world = load_spec(ref, None, start, entry.get("start_room"))
     except AvsError as exc:
         raise at.error(str(exc)) from None
     labels = {o.label for o in world.objects} | {f.label for f in world.furniture}
