@@ -10,20 +10,20 @@ from avs_planner.experiment.stats import wilson
 Row = dict[str, Any]
 
 
-def sim_time_plot(rows: list[Row], strategies: list[str], path: Path) -> Path | None:
-    """Box plots of simulated time per strategy (completed episodes), points on top."""
-    data = [[r["sim_time_s"] for r in rows if r["strategy"] == s and r["sim_time_s"] is not None]
-            for s in strategies]
+def sim_time_plot(rows: list[Row], key: str, names: list[str], path: Path) -> Path | None:
+    """Box plots of simulated time per `key` value (strategy, or group), runs on top."""
+    data = [[r["sim_time_s"] for r in rows if r[key] == name and r["sim_time_s"] is not None]
+            for name in names]
     if not any(data):
         return None
-    figure, axes = _figure(max(4.0, 1.4 * len(strategies) + 2))
+    figure, axes = _figure(max(4.0, 1.1 * len(names) + 2))
     axes.boxplot(data, showfliers=False)
     for i, values in enumerate(data, start=1):
         jitter = [i + 0.25 * ((k * 0.618) % 1 - 0.5) for k in range(len(values))]
         axes.scatter(jitter, values, s=8, alpha=0.5, color="tab:blue")
-    axes.set_xticks(range(1, len(strategies) + 1), strategies)
+    axes.set_xticks(range(1, len(names) + 1), names)
     axes.set_ylabel("simulated time (s)")
-    axes.set_title("Simulated search time per strategy")
+    axes.set_title(f"Simulated time per {key} (completed runs)")
     return _save(figure, path)
 
 
@@ -49,7 +49,7 @@ def success_plot(rows: list[Row], groups: list[str], strategies: list[str],
     axes.set_xticks(range(len(groups)), groups)
     axes.set_ylim(0, 1.05)
     axes.set_ylabel("runs ending as expected")
-    axes.set_title("Success (found, or correctly gave up) by group, 95% Wilson intervals")
+    axes.set_title("Found, or gave up on an absent target (95% Wilson)")
     if len(strategies) > 1:
         axes.legend()
     return _save(figure, path)

@@ -206,8 +206,9 @@ def _band(rows: list[Row], column: str, digits: int) -> str:
 def _figures(rows: list[Row], groups: list[str], strategies: list[str], out: Path
              ) -> list[str]:
     stem = out.with_suffix("")
-    drawn = [("Simulated time per strategy",
-              sim_time_plot([r for r in rows if r["status"] == "ok"], strategies,
+    key, names = ("strategy", strategies) if len(strategies) > 1 else ("group", groups)
+    drawn = [(f"Simulated time per {key}",
+              sim_time_plot([r for r in rows if r["status"] == "ok"], key, names,
                             Path(f"{stem}-sim-time.png"))),
              ("Success by scenario or world group",
               success_plot(rows, groups, strategies, as_expected,
