@@ -18,11 +18,12 @@ from typing import Any
 
 from avs_planner.experiment.backends import Job, OnDone, Record, fresh_dir, timeout_record
 from avs_planner.experiment.errors import CampaignError
-from avs_planner.experiment.worker import DEFAULT_RUNNER, execute_collect
+from avs_planner.experiment.worker import DEFAULT_RUNNER, execute_collect, preload
 
 # A Ray worker process runs up to this many episodes, then a fresh one takes over: the 2 s of
 # imports are paid once per 20 episodes, not per episode (each episode builds its own world,
-# robot and mind from its seed; results equal the local backend's, see the tests).
+# robot and mind from its seed; results equal the local backend's, see the tests). The first
+# workers import before the first episode starts (`_warm`).
 MAX_CALLS = 20
 _PROJECT_ROOT = str(Path(__file__).resolve().parents[2])
 
@@ -47,6 +48,8 @@ class RayBackend:
 
     def run(self, jobs: Iterable[Job], on_done: OnDone) -> None:
         pending = deque(jobs)
+        if pending:
+            self._warm(min(self.slots, len(pending)))
         try:
             while pending or self._flying:
                 while pending and len(self._flying) < self.slots:
@@ -60,6 +63,15 @@ class RayBackend:
     def close(self) -> None:
         if self._owns and self._ray.is_initialized():
             self._ray.shutdown()
+
+    def _warm(self, workers: int) -> None:
+        """Import the episode stack in `workers` Ray workers at once, before any episode's
+        clock starts (they are then reused for the episodes)."""
+        warm = self._ray.remote(num_cpus=1, max_retries=0)(preload)
+        try:
+            self._ray.get([warm.remote(self.runner) for _ in range(workers)], timeout=600)
+        except self._ray.exceptions.RayError as exc:
+            raise CampaignError(f"Ray workers cannot import the episode runner: {exc}") from None
 
     def _submit(self, job: Job) -> None:
         fresh_dir(job.out_dir)
