@@ -12,6 +12,7 @@ from __future__ import annotations
 import multiprocessing
 import os
 import shutil
+import sys
 import threading
 import time
 from collections.abc import Callable, Iterable
@@ -85,7 +86,9 @@ class LocalBackend:
         self.slots = slots
         self.runner = runner
         self._ctx = multiprocessing.get_context("forkserver")
-        self._ctx.set_forkserver_preload(["avs_planner.experiment.worker", *PRELOAD])
+        module = runner.rpartition(":")[0]
+        extra = [] if module.endswith(".py") or module in PRELOAD else [module]
+        self._ctx.set_forkserver_preload(["avs_planner.experiment.worker", *PRELOAD, *extra])
         self._live: set[multiprocessing.process.BaseProcess] = set()
         self._lock = threading.Lock()
         self._stopping = threading.Event()
@@ -198,6 +201,9 @@ def _child(writer: Connection, spec: dict[str, Any], out_dir: str, runner: str,
     _exit_with(parent)
     writer.send(execute(spec, out_dir, runner))
     writer.close()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(0)  # the record is sent, the files closed: skip tearing down the interpreter
 
 
 def _exit_with(parent: int, interval_s: float = 1.0) -> None:
