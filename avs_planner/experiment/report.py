@@ -81,8 +81,12 @@ def _header(rows: list[Row], meta: dict[str, Any]) -> list[str]:
     lines += [f"- runs recorded: {len(rows)} of {meta.get('runs', '?')}; completed "
               f"{len(rows) - len(failed)}, crashed/timed out/failed {len(failed)}",
               f"- episode wall time, summed: {episode:.0f} s; median scheduling overhead per "
-              f"episode (wall time outside the episode): {_num(overhead, 3)} s", ""]
-    return lines
+              f"episode (wall time outside the episode): {_num(overhead, 3)} s"]
+    for run in meta.get("invocations", []):
+        lines.append(f"- `avs experiment run` finished {run.get('finished')}: {run.get('ran')} "
+                     f"episodes ({run.get('failed')} failed) on {run.get('backend')} x"
+                     f"{run.get('workers')} in {run.get('wall_s')} s")
+    return lines + [""]
 
 
 def _strategy_table(rows: list[Row], strategies: list[str]) -> list[str]:

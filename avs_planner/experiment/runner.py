@@ -24,6 +24,7 @@ from avs_planner.experiment.results import RESULTS_FILE, write_results
 from avs_planner.experiment.worker import DEFAULT_RUNNER
 
 RECORD_FILE = "record.json"
+META_FILE = "campaign.json"
 DEFAULT_WALL_BUDGET_S = 600.0  # the episode runner's default
 
 
@@ -89,7 +90,7 @@ def run_campaign(campaign: Campaign, options: RunOptions,
 
 def _run(campaign: Campaign, runs: list[RunSpec], options: RunOptions, backend: Backend,
          on_progress: Callable[[Progress], None] | None) -> CampaignResult:
-    _claim(options.out, campaign, len(runs))
+    meta = _claim(options.out, campaign, len(runs))
     records = load_records(options.out, runs)
     todo = [run for run in runs if not _done(records.get(run.run_id), options.retry_failed)]
     skipped = len(runs) - len(todo)
@@ -117,6 +118,7 @@ def _run(campaign: Campaign, runs: list[RunSpec], options: RunOptions, backend: 
         backend.run(jobs, on_done)
     finally:
         results = table.write()
+        _log_invocation(options.out, meta, progress, backend)
     return CampaignResult(progress, results, time.monotonic() - progress.started,
                           backend.name, backend.slots)
 
@@ -186,24 +188,45 @@ def _read_record(path: Path) -> Record | None:
     return record if isinstance(record, dict) and "status" in record else None
 
 
-def _claim(out: Path, campaign: Campaign, total: int) -> None:
+def _claim(out: Path, campaign: Campaign, total: int) -> dict[str, Any]:
     """DIR belongs to one campaign; refuse to mix another one's runs into it."""
-    meta = out / "campaign.json"
-    if meta.exists():
-        try:
-            name = json.loads(meta.read_text(encoding="utf-8")).get("name")
-        except (OSError, ValueError, AttributeError):
-            name = None
-        if name != campaign.name:
-            raise CampaignError(f"{out} holds campaign {name!r}, not {campaign.name!r}; "
-                                "choose another --out")
+    meta = _read_meta(out)
+    if meta is not None and meta.get("name") != campaign.name:
+        raise CampaignError(f"{out} holds campaign {meta.get('name')!r}, not "
+                            f"{campaign.name!r}; choose another --out")
+    meta = {"name": campaign.name, "description": campaign.description,
+            "source": campaign.source, "runs": total,
+            "invocations": (meta or {}).get("invocations", [])}
+    _write_meta(out, meta)
+    return meta
+
+
+def _read_meta(out: Path) -> dict[str, Any] | None:
+    try:
+        meta = json.loads((out / META_FILE).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError):
+        return {}
+    return meta if isinstance(meta, dict) else {}
+
+
+def _write_meta(out: Path, meta: dict[str, Any]) -> None:
     try:
         out.mkdir(parents=True, exist_ok=True)
-        meta.write_text(json.dumps({"name": campaign.name, "description": campaign.description,
-                                    "source": campaign.source, "runs": total}, indent=1) + "\n",
-                        encoding="utf-8")
+        (out / META_FILE).write_text(json.dumps(meta, indent=1) + "\n", encoding="utf-8")
     except OSError as exc:
         raise CampaignError(f"cannot write to {out}: {exc}") from None
+
+
+def _log_invocation(out: Path, meta: dict[str, Any], progress: Progress, backend: Backend
+                    ) -> None:
+    """What this `run` did, for the report: backend, workers, runs, wall time."""
+    meta["invocations"].append({
+        "finished": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "backend": backend.name,
+        "workers": backend.slots, "ran": progress.ran, "failed": progress.failed,
+        "wall_s": round(time.monotonic() - progress.started, 1)})
+    _write_meta(out, meta)
 
 
 def _jsonable(value: Any) -> Any:

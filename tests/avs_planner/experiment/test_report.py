@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import json
 from pathlib import Path
 
 import pytest
@@ -79,6 +80,10 @@ def _fixture(path: Path) -> None:
 
 def test_the_report_from_a_fixture_table(tmp_path):
     _fixture(tmp_path / "results.csv")
+    (tmp_path / "campaign.json").write_text(json.dumps({
+        "name": "fixture", "runs": 23, "invocations": [
+            {"finished": "2026-11-24T08:00:00", "backend": "local", "workers": 2, "ran": 23,
+             "failed": 1, "wall_s": 61.5}]}))
     report = build_report(tmp_path, tmp_path / "out" / "report.md").read_text()
     lines = report.splitlines()
     a = next(line for line in lines if line.startswith("| A | 11 |"))
@@ -95,6 +100,10 @@ def test_the_report_from_a_fixture_table(tmp_path):
     assert "median scheduling overhead per episode (wall time outside the episode): 0.100 s" \
         in report
     assert "Beside the seed paper" not in report
+    assert report.startswith("# Campaign report: fixture\n")
+    assert "- runs recorded: 23 of 23; completed 22, crashed/timed out/failed 1" in report
+    assert ("- `avs experiment run` finished 2026-11-24T08:00:00: 23 episodes (1 failed) on "
+            "local x2 in 61.5 s") in report
     for png in ("report-sim-time.png", "report-success.png"):
         assert f"]({png})" in report
         assert (tmp_path / "out" / png).read_bytes()[:4] == b"\x89PNG"

@@ -66,6 +66,9 @@ def test_a_stopped_campaign_resumes_without_rerunning_finished_episodes(tmp_path
     assert executions(tmp_path).count("e-switching-s1") == 2
     assert len(executions(tmp_path)) == 7
     assert len(read_results(tmp_path / "results.csv")) == 6
+    invocations = json.loads((tmp_path / "campaign.json").read_text())["invocations"]
+    assert [i["ran"] for i in invocations] == [2, 4, 1]
+    assert {i["backend"] for i in invocations} == {"local"}
 
 
 def test_a_changed_episode_spec_is_run_again(tmp_path):
