@@ -92,9 +92,13 @@ class LocalBackend:
         self._live: set[multiprocessing.process.BaseProcess] = set()
         self._lock = threading.Lock()
         self._stopping = threading.Event()
+        self._failure: BaseException | None = None
 
     def run(self, jobs: Iterable[Job], on_done: OnDone) -> None:
-        queue = iter(list(jobs))
+        todo = list(jobs)
+        if not todo:
+            return
+        queue = iter(todo)
         self._warm()
         threads = [threading.Thread(target=self._slot, args=(queue, on_done), daemon=True,
                                     name=f"avs-campaign-slot-{i}") for i in range(self.slots)]
@@ -109,6 +113,8 @@ class LocalBackend:
             self._kill_all()
             for thread in threads:
                 thread.join(10)
+        if self._failure is not None:
+            raise self._failure  # e.g. the disk filled up while writing a record
 
     def close(self) -> None:
         self._kill_all()
@@ -120,6 +126,13 @@ class LocalBackend:
         process.join()
 
     def _slot(self, queue: Iterable[Job], on_done: OnDone) -> None:
+        try:
+            self._serve(queue, on_done)
+        except BaseException as exc:  # noqa: BLE001 - handed to the main thread by `run`
+            self._failure = exc
+            self._stopping.set()
+
+    def _serve(self, queue: Iterable[Job], on_done: OnDone) -> None:
         for job in _locked(queue, self._lock):
             if self._stopping.is_set():
                 return

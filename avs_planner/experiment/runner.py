@@ -173,10 +173,13 @@ def _write_record(job: Job, record: Record, backend: str) -> Record:
             "overhead_s": _round(record["wall_s"] - episode_s if episode_s is not None
                                  and record.get("wall_s") is not None else None),
             "spec": _jsonable(job.run.episode), "summary": record.get("summary")}
-    job.out_dir.mkdir(parents=True, exist_ok=True)
     tmp = job.out_dir / (RECORD_FILE + ".tmp")
-    tmp.write_text(json.dumps(full, indent=1) + "\n", encoding="utf-8")
-    tmp.replace(job.out_dir / RECORD_FILE)  # a record is whole or absent
+    try:
+        job.out_dir.mkdir(parents=True, exist_ok=True)
+        tmp.write_text(json.dumps(full, indent=1) + "\n", encoding="utf-8")
+        tmp.replace(job.out_dir / RECORD_FILE)  # a record is whole or absent
+    except OSError as exc:
+        raise CampaignError(f"cannot write the record of {job.run.run_id}: {exc}") from None
     return full
 
 

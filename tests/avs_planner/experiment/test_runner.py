@@ -118,3 +118,16 @@ def test_the_progress_line_counts_and_estimates():
     progress.started -= 20  # 2 runs in 20 s: 6 to go take 60 s
     assert progress.eta_s() == pytest.approx(60, abs=1)
     assert Progress(total=3, done=0, failed=0, skipped=0).line().endswith("ETA --")
+
+
+def test_a_record_that_cannot_be_written_stops_the_campaign_with_its_error(tmp_path,
+                                                                          monkeypatch):
+    from avs_planner.experiment import runner as runner_module
+
+    def full_disk(job, record, backend):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(runner_module, "_write_record", full_disk)
+    with pytest.raises(OSError, match="No space left"):
+        run(tmp_path)
+    assert read_results(tmp_path / "results.csv") == []
