@@ -52,7 +52,8 @@ def _row(strategy: str, seed: int, **values) -> dict:
             "target": "cup", "expected": "found", "strategy": strategy, "robot": "",
             "seed": seed, "status": "ok", "backend": "local", "plans": 4,
             "cp_s_per_plan": 0.3, "dt_s_per_action": 1.0, "distance_m": 10.0,
-            "episode_s": 5.0, "wall_s": 5.1, "overhead_s": 0.1, "false_report": "false"}
+            "episode_s": 5.0, "wall_s": 5.1, "overhead_s": 0.1, "false_report": "false",
+            "dt_calls": 2}
     return {**base, **values}
 
 
@@ -120,7 +121,8 @@ def test_the_seed003_table_sets_our_numbers_beside_the_papers(tmp_path):
         writer.writeheader()
         writer.writerows(rows)
     report = build_report(tmp_path, tmp_path / "report.md").read_text()
-    assert "| a | found | 5/0/0 / 0 (of 5) | 12 [10-14] | 0.300 [0.300-0.300] |" in report
+    assert ("| a | found | 5/0/0 / 0 (of 5) | 12 [10-14] | 0.300 [0.300-0.300] | 2 [2-2] | "
+            "1.000 [1.000-1.000] |") in report
     assert "| c | gave_up | 0/5/0 / 0 (of 5) |" in report
 
 
