@@ -50,3 +50,12 @@ def hang_on_seed_1(spec: dict[str, Any], emit: Any = None, should_stop: Any = No
     if spec["seed"] == 1:
         time.sleep(60)
     return summary(spec)
+
+
+def crash_1_raise_2_hang_3(spec: dict[str, Any], emit: Any = None, should_stop: Any = None
+                           ) -> dict[str, Any]:
+    if spec["seed"] == 2:
+        raise RuntimeError("the planner fell over")
+    if spec["seed"] == 3:
+        time.sleep(60)
+    return crash_on_seed_1(spec)

@@ -131,3 +131,15 @@ def test_a_record_that_cannot_be_written_stops_the_campaign_with_its_error(tmp_p
     with pytest.raises(OSError, match="No space left"):
         run(tmp_path)
     assert read_results(tmp_path / "results.csv") == []
+
+
+@pytest.mark.slow
+def test_the_ray_backend_records_crashes_errors_and_timeouts(tmp_path):
+    pytest.importorskip("ray", reason="Ray is not installed (pip install '.[ray]')")
+    result, _ = run(tmp_path, "crash_1_raise_2_hang_3", backend="ray", kill_margin_s=1.0,
+                    campaign={"seeds": "0-3", "wall_budget_s": 8})  # a new Ray worker
+    # (after a crash) takes seconds to start, and the deadline counts from submission
+    status = {r["run_id"]: r["status"] for r in read_results(result.results)}
+    assert status == {f"{s}-switching-s{k}": v for s in "ae" for k, v in
+                      enumerate(["ok", "crashed", "error", "timeout"])}
+    assert (tmp_path / "runs" / "a-switching-s0" / "summary.json").exists()
