@@ -193,6 +193,8 @@ def _read_record(path: Path) -> Record | None:
 
 def _claim(out: Path, campaign: Campaign, total: int) -> dict[str, Any]:
     """DIR belongs to one campaign; refuse to mix another one's runs into it."""
+    if out.exists() and not out.is_dir():
+        raise CampaignError(f"--out {out} is a file, not a directory")
     meta = _read_meta(out)
     if meta is not None and meta.get("name") != campaign.name:
         raise CampaignError(f"{out} holds campaign {meta.get('name')!r}, not "

@@ -108,6 +108,9 @@ def test_a_directory_of_another_campaign_is_refused(tmp_path):
     (tmp_path / "campaign.json").write_text(json.dumps({"name": "other"}))
     with pytest.raises(CampaignError, match="holds campaign 'other', not 'tiny'"):
         run(tmp_path)
+    (tmp_path / "file").write_text("")
+    with pytest.raises(CampaignError, match="is a file, not a directory"):
+        run(tmp_path / "file")
 
 
 def test_the_progress_line_counts_and_estimates():
