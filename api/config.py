@@ -52,6 +52,10 @@ class Settings(BaseSettings):
         "trusted ('*' for any); default: none, the TCP peer is the client")
     plan_results_kept: int = Field(100, ge=1, le=10_000, description="finished async plan jobs "
                                    "kept for polling (oldest dropped first)")
+    ray_address: str | None = Field(
+        None, description="run episode tasks as Ray tasks on this cluster ('local': start Ray "
+        "on this machine); default: local worker processes"
+    )
 
     @property
     def db_path(self) -> Path:

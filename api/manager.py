@@ -77,11 +77,7 @@ class TaskManager:
         self.settings = settings
         self.store = store
         self.draining = draining or threading.Event()  # set when the service begins to stop
-        self.episodes = WorkerPool(
-            "episodes", settings.workers, settings.memory_limit_mb,
-            {"episode": settings.episode_runner},
-            settings.cancel_grace_s, nice=settings.worker_nice, warm=settings.warm_workers,
-        )
+        self.episodes = _episode_pool(settings)
         self.jobs = WorkerPool(
             "jobs", settings.plan_workers, settings.memory_limit_mb, {"plan": settings.plan_runner},
             settings.cancel_grace_s, preload=PRELOAD_JOBS if settings.preload_planner else (),
@@ -248,6 +244,20 @@ def _relative(event: dict[str, Any], root: str) -> dict[str, Any]:
     `timeout-1.pddl`, never the server's file system layout)."""
     return {k: v[len(root):] if isinstance(v, str) and v.startswith(root) else v
             for k, v in event.items()}
+
+
+def _episode_pool(settings: Settings) -> WorkerPool:
+    """Local worker processes, or Ray tasks when the settings name a Ray cluster."""
+    if settings.ray_address:
+        from api.ray_pool import RayWorkerPool
+
+        return RayWorkerPool("episodes", settings.workers, settings.ray_address,
+                             settings.episode_runner, settings.cancel_grace_s)
+    return WorkerPool(
+        "episodes", settings.workers, settings.memory_limit_mb,
+        {"episode": settings.episode_runner},
+        settings.cancel_grace_s, nice=settings.worker_nice, warm=settings.warm_workers,
+    )
 
 
 def _task_outcome(result: JobResult) -> tuple[TaskState, dict[str, Any] | None, str | None]:

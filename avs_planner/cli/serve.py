@@ -33,6 +33,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--port", type=int, help="TCP port (default 8000)")
     parser.add_argument("--data-dir", type=Path, help="tasks, events and results (SQLite)")
     parser.add_argument("--workers", type=int, help="worker processes running episodes")
+    parser.add_argument("--ray-address", help="run episodes as Ray tasks on this cluster "
+                        "(HOST:PORT, or 'local' to start Ray here; pip install '.[ray]')")
     parser.add_argument("--log-level", default="info", choices=["debug", "info", "warning"])
     parser.set_defaults(func=run)
 
@@ -45,7 +47,8 @@ def run(args: argparse.Namespace) -> int:
     overrides = {
         key: value
         for key, value in (("host", args.host), ("port", args.port),
-                           ("data_dir", args.data_dir), ("workers", args.workers))
+                           ("data_dir", args.data_dir), ("workers", args.workers),
+                           ("ray_address", args.ray_address))
         if value is not None
     }
     try:
@@ -69,6 +72,7 @@ def run(args: argparse.Namespace) -> int:
         raise ServeError(f"cannot use data dir {settings.data_dir}: {exc}") from exc
     try:
         _check_data_dir(settings)
+        _check_ray(settings)
         return _serve(settings, args.log_level)
     finally:
         lock.release(held)
@@ -84,6 +88,14 @@ def _check_data_dir(settings: Settings) -> None:
         TaskStore(settings.db_path).close()
     except (OSError, sqlite3.Error) as exc:
         raise ServeError(f"cannot use data dir {settings.data_dir}: {exc}") from exc
+
+
+def _check_ray(settings: Settings) -> None:
+    if settings.ray_address:
+        try:
+            import ray  # noqa: F401
+        except ImportError:
+            raise ServeError("--ray-address needs Ray: pip install '.[ray]'") from None
 
 
 def _serve(settings: Settings, log_level: str) -> int:

@@ -60,7 +60,7 @@ def test_stream_ends_with_shutdown_event_when_draining(client: TestClient,
     started = time.monotonic()
     with client.stream("GET", f"/v1/tasks/{task_id}/events") as stream:
         text = "".join(stream.iter_text())
-    assert time.monotonic() - started < 3  # not the 30 s the task takes
+    assert time.monotonic() - started < 15  # not the 30 s the task takes (a loaded machine is slow)
     assert text.rstrip().endswith("retry: 5000") or "event: shutdown" in text
     last = text.split("event: shutdown")[1]
     assert "Last-Event-ID" in last and "\nid:" not in last  # resumable: no id of its own
@@ -111,11 +111,11 @@ def test_short_plan_is_not_blocked_by_a_long_one(make_settings: Make) -> None:
                                 kwargs={"json": {"domain": DOMAIN, "problem": "sleep 20"}})
         long.start()
         time.sleep(0.5)
-        started = time.monotonic()
         short = client.post("/v1/plans", json={"domain": DOMAIN, "problem": PROBLEM})
-        took = time.monotonic() - started
         assert short.status_code == 200 and short.json()["status"] == "solved"
-        assert took < 1.0 + short.json()["planning_time_s"]
+        # answered while the 20 s job still runs: it did not wait behind it (no wall-clock
+        # threshold, which a loaded machine would break)
+        assert long.is_alive()
         client.app.state.manager.jobs.stop()  # end the long one now
         long.join(timeout=10)
 
@@ -138,7 +138,7 @@ def test_disconnected_client_frees_its_worker(make_settings: Make) -> None:
         quick = {"domain_text": DOMAIN, "problem_text": "sleep 0.1"}
         result = client.portal.call(manager.run_job, "plan", quick)
         assert result.outcome.value == "done"
-        assert time.monotonic() - started < 8  # a fresh worker, not the 30 s job's end
+        assert time.monotonic() - started < 15  # a fresh worker, not the 30 s job's end
 
 
 def test_async_plan_job_polls_to_a_result_and_cancels(make_settings: Make) -> None:
@@ -177,4 +177,4 @@ def test_run_job_is_cancelled_with_its_coroutine(make_settings: Make) -> None:
         started = time.monotonic()
         quick = {"domain_text": DOMAIN, "problem_text": "sleep 0.1"}
         assert client.portal.call(manager.run_job, "plan", quick).outcome.value == "done"
-        assert time.monotonic() - started < 8
+        assert time.monotonic() - started < 15  # well before the 30 s job ends

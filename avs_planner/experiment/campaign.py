@@ -1,0 +1,239 @@
+"""Campaign files: which episodes to run, validated with errors that name the entry.
+
+A campaign is worlds (or the seed's scenarios) × targets × strategies × robots × seeds; the
+format is in docs/experiments.md. `load_campaign` reads and checks a file (or a built-in by
+name, from `campaigns/`), and `Campaign.runs()` expands it into one `RunSpec` per episode,
+each with a stable run id (the name of its directory in the output).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from avs_planner.errors import AvsError
+from avs_planner.experiment.errors import CampaignError
+from avs_planner.experiment.subjects import Subject, scenario_subjects, world_subjects
+from avs_planner.experiment.values import Where, parse_seeds, positive_number
+
+CAMPAIGN_DIR = Path(__file__).parent / "campaigns"
+DEFAULT_STRATEGY = "switching"
+_TOP_KEYS = {"name", "description", "worlds", "scenarios", "targets", "strategies", "robots",
+             "seeds", "time_budget_s", "wall_budget_s"}
+_STRATEGY_KEYS = {"name", "label", "options"}
+
+
+@dataclass(frozen=True)
+class Strategy:
+    """A registered strategy under a label (the same strategy may run with other options)."""
+
+    label: str
+    name: str
+    options: Mapping[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One episode of a campaign: what it searches, how, and where its files go."""
+
+    run_id: str
+    subject: Subject
+    strategy: Strategy
+    robot: str | None
+    seed: int
+    episode: Mapping[str, Any]
+
+    def columns(self) -> dict[str, Any]:
+        """The run's coordinates as results-table columns."""
+        s = self.subject
+        return {"run_id": self.run_id, "scenario": s.scenario or "", "world": s.world,
+                "group": s.group, "target": s.target, "expected": s.expected or "",
+                "strategy": self.strategy.label, "robot": self.robot or "", "seed": self.seed}
+
+
+@dataclass(frozen=True)
+class Campaign:
+    """A validated campaign; `runs()` is the list of its episodes, in a fixed order."""
+
+    name: str
+    description: str
+    source: str
+    subjects: tuple[Subject, ...]
+    strategies: tuple[Strategy, ...]
+    robots: tuple[str | None, ...]
+    seeds: tuple[int, ...]
+    time_budget_s: float | None = None
+    wall_budget_s: float | None = None
+
+    def runs(self) -> list[RunSpec]:
+        runs: list[RunSpec] = []
+        for seed in self.seeds:
+            for subject in self.subjects:
+                for robot in self.robots:
+                    runs.extend(self._run(subject, strategy, robot, seed)
+                                for strategy in self.strategies)
+        _check_unique(runs, self.source)
+        return runs
+
+    def _run(self, subject: Subject, strategy: Strategy, robot: str | None, seed: int
+             ) -> RunSpec:
+        spec: dict[str, Any] = {**subject.spec, "target": subject.target, "seed": seed}
+        if strategy.name != DEFAULT_STRATEGY or strategy.options:
+            spec["strategy"] = strategy.name
+            spec["strategy_options"] = dict(strategy.options)
+        if robot is not None:
+            spec["robot"] = robot
+        for key in ("time_budget_s", "wall_budget_s"):
+            if getattr(self, key) is not None:
+                spec[key] = getattr(self, key)
+        parts = [subject.scenario or subject.world]
+        if subject.scenario is None:
+            parts.append(subject.target)
+        parts += [strategy.label, robot or "", f"s{seed}"]
+        return RunSpec(_slug("-".join(p for p in parts if p)), subject, strategy, robot, seed,
+                       spec)
+
+
+def builtin_campaigns() -> list[str]:
+    return sorted(p.stem for p in CAMPAIGN_DIR.glob("*.yaml"))
+
+
+def load_campaign(name_or_path: str | Path) -> Campaign:
+    """A built-in campaign by name (e.g. `seed003-fig3`) or a campaign YAML file."""
+    path = Path(name_or_path)
+    if not path.exists() and not path.suffix:
+        path = CAMPAIGN_DIR / f"{name_or_path}.yaml"
+        if not path.exists():
+            raise CampaignError(f"unknown campaign {str(name_or_path)!r}: not a file, and the "
+                                f"built-in campaigns are {', '.join(builtin_campaigns())}")
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError) as exc:
+        raise CampaignError(f"{path}: cannot read campaign: {exc}") from None
+    return parse_campaign(data, str(path), path.parent)
+
+
+def parse_campaign(data: Any, source: str, base: Path) -> Campaign:
+    """Validate campaign data (as read from YAML); `base` resolves relative world paths."""
+    where = Where(source)
+    if not isinstance(data, dict):
+        raise where.error("a campaign is a mapping (name, worlds or scenarios, targets, ...)")
+    unknown = set(data) - _TOP_KEYS
+    if unknown:
+        raise where.error(f"unknown keys {sorted(unknown)}; allowed: {sorted(_TOP_KEYS)}")
+    return Campaign(
+        name=str(data.get("name") or Path(source).stem),
+        description=str(data.get("description") or ""), source=source,
+        subjects=_subjects(data, where, base),
+        strategies=_strategies(data.get("strategies", [DEFAULT_STRATEGY]), where.at("strategies")),
+        robots=_robots(data.get("robots"), where.at("robots")),
+        seeds=tuple(parse_seeds(data.get("seeds", 0), where.at("seeds"))),
+        time_budget_s=_budget(data, "time_budget_s", where),
+        wall_budget_s=_budget(data, "wall_budget_s", where),
+    )
+
+
+def _subjects(data: dict[str, Any], where: Where, base: Path) -> tuple[Subject, ...]:
+    has_worlds, has_scenarios = "worlds" in data, "scenarios" in data
+    if has_worlds == has_scenarios:
+        raise where.error("give either 'worlds' (with 'targets') or 'scenarios', not both")
+    if has_scenarios:
+        if "targets" in data:
+            raise where.at("targets").error("scenarios bring their own targets; drop 'targets'")
+        return tuple(scenario_subjects(data["scenarios"], where.at("scenarios"), base))
+    return tuple(world_subjects(data["worlds"], data.get("targets"), where, base))
+
+
+def _strategies(value: Any, where: Where) -> tuple[Strategy, ...]:
+    if isinstance(value, str):
+        value = [value]
+    if isinstance(value, dict):  # {name: options}
+        value = [{"name": k, "options": v or {}} for k, v in value.items()]
+    if not isinstance(value, list) or not value:
+        raise where.error("a non-empty list of strategy names or {name, label, options}")
+    known = strategy_names()
+    strategies = [_strategy(item, where.at(i), known) for i, item in enumerate(value)]
+    labels = [s.label for s in strategies]
+    for i, label in enumerate(labels):
+        if label in labels[:i]:
+            raise where.at(i).error(f"label {label!r} is used twice; give each entry a "
+                                    "distinct 'label'")
+    return tuple(strategies)
+
+
+def _strategy(item: Any, where: Where, known: list[str]) -> Strategy:
+    if isinstance(item, str):
+        item = {"name": item}
+    if not isinstance(item, dict) or "name" not in item:
+        raise where.error("a strategy name or a mapping {name, label, options}")
+    if set(item) - _STRATEGY_KEYS:
+        raise where.error(f"unknown keys {sorted(set(item) - _STRATEGY_KEYS)}; allowed: "
+                          f"{sorted(_STRATEGY_KEYS)}")
+    name = item["name"]
+    if name not in known:
+        raise where.error(f"unknown strategy {name!r}; known strategies: {', '.join(known)}")
+    options = item.get("options") or {}
+    if not isinstance(options, dict):
+        raise where.at("options").error("strategy options are a mapping")
+    _check_options(name, options, where.at("options"))
+    label = str(item.get("label") or name)
+    if not re.fullmatch(r"[A-Za-z0-9_.-]+", label):
+        raise where.at("label").error(f"{label!r}: use letters, digits, '-', '_' or '.'")
+    return Strategy(label, name, options)
+
+
+def strategy_names() -> list[str]:
+    """The registered strategies."""
+    from avs_planner.strategies import strategy_names as registered
+
+    return list(registered())
+
+
+def _check_options(name: str, options: dict[str, Any], where: Where) -> None:
+    """The strategy's own check of its options (names and types), at load time."""
+    from avs_planner.strategies import get_strategy
+
+    try:
+        get_strategy(name).check_options(options)
+    except AvsError as exc:
+        raise where.error(str(exc)) from None
+
+
+def _robots(value: Any, where: Where) -> tuple[str | None, ...]:
+    if value is None:
+        return (None,)  # each world's own robot
+    if isinstance(value, str):
+        value = [value]
+    if not isinstance(value, list) or not value:
+        raise where.error("a non-empty list of robot models")
+    from avs_planner.episode.robot import ROBOT_MODELS
+
+    for i, robot in enumerate(value):
+        if robot not in ROBOT_MODELS:
+            raise where.at(i).error(f"unknown robot {robot!r}; known: "
+                                    f"{', '.join(sorted(ROBOT_MODELS))}")
+    return tuple(value)
+
+
+def _budget(data: dict[str, Any], key: str, where: Where) -> float | None:
+    if key not in data:
+        return None
+    return positive_number(data[key], where.at(key))
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^a-z0-9_.]+", "-", text.lower()).strip("-")
+
+
+def _check_unique(runs: list[RunSpec], source: str) -> None:
+    seen: dict[str, RunSpec] = {}
+    for run in runs:
+        other = seen.setdefault(run.run_id, run)
+        if other is not run:
+            raise CampaignError(f"{source}: two runs would share the id {run.run_id!r} "
+                                f"(world {run.subject.world!r} listed twice?)")

@@ -1,0 +1,106 @@
+"""The results table: one CSV row per run, the campaign's coordinates then the episode's numbers.
+
+CSV because every tool reads it (pandas, R, a spreadsheet, `csv` in the standard library),
+it needs no new dependency, and a 5,000-run campaign is a few hundred kilobytes; Parquet's
+column compression and types buy nothing at that size. Lists from the summary (CP time per
+plan, DT time per decision) become totals, counts and medians; the full lists stay in each
+run's summary.json.
+"""
+
+from __future__ import annotations
+
+import csv
+import statistics
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+RESULTS_FILE = "results.csv"
+KEY_COLUMNS = ["run_id", "scenario", "world", "group", "target", "expected", "strategy",
+               "robot", "seed"]
+VALUE_COLUMNS = ["status", "error", "outcome", "reason", "correct", "success",
+                 "correct_give_up", "false_report", "found_label", "sim_time_s", "distance_m",
+                 "plans", "replans", "cp_calls", "cp_time_s", "cp_s_per_plan", "dt_calls",
+                 "dt_decisions", "dt_time_s", "dt_s_per_action", "views_processed",
+                 "episode_s", "wall_s", "overhead_s", "backend"]
+COLUMNS = KEY_COLUMNS + VALUE_COLUMNS
+_INTS = {"seed", "plans", "replans", "cp_calls", "dt_calls", "dt_decisions", "views_processed"}
+_BOOLS = {"correct", "success", "correct_give_up", "false_report"}
+_TEXT = {"run_id", "scenario", "world", "group", "target", "expected", "strategy", "robot",
+         "status", "error", "outcome", "reason", "found_label", "backend"}
+
+
+def row(record: Mapping[str, Any]) -> dict[str, Any]:
+    """One table row from a run record (see runner.py); episode columns empty if it failed."""
+    out: dict[str, Any] = {k: record.get(k) for k in KEY_COLUMNS}
+    out.update({k: record.get(k) for k in ("status", "error", "episode_s", "wall_s",
+                                           "overhead_s", "backend")})
+    summary = record.get("summary")
+    if record.get("status") == "ok" and isinstance(summary, Mapping):
+        out.update(_summary_columns(summary, record.get("expected") or ""))
+    return out
+
+
+def _summary_columns(s: Mapping[str, Any], expected: str) -> dict[str, Any]:
+    outcome, correct = s.get("outcome"), bool(s.get("correct"))
+    cp = [float(t) for t in s.get("cp_time_s") or []]
+    dt = [float(t) for t in s.get("dt_decision_time_s") or []]
+    found = outcome == "found"
+    return {
+        "outcome": outcome, "reason": s.get("reason"), "correct": correct,
+        "success": found and correct if expected != "gave_up" else None,
+        "correct_give_up": outcome == "gave_up" if expected == "gave_up" else None,
+        "false_report": found and not correct,
+        "found_label": (s.get("object") or {}).get("label"),
+        "sim_time_s": s.get("sim_time_s"), "distance_m": s.get("distance_m"),
+        "plans": s.get("plans"), "replans": s.get("replans"), "cp_calls": len(cp),
+        "cp_time_s": round(sum(cp), 4), "cp_s_per_plan": _mean(cp),
+        "dt_calls": s.get("dt_calls"), "dt_decisions": len(dt), "dt_time_s": round(sum(dt), 4),
+        "dt_s_per_action": _mean(dt), "views_processed": s.get("views_processed"),
+    }
+
+
+def _mean(values: list[float]) -> float | None:
+    return round(statistics.fmean(values), 4) if values else None
+
+
+def write_results(out: Path, runs: Iterable[Any], records: Mapping[str, Mapping[str, Any]]
+                  ) -> Path:
+    """Write `out/results.csv`: the recorded runs, in the campaign's order."""
+    path = out / RESULTS_FILE
+    tmp = path.with_suffix(".csv.tmp")
+    with tmp.open("w", newline="", encoding="utf-8") as f:
+        writer = csv.DictWriter(f, fieldnames=COLUMNS)
+        writer.writeheader()
+        for run in runs:
+            record = records.get(run.run_id)
+            if record is not None:
+                writer.writerow({k: _cell(v) for k, v in row(record).items()})
+    tmp.replace(path)
+    return path
+
+
+def _cell(value: Any) -> Any:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return value
+
+
+def read_results(path: Path) -> list[dict[str, Any]]:
+    """The table back as typed rows (None for empty cells)."""
+    with path.open(newline="", encoding="utf-8") as f:
+        return [{k: _parse(k, v) for k, v in r.items()} for r in csv.DictReader(f)]
+
+
+def _parse(column: str, text: str | None) -> Any:
+    if text is None or text == "":
+        return None if column not in _TEXT else ""
+    if column in _TEXT:
+        return text
+    if column in _BOOLS:
+        return text == "true"
+    if column in _INTS:
+        return int(float(text))
+    return float(text)

@@ -1,0 +1,61 @@
+"""Stand-in episode runners for the campaign tests (loaded by file path in worker processes).
+
+Each writes a summary.json like the real runner's, derived from the spec only, and appends
+the run to `executions.log` beside the output's runs/ folder, so a test can count re-runs.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import time
+from pathlib import Path
+from typing import Any
+
+
+def summary(spec: dict[str, Any], emit: Any = None, should_stop: Any = None) -> dict[str, Any]:
+    out = Path(spec["output_dir"])
+    with (out.parent.parent / "executions.log").open("a", encoding="utf-8") as log:
+        log.write(f"{out.name}\n")
+    found = "no_tables" not in str(spec.get("world"))  # scenario e's world has no cereal box
+    result = {
+        "outcome": "found" if found else "gave_up", "reason": "fake", "target": spec["target"],
+        "object": {"label": spec["target"]} if found else None, "correct": found,
+        "sim_time_s": 100.0 + spec["seed"], "distance_m": 10.0, "plans": 3, "replans": 2,
+        "cp_time_s": [0.01, 0.03], "dt_calls": 1, "dt_decision_time_s": [0.5],
+        "views_processed": 4, "seed": spec["seed"], "world": spec.get("world"),
+    }
+    (out / "summary.json").write_text(json.dumps(result), encoding="utf-8")
+    (out / "trace.jsonl").write_text('{"type": "done"}\n', encoding="utf-8")
+    return result
+
+
+def crash_on_seed_1(spec: dict[str, Any], emit: Any = None, should_stop: Any = None
+                    ) -> dict[str, Any]:
+    if spec["seed"] == 1:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return summary(spec)
+
+
+def raise_on_seed_1(spec: dict[str, Any], emit: Any = None, should_stop: Any = None
+                    ) -> dict[str, Any]:
+    if spec["seed"] == 1:
+        raise RuntimeError("the planner fell over")
+    return summary(spec)
+
+
+def hang_on_seed_1(spec: dict[str, Any], emit: Any = None, should_stop: Any = None
+                   ) -> dict[str, Any]:
+    if spec["seed"] == 1:
+        time.sleep(60)
+    return summary(spec)
+
+
+def crash_1_raise_2_hang_3(spec: dict[str, Any], emit: Any = None, should_stop: Any = None
+                           ) -> dict[str, Any]:
+    if spec["seed"] == 2:
+        raise RuntimeError("the planner fell over")
+    if spec["seed"] == 3:
+        time.sleep(60)
+    return crash_on_seed_1(spec)

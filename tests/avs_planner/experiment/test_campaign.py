@@ -1,0 +1,184 @@
+"""Campaign files: each kind of mistake is refused naming its entry; expansion is the product."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from avs_planner.experiment import CampaignError, load_campaign
+from avs_planner.experiment import subjects as subjects_module
+from avs_planner.experiment.campaign import parse_campaign
+from avs_planner.experiment.report import PAPER_OUTCOME
+
+STRATEGIES = ["switching", "exhaustive", "most-likely-room"]  # registered in main
+
+
+def parse(data, base: Path = Path(".")):
+    return parse_campaign(data, "c.yaml", base)
+
+
+def refused(data, *fragments: str) -> str:
+    with pytest.raises(CampaignError) as info:
+        parse(data).runs()
+    message = str(info.value)
+    assert message.startswith("c.yaml: "), message
+    for fragment in fragments:
+        assert fragment in message, message
+    return message
+
+
+WORLD = {"worlds": ["office"], "targets": ["cerealbox"]}
+
+
+@pytest.mark.parametrize(("data", "fragments"), [
+    ([1, 2], ["a campaign is a mapping"]),
+    ({**WORLD, "seed": 3}, ["unknown keys ['seed']"]),
+    ({"targets": ["cup"]}, ["either 'worlds'"]),
+    ({**WORLD, "scenarios": ["a"]}, ["either 'worlds'"]),
+    ({"scenarios": ["a"], "targets": ["cup"]}, ["targets: scenarios bring their own"]),
+    ({"scenarios": ["a", "zz"]}, ["scenarios[1]: ", "unknown scenario 'zz'"]),
+    ({"worlds": ["office", "atlantis"], "targets": ["cup"]}, ["worlds[1]: "]),
+    ({"worlds": [{"world": "office", "color": 1}], "targets": ["cup"]},
+     ["worlds[0]: unknown keys ['color']"]),
+    ({"worlds": [3], "targets": ["cup"]}, ["worlds[0]: a world name or path"]),
+    ({"worlds": [{"world": "office", "start": [1, "x", 0]}], "targets": ["cup"]},
+     ["worlds[0].start: a start pose is [x, y, yaw]"]),
+    ({"worlds": [{"world": "office", "start_room": "attic"}], "targets": ["cup"]},
+     ["worlds[0]: --start-room 'attic': the world has rooms"]),
+    ({**WORLD, "strategies": ["switching", "flap"]},
+     ["strategies[1]: unknown strategy 'flap'", "exhaustive, most-likely-room, switching"]),
+    ({**WORLD, "strategies": [{"name": "exhaustive", "options": {"headings": "many"}}]},
+     ["strategies[0].options: strategy 'exhaustive': option 'headings' must be an int"]),
+    ({**WORLD, "strategies": [{"name": "exhaustive", "options": {"speed": 2}}]},
+     ["strategies[0].options: strategy 'exhaustive': unknown option(s) speed"]),
+    ({**WORLD, "strategies": ["switching", "switching"]},
+     ["strategies[1]: label 'switching' is used twice"]),
+    ({**WORLD, "strategies": [{"name": "switching", "options": [1]}]},
+     ["strategies[0].options: "]),
+    ({**WORLD, "seeds": "5-2"}, ["seeds: range '5-2' is empty"]),
+    ({**WORLD, "seeds": "0-3,x"}, ["seeds: 'x' is not a seed"]),
+    ({**WORLD, "seeds": [1, "a"]}, ["seeds[1]: a seed is an integer"]),
+    ({**WORLD, "seeds": "0-3,2"}, ["seeds: seed(s) [2] listed twice"]),
+    ({**WORLD, "time_budget_s": -5}, ["time_budget_s: must be a positive"]),
+    ({**WORLD, "wall_budget_s": "long"}, ["wall_budget_s: must be a number"]),
+    ({**WORLD, "robots": ["pioneer", "r2d2"]}, ["robots[1]: unknown robot 'r2d2'", "pr2"]),
+    ({"worlds": ["office"]}, ["worlds[0]: no targets"]),
+    ({"worlds": ["office", "office_no_tables"], "targets": {"office": ["cup"]}},
+     ["targets: no targets for world 'office_no_tables'"]),
+    ({"worlds": ["office"], "targets": "auto"}, ["targets: 'auto' targets are for generated"]),
+    ({"worlds": ["office"], "targets": [{"label": "cup", "expected": "maybe"}]},
+     ["targets[0].expected: found or gave_up"]),
+    ({"worlds": ["office"], "targets": [["cup"]]}, ["targets[0]: a label or"]),
+    ({"worlds": ["office"], "targets": ["cup", "banana"]},
+     ["targets[1]: unknown target label 'banana'; the knowledge knows book, cerealbox"]),
+    ({"worlds": ["office"], "targets": {"office": [{"label": "bananas"}]}},
+     ["targets.office[0].label: unknown target label 'bananas'"]),
+    ({"worlds": [{"generate": {"style": "office"}}], "targets": "auto"},
+     ["worlds[0].generate: a mapping with 'seeds'"]),
+    ({"worlds": [{"generate": {"seeds": "0-2", "rooms": 0}}], "targets": "auto"},
+     ["worlds[0].generate.rooms: a positive number"]),
+    ({"worlds": ["office", "office"], "targets": ["cup"]}, ["share the id 'office-cup"]),
+])
+def test_a_bad_campaign_is_refused_naming_the_entry(data, fragments):
+    refused(data, *fragments)
+
+
+def test_an_unknown_built_in_lists_the_built_ins():
+    with pytest.raises(CampaignError, match="built-in campaigns are .*seed003-fig3"):
+        load_campaign("seed004-fig9")
+
+
+def test_a_broken_yaml_file_is_named(tmp_path):
+    path = tmp_path / "broken.yaml"
+    path.write_text("worlds: [office\n", encoding="utf-8")
+    with pytest.raises(CampaignError, match=r"broken\.yaml: cannot read campaign"):
+        load_campaign(path)
+
+
+def test_worlds_targets_strategies_robots_and_seeds_multiply():
+    campaign = parse({"worlds": ["office", "office_no_tables"],
+                      "targets": ["cerealbox", {"label": "stapler", "expected": "found"}],
+                      "strategies": ["switching", {"name": "exhaustive", "label": "ex-fast",
+                                                   "options": {"headings": 8}}],
+                      "robots": ["pioneer", "pr2"], "seeds": "0-2", "time_budget_s": 300})
+    runs = campaign.runs()
+    assert len(runs) == 2 * 2 * 2 * 2 * 3
+    assert len({r.run_id for r in runs}) == len(runs)
+    first = runs[0]
+    assert first.run_id == "office-cerealbox-switching-pioneer-s0"
+    assert dict(first.episode) == {"world": "office", "target": "cerealbox", "seed": 0,
+                                   "robot": "pioneer", "time_budget_s": 300.0}
+    ex = next(r for r in runs if r.strategy.label == "ex-fast")
+    assert ex.episode["strategy"] == "exhaustive"
+    assert ex.episode["strategy_options"] == {"headings": 8}
+    expected = {(r.subject.world, r.subject.target): r.subject.expected for r in runs}
+    assert expected[("office", "cerealbox")] == "found"  # on the kitchen table
+    assert expected[("office_no_tables", "cerealbox")] == "gave_up"  # Fig. 3e: none anywhere
+    assert expected[("office_no_tables", "stapler")] == "found"  # as the entry says
+
+
+def test_targets_per_world_and_world_files_relative_to_the_campaign(tmp_path):
+    world = Path(subjects_module.__file__).parents[2] / "sim" / "worlds" / "office.yaml"
+    (tmp_path / "mine.yaml").write_text(world.read_text(encoding="utf-8"), encoding="utf-8")
+    campaign = parse({"worlds": ["office", {"world": "mine.yaml", "targets": ["cup"],
+                                            "start_room": "kitchen"}],
+                      "targets": {"office": ["stapler", "toilet"]}}, tmp_path)
+    runs = campaign.runs()
+    assert [(r.subject.world, r.subject.target, r.subject.expected) for r in runs] == [
+        ("office", "stapler", "found"), ("office", "toilet", "gave_up"),
+        ("mine", "cup", "found")]  # office.yaml has a cup
+    assert runs[2].episode["world"] == str(tmp_path / "mine.yaml")
+    assert runs[2].episode["start_room"] == "kitchen"
+
+
+def test_generated_worlds_with_auto_targets(monkeypatch):
+    calls = []
+
+    def fake(seed, style, rooms):
+        calls.append((seed, style, rooms))
+        return [("cup", True), (f"thing{seed}", True), ("banana", False)]
+
+    monkeypatch.setattr(subjects_module, "generated_targets", fake)
+    campaign = parse({"worlds": [{"generate": {"seeds": "3-6", "style": "office", "rooms": 6}}],
+                      "targets": "auto", "strategies": STRATEGIES})
+    runs = campaign.runs()
+    assert calls == [(s, "office", 6) for s in range(3, 7)]
+    assert len(runs) == 4 * 3 * 3
+    run = runs[0]
+    assert run.run_id == "gen-office-3-r6-cup-switching-s0"
+    assert run.episode["generate"] == {"seed": 3, "style": "office", "rooms": 6}
+    assert "world" not in run.episode
+    assert run.subject.group == "gen-office-r6"
+    in_4 = {(r.subject.target, r.subject.expected) for r in runs
+            if r.subject.world == "gen-office-4-r6"}
+    assert in_4 == {("cup", "found"), ("thing4", "found"), ("banana", "gave_up")}
+
+
+def test_the_built_in_seed003_campaign_is_fig3_a_to_f_times_20_seeds():
+    campaign = load_campaign("seed003-fig3")
+    runs = campaign.runs()
+    assert len(runs) == 120
+    assert {r.subject.scenario: r.subject.expected for r in runs} == PAPER_OUTCOME
+    assert sorted({r.seed for r in runs}) == list(range(20))
+    f = next(r for r in runs if r.subject.scenario == "f")
+    assert f.episode["pre_explore"] is True and f.episode["target"] == "whiteboardmarker"
+
+
+def test_generated_worlds_with_the_generators_own_targets():
+    pytest.importorskip("sim.generate", reason="the world generator is not in this build")
+    runs = parse({"worlds": [{"generate": {"seeds": "0-1", "style": "office", "rooms": 6}}],
+                  "targets": "auto"}).runs()
+    assert len(runs) == 2 * 3
+    for world in ("gen-office-0-r6", "gen-office-1-r6"):
+        expected = sorted(r.subject.expected for r in runs if r.subject.world == world)
+        assert expected == ["found", "found", "gave_up"], world
+
+
+def test_the_built_in_generated_campaign_is_50_worlds_times_3_strategies(monkeypatch):
+    monkeypatch.setattr(subjects_module, "generated_targets",
+                        lambda seed, style, rooms: [("cup", True), ("mug", True), ("x", False)])
+    runs = load_campaign("generated-50").runs()
+    assert len(runs) == 50 * 3 * 3
+    assert {r.strategy.name for r in runs} == set(STRATEGIES)
+    assert {r.subject.spec["generate"]["rooms"] for r in runs} == {6}
