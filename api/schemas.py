@@ -90,6 +90,17 @@ class PlanCreate(BaseModel):
         "is returned (default 2500 with the default heuristic)")
 
 
+class Diagnostic(BaseModel):
+    """One linter finding; `file` is `domain` or `problem[i]`."""
+
+    file: str
+    line: int
+    column: int
+    severity: Literal["error", "warning"]
+    message: str
+    code: str
+
+
 class PlanPublic(BaseModel):
     """The planner's answer: status, plan and its cost, success probability and objective."""
 
@@ -104,6 +115,9 @@ class PlanPublic(BaseModel):
     stopped_by: str | None = Field(
         None, description="patience, timeout or node_limit: the search was stopped with a "
         "plan in hand, which is the best found so far")
+    warnings: list[Diagnostic] = Field(
+        default_factory=list, description="what the reader accepted or repaired, e.g. a "
+        "requirement used but not declared (`avs domain check --strict` makes these errors)")
 
 
 class DomainCheckCreate(BaseModel):
@@ -111,17 +125,6 @@ class DomainCheckCreate(BaseModel):
 
     domain: str = Field(min_length=1, max_length=MAX_TEXT)
     problems: list[str] = Field(default_factory=list, max_length=50)
-
-
-class Diagnostic(BaseModel):
-    """One linter finding; `file` is `domain` or `problem[i]`."""
-
-    file: str
-    line: int
-    column: int
-    severity: Literal["error", "warning"]
-    message: str
-    code: str
 
 
 class DomainCheckPublic(BaseModel):

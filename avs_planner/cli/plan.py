@@ -69,6 +69,8 @@ def run(args: argparse.Namespace) -> int:
         **{k: v for k, v in given.items() if v is not None},
     ).check()
     pproblem = read_files(args.domain, args.problem)
+    for warning in pproblem.warnings:
+        print(warning, file=sys.stderr)
     result = plan(pproblem, options)
     print(json.dumps(result.as_json()) if args.json else _text(result))
     hint = _limit_hint(result, options.heuristic)
