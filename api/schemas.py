@@ -88,6 +88,9 @@ class PlanCreate(BaseModel):
         None, ge=0, le=10_000_000,
         description="once a plan is found, expansions without a better one before the best "
         "is returned (default 2500 with the default heuristic)")
+    anytime: bool | None = Field(
+        None, description="anytime satisficing: greedy best-first first, then weighted A* "
+        "restarts; the best plan by objective at timeout_s")
 
 
 class Diagnostic(BaseModel):

@@ -27,7 +27,7 @@ async def create_plan(
 
     The planner's own timeout is capped below the job's wall-clock limit, so a long search
     ends as status `timeout` rather than a killed job (504)."""
-    options = body.model_dump(include={"reward", "weight", "timeout_s", "patience"},
+    options = body.model_dump(include={"reward", "weight", "timeout_s", "patience", "anytime"},
                               exclude_none=True)
     cap = settings.plan_time_limit_s * PLANNER_SHARE
     options["timeout_s"] = min(options.get("timeout_s", cap), cap)
