@@ -1,7 +1,8 @@
 """Anytime satisficing search (`SearchOptions.anytime`, `avs plan --anytime`).
 
 LAMA's schedule on our objective: first a greedy best-first search with the FF heuristic,
-helpful actions first and deferred evaluation, on unit action costs (LAMA's first
+helpful actions first (alternating with a round without them) and deferred evaluation, on
+unit action costs (LAMA's first
 iteration: plan length guides it, so it finds a plan fast); then weighted A* restarted with
 decreasing weights (5, 3, 2, 1) on the real objective c + R(1 - p). Every plan is judged by
 that objective and the best so far is kept; at the deadline (`timeout_s`) it is returned,
@@ -25,6 +26,8 @@ from avs_planner.cp.task import GroundTask
 
 GREEDY_WEIGHT = 1e6  # f = c + w h: with h in plan steps, g only breaks ties (greedy)
 WEIGHTS = (5.0, 3.0, 2.0, 1.0)  # LAMA's restarts after its greedy iteration
+FIRST_BUDGET = 2000  # expansions of the first greedy round
+BUDGET_GROWTH = 4
 
 
 def unit_cost(task: GroundTask) -> GroundTask:
@@ -44,12 +47,9 @@ def anytime_search(
     """Greedy first, then restarting weighted A*; the best plan by objective at the end."""
     start = time.perf_counter()
     deadline = None if options.timeout_s is None else start + options.timeout_s
-    greedy = replace(options, anytime=False, weight=GREEDY_WEIGHT, lazy=True, patience=0,
-                     timeout_s=options.timeout_s)
-    best = search(unit_cost(task), greedy, symmetries)
+    best, expanded = _greedy(task, options, symmetries, deadline)
     history = [_entry("greedy", best, start)] if best.solved else []
-    expanded = best.expanded
-    if not best.solved and best.status is not PlanStatus.TIMEOUT:
+    if not best.solved and best.status not in (PlanStatus.TIMEOUT, PlanStatus.NODE_LIMIT):
         return _done(best, options, start, expanded, history, None)
     stopped = None if best.solved else "timeout"
     for weight in WEIGHTS:
@@ -69,6 +69,32 @@ def anytime_search(
     if not best.solved:
         return _done(best, options, start, expanded, history, None)
     return _done(best, options, start, expanded, history, stopped)
+
+
+def _greedy(task: GroundTask, options: SearchOptions, symmetries: Symmetries,
+            deadline: float | None) -> tuple[PlanResult, int]:
+    """Greedy best-first on unit costs, with and without the helpful-actions queue in turn,
+    each under an expansion budget that grows fourfold per round until one finds a plan or proves
+    there is none: helpful actions make barman easy and mislead on tetris, and the rounds
+    cost at most a small factor over the better of the two."""
+    unit = unit_cost(task)
+    greedy = replace(options, anytime=False, weight=GREEDY_WEIGHT, lazy=True, patience=0)
+    budget, expanded = FIRST_BUDGET, 0
+    result = PlanResult(PlanStatus.TIMEOUT)
+    while True:
+        for preferred in (True, False):
+            left = None if deadline is None else deadline - time.perf_counter()
+            if left is not None and left <= 0:
+                return result, expanded
+            limit = budget if options.node_limit is None else min(budget, options.node_limit)
+            result = search(unit, replace(greedy, preferred=preferred, node_limit=limit,
+                                          timeout_s=left), symmetries)
+            expanded += result.expanded
+            if result.status is not PlanStatus.NODE_LIMIT:
+                return result, expanded
+            if options.node_limit is not None and limit >= options.node_limit:
+                return result, expanded
+        budget *= BUDGET_GROWTH
 
 
 def _entry(weight: float | str, result: PlanResult, start: float) -> dict:
