@@ -47,7 +47,7 @@ def anytime_search(
     """Greedy first, then restarting weighted A*; the best plan by objective at the end."""
     start = time.perf_counter()
     deadline = None if options.timeout_s is None else start + options.timeout_s
-    best, expanded = _greedy(task, options, symmetries, deadline)
+    best, expanded = greedy_search(task, options, symmetries, deadline)
     history = [_entry("greedy", best, start)] if best.solved else []
     if not best.solved and best.status not in (PlanStatus.TIMEOUT, PlanStatus.NODE_LIMIT):
         return _done(best, options, start, expanded, history, None)
@@ -71,8 +71,8 @@ def anytime_search(
     return _done(best, options, start, expanded, history, stopped)
 
 
-def _greedy(task: GroundTask, options: SearchOptions, symmetries: Symmetries,
-            deadline: float | None) -> tuple[PlanResult, int]:
+def greedy_search(task: GroundTask, options: SearchOptions, symmetries: Symmetries,
+                  deadline: float | None) -> tuple[PlanResult, int]:
     """Greedy best-first on unit costs, with and without the helpful-actions queue in turn,
     each under an expansion budget that grows fourfold per round until one finds a plan or proves
     there is none: helpful actions make barman easy and mislead on tetris, and the rounds
