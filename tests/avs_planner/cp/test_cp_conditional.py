@@ -61,3 +61,18 @@ def test_static_conditions_become_plain_effects() -> None:
     assert done == {("done", p) for p in ("ap2", "ap28", "ap51", "ap117", "ap121", "ap132")}
     assert not workat.clauses
     assert len({a.label for a in task.actions}) == len(task.actions)
+
+
+def test_up_engine_takes_conditional_effects() -> None:
+    from unified_planning.io import PDDLReader
+    from unified_planning.shortcuts import OneshotPlanner
+
+    import avs_planner.up_engine  # noqa: F401 - registers "avs"
+
+    problem = PDDLReader().parse_problem(str(DATA / "briefcase-domain.pddl"),
+                                         str(DATA / "briefcase-problem.pddl"))
+    with OneshotPlanner(name="avs", params={"anytime": True}) as planner:
+        assert planner.supports(problem.kind)
+        result = planner.solve(problem, timeout=30)
+    assert result.status.name == "SOLVED_SATISFICING"
+    assert SequentialPlanValidator().validate(problem, result.plan).status.name == "VALID"
