@@ -63,8 +63,20 @@ def summary(rows: list[dict], probabilistic: bool) -> list[str]:
         lines.append(f"-- plan cost, ours/FD, median over the {len(both)} both solved: "
                      f"{ratio:.3f}")
     if probabilistic:
-        lines += [line for line in (office_scale(rows), building_scale(rows)) if line]
+        lines += [line for line in (stages(rows), office_scale(rows), building_scale(rows))
+                  if line]
     return lines
+
+
+def stages(rows: list[dict]) -> str | None:
+    """Where a cold call on the 20-place problems spends its time, stage by stage."""
+    group = [r for r in rows if "-p20-" in r["label"] and r.get("stages")]
+    if not group:
+        return None
+    parts = ", ".join(f"{stage} {_median(r['stages'][stage] for r in group) * 1e3:.1f}"
+                      for stage in group[0]["stages"])
+    return f"-- 20-place cold call by stage (ms, medians): {parts}; warm replan " \
+           f"{_median(r['warm_s'] for r in group) * 1e3:.1f} ms"
 
 
 TARGET_RATIO = 5.0  # issue 21: office scale at least this many times faster than FD's own
