@@ -74,6 +74,11 @@ class CompactActions(Sequence[GroundAction]):
     def __len__(self) -> int:
         return len(self._table)
 
+    @property
+    def table(self) -> Sequence[GroundAction]:
+        """The action table over the structure's fact ids that this one renumbers."""
+        return self._table
+
     @overload
     def __getitem__(self, i: int) -> GroundAction: ...
 
