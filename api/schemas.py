@@ -99,6 +99,20 @@ class PlanCreate(BaseModel):
         None, ge=0, le=10_000_000,
         description="once a plan is found, expansions without a better one before the best "
         "is returned (default 2500 with the default heuristic)")
+    anytime: bool | None = Field(
+        None, description="anytime satisficing: greedy best-first first, then weighted A* "
+        "restarts; the best plan by objective at timeout_s")
+
+
+class Diagnostic(BaseModel):
+    """One linter finding; `file` is `domain` or `problem[i]`."""
+
+    file: str
+    line: int
+    column: int
+    severity: Literal["error", "warning"]
+    message: str
+    code: str
 
 
 class PlanPublic(BaseModel):
@@ -115,6 +129,9 @@ class PlanPublic(BaseModel):
     stopped_by: str | None = Field(
         None, description="patience, timeout or node_limit: the search was stopped with a "
         "plan in hand, which is the best found so far")
+    warnings: list[Diagnostic] = Field(
+        default_factory=list, description="what the reader accepted or repaired, e.g. a "
+        "requirement used but not declared (`avs domain check --strict` makes these errors)")
 
 
 class PlanJobState(StrEnum):
@@ -148,17 +165,6 @@ class DomainCheckCreate(BaseModel):
 
     domain: str = Field(min_length=1, max_length=MAX_TEXT)
     problems: list[str] = Field(default_factory=list, max_length=50)
-
-
-class Diagnostic(BaseModel):
-    """One linter finding; `file` is `domain` or `problem[i]`."""
-
-    file: str
-    line: int
-    column: int
-    severity: Literal["error", "warning"]
-    message: str
-    code: str
 
 
 class DomainCheckPublic(BaseModel):

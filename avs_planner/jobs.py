@@ -88,7 +88,7 @@ def plan(domain_text: str, problem_text: str, options: Mapping[str, Any] | None 
         return _invalid(exc.file, exc.line, exc.column, exc.message)
     except AvsError as exc:  # PlanningError: a construct the planner does not support
         return {"status": "unsupported", "message": str(exc)}
-    return result.as_json()
+    return {**result.as_json(), "warnings": [_diagnostic(w) for w in problem.warnings]}
 
 
 def _invalid(file: str, line: int, column: int, message: str) -> dict[str, Any]:

@@ -69,6 +69,7 @@ class AvsPlanner(Engine, OneshotPlannerMixin):
             node_limit=params.pop("node_limit", None),
             min_success=float(params.pop("min_success", 0.0)),
             engine=str(params.pop("engine", "auto")),
+            anytime=bool(params.pop("anytime", False)),
         )
         if params:
             raise up.exceptions.UPUsageError(f"unknown avs parameters: {sorted(params)}")
@@ -91,6 +92,8 @@ class AvsPlanner(Engine, OneshotPlannerMixin):
         for cond in ("NEGATIVE_CONDITIONS", "DISJUNCTIVE_CONDITIONS", "EQUALITIES",
                      "EXISTENTIAL_CONDITIONS", "UNIVERSAL_CONDITIONS"):
             kind.set_conditions_kind(cond)
+        for effect in ("CONDITIONAL_EFFECTS", "FORALL_EFFECTS"):
+            kind.set_effects_kind(effect)  # compiled away while grounding (cp/conditional.py)
         kind.set_initial_state("UNDEFINED_INITIAL_NUMERIC")  # a missing needed value is an error
         kind.set_quality_metrics("ACTIONS_COST")
         kind.set_quality_metrics("PLAN_LENGTH")
@@ -136,7 +139,7 @@ class AvsPlanner(Engine, OneshotPlannerMixin):
         if not result.solved:
             return PlanGenerationResult(_STATUS[result.status], None, self.name, metrics)
         optimal = (get_heuristic(options.heuristic).admissible and options.weight == 1.0
-                   and result.stopped_by is None)
+                   and result.stopped_by is None and not options.anytime)
         status = (
             PlanGenerationResultStatus.SOLVED_OPTIMALLY if optimal
             else PlanGenerationResultStatus.SOLVED_SATISFICING

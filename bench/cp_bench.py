@@ -1,20 +1,23 @@
-"""Continual planner vs Fast Downward lama-first (through UP), same run, per instance.
+"""Continual planner vs Fast Downward lama-first, same runs, per instance, failures counted.
 
-Run: `.venv/bin/python -m bench.cp_bench [--quick | --full]` (default ~2.5 min here).
+Run: `.venv/bin/python -m bench.cp_bench [--quick | --full] [--runs N] [--limit S]`.
 Instances: the AVS problems in domains/avs/problems, generated AVS problems of growing size
-(bench/avs_generator.py, seeds 0-2 of each size) and IPC instances from ../shared/ipc. Per
-instance it prints both times, their ratio (FD / ours, > 1 means we are faster), both plans'
-cost and, for AVS, both plans' true objective c + R(1 - p). FD cannot read probabilities, so
-for it each ground action's cost becomes round(100 (c + R (-ln p))) through a per-action cost
-fluent. Our time is `planning_time_s` (grounding + search), the median of 5 cold calls (new
-problem object, new grounding cache) and, for AVS, also of 5 warm replans from the same state
-(grounding structure, action table and packed task reused; in episodes about 60% of replans
-reuse their table) and of 5 replans with what the last call left for reuse dropped first
-(action table and evaluations, as a replan whose new state reaches other actions and values:
-"warm, new actions" in the summary); the summary also splits the 20-place problems' cold calls
-by stage (`cold_stages`) and checks issue 3's target on the problems it names
-(`office_scale`). FD's time is the wall time of `OneshotPlanner.solve`, one run
-(writing PDDL, translate, search). Our plans are checked with UP's sequential plan validator.
+(bench/avs_generator.py, seeds 0-2; `--building` adds the 80- and 160-place ones) and the IPC
+set at ../shared/ipc (`AVS_IPC_DIR` elsewhere; the bench stops when it is missing).
+
+Per instance, both sides get the same number of runs (`--runs`, median reported):
+- ours, read: reading the PDDL text plus planning, cold (new problem, new grounding cache);
+- ours, plan: `planning_time_s` of the same calls (grounding + search);
+- FD own: the translator's and the search component's own times from FD's log, no
+  interpreter start-up (bench/fd_runner.py runs FD's driver on PDDL files);
+- FD e2e: the driver's wall time, start-ups included.
+A failure or a timeout counts as the limit (`--limit`, default 60 s) in every time and
+ratio, and the coverage line says how many each side solved. Ratios are FD / ours (> 1: we
+are faster), against ours with reading. For AVS, ours is the default weighted A* (w = 2) on
+c + R(1 - p), and FD plans the deterministic compilation: each ground action's cost becomes
+round(100 (c + R (-ln p))) through a per-action cost fluent; both plans' true objective is
+printed. For IPC, ours is the anytime mode's greedy phase (LAMA's first iteration, which is
+what lama-first runs). Our plans are checked with UP's sequential plan validator.
 """
 
 from __future__ import annotations
@@ -22,60 +25,85 @@ from __future__ import annotations
 import argparse
 import gc
 import math
+import os
 import statistics
 import sys
+import tempfile
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from unified_planning.engines.plan_validator import SequentialPlanValidator
-from unified_planning.io import PDDLReader
+from unified_planning.io import PDDLWriter
 from unified_planning.model import MinimizeActionCosts, Problem
-from unified_planning.shortcuts import Fluent, IntType, OneshotPlanner, get_environment
+from unified_planning.shortcuts import Fluent, IntType, get_environment
 
+from avs_planner.cp.anytime import greedy_search
 from avs_planner.cp.grounding import GroundingCache, gc_paused, ground
 from avs_planner.cp.planner import plan
 from avs_planner.cp.search import PlanResult, SearchOptions, objective, search
-from avs_planner.cp.symmetry import find_symmetries
+from avs_planner.cp.symmetry import NO_SYMMETRIES, find_symmetries
 from avs_planner.cp.task import GroundTask
 from avs_planner.pddl import read_text
 from avs_planner.pddl.model import ProbabilisticProblem
 from avs_planner.up_engine import to_up_plan
 from bench.avs_generator import AvsSize, generate
+from bench.cp_report import office_scale, report  # noqa: F401 - office_scale: tests
+from bench.fd_runner import FdRun, run_fd
 
 ROOT = Path(__file__).resolve().parents[1]
-IPC = Path(__file__).resolve().parents[2] / "shared" / "ipc"  # beside the checkout
+IPC = Path(os.environ.get("AVS_IPC_DIR", ROOT.parent / "shared" / "ipc"))  # beside the checkout
 REWARD = 500.0
-TIMEOUT_S = 10.0
+LIMIT_S = 60.0
 PROHIBITIVE = 10**7
-OPTIONS = SearchOptions(reward=REWARD, weight=2.0, heuristic="ff", timeout_s=TIMEOUT_S)
+OPTIONS = SearchOptions(reward=REWARD, weight=2.0, heuristic="ff", timeout_s=LIMIT_S)
 SIZES = (AvsSize(8, 2, 2, 4), AvsSize(12, 3, 3, 6), AvsSize(20, 5, 4, 8))
-RUNS = 5  # our timings per instance (median); FD runs once (0.3-9 s each)
+BUILDING = (AvsSize(40, 8, 8, 8), AvsSize(80, 16, 16, 8), AvsSize(160, 32, 32, 8))
+RUNS = 3  # runs per instance, on both sides (median)
 
 
-def avs_cases(quick: bool) -> list[tuple[str, ProbabilisticProblem]]:
-    domain_text = (ROOT / "domains/avs/domain.pddl").read_text()
-    cases = [
-        (f"avs/{p.stem}", read_text(domain_text, p.read_text(), "domain.pddl", p.name))
-        for p in sorted((ROOT / "domains/avs/problems").glob("*.pddl"))
-    ]
+@dataclass(frozen=True)
+class Case:
+    """One instance: its PDDL text (ours reads it in the timing) and files (FD reads them)."""
+
+    label: str
+    domain: Path
+    problem: Path
+    probabilistic: bool
+
+    def read(self) -> ProbabilisticProblem:
+        return read_text(self.domain.read_text(), self.problem.read_text(),
+                         str(self.domain), str(self.problem))
+
+
+def require_ipc() -> Path:
+    if not IPC.is_dir():
+        raise SystemExit(f"IPC benchmark set missing at {IPC} (put it at ../shared/ipc beside "
+                         f"the checkout, or set AVS_IPC_DIR)")
+    return IPC
+
+
+def avs_cases(quick: bool, building: bool, scratch: Path) -> list[Case]:
+    domain = ROOT / "domains/avs/domain.pddl"
+    cases = [Case(f"avs/{p.stem}", domain, p, True)
+             for p in sorted((ROOT / "domains/avs/problems").glob("*.pddl"))]
     seeds = (0,) if quick else (0, 1, 2)  # every seed of the sizes the target names
-    for size in SIZES[:2] if quick else SIZES:
+    sizes = (SIZES[:2] if quick else SIZES) + (BUILDING if building else ())
+    for size in sizes:
         for seed in seeds:
-            text = generate(size, seed)
-            cases.append((f"gen/{size.name}-s{seed}",
-                          read_text(domain_text, text, "domain.pddl", size.name)))
+            path = scratch / f"{size.name}-s{seed}.pddl"
+            path.write_text(generate(size, seed))
+            cases.append(Case(f"gen/{size.name}-s{seed}", domain, path, True))
     return cases
 
 
-def ipc_cases(quick: bool, full: bool = False) -> list[tuple[str, ProbabilisticProblem]]:
+def ipc_cases(quick: bool, full: bool = False) -> list[Case]:
     cases = []
-    for domain in sorted(IPC.glob("*/domain.pddl")):
+    for domain in sorted(require_ipc().glob("*/domain.pddl")):
         instances = sorted(domain.parent.glob("instance-*.pddl"),
                            key=lambda p: int(p.stem.split("-")[1]))
         for problem in instances if full else instances[:2] if quick else instances[::2]:
-            up = PDDLReader().parse_problem(str(domain), str(problem))
-            cases.append((f"{domain.parent.name}/{problem.stem}", ProbabilisticProblem(up)))
+            cases.append(Case(f"{domain.parent.name}/{problem.stem}", domain, problem, False))
     return cases
 
 
@@ -118,58 +146,69 @@ def true_objective(task: GroundTask, labels: list[tuple[str, tuple[str, ...]]]) 
     return cost, p, objective(cost, p, REWARD)
 
 
-def run_fd(problem: Problem) -> tuple[float, list | None]:
-    start = time.perf_counter()
-    with OneshotPlanner(name="fast-downward",
-                        params={"fast_downward_alias": "lama-first"}) as planner:
-        result = planner.solve(problem, timeout=60)
-    elapsed = time.perf_counter() - start
-    if result.plan is None:
-        return elapsed, None
-    return elapsed, [(ai.action.name, tuple(str(p) for p in ai.actual_parameters))
-                     for ai in result.plan.actions]
-
-
 def valid(problem: Problem, up_plan) -> bool:
     validator = SequentialPlanValidator()
     validator.skip_checks = True  # elevators' partially defined costs trip the kind check
     return validator.validate(problem, up_plan).status.name == "VALID"
 
 
-def bench_case(label: str, pproblem: ProbabilisticProblem, probabilistic: bool,
-               runs: int = RUNS) -> dict:
-    """Our time is the median of `runs` cold calls (each on a new problem object with a new
-    GroundingCache, the heap collected first) and, for AVS, of `runs` warm replans; single
-    timings on this shared machine vary up to 1.5x from run to run."""
-    colds = []
-    for _ in range(runs):
-        fresh = replace(pproblem)  # a new problem object: nothing is cached for it
-        gc.collect()  # each timing starts from a collected heap (the planner pauses the GC)
-        colds.append(plan(fresh, OPTIONS, cache=GroundingCache()))
-    ours: PlanResult = colds[0]
-    cache = GroundingCache()
-    plan(pproblem, OPTIONS, cache=cache)
-    warms, fresh_tables = [], []
-    for _ in range(runs if probabilistic else 0):
-        gc.collect()
-        warms.append(plan(pproblem, OPTIONS, cache=cache).planning_time_s)
-        cache.forget_last_calls()  # as a replan reaching other actions and values
-        gc.collect()
-        fresh_tables.append(plan(pproblem, OPTIONS, cache=cache).planning_time_s)
-    task = ground(pproblem, cache=cache)
-    fd_input = fd_problem(pproblem, task) if probabilistic else pproblem.problem
-    fd_time, fd_plan = run_fd(fd_input)
-    stages = cold_stages(pproblem, runs) if probabilistic else {}
-    row = {"label": label, "ours_s": statistics.median(r.planning_time_s for r in colds),
-           "stages": stages,
-           "warm_s": statistics.median(warms) if warms else math.nan,
-           "new_table_s": statistics.median(fresh_tables) if fresh_tables else math.nan,
-           "fd_s": fd_time,
-           "status": ours.status.value, "expanded": ours.expanded}
-    if ours.solved:
-        row["ours_valid"] = valid(pproblem.problem, to_up_plan(pproblem.problem, ours.plan))
-        row["ours_cost"], row["ours_obj"] = ours.cost, ours.objective
+def ours_once(case: Case, limit_s: float) -> tuple[float, float, PlanResult, object]:
+    """(read + plan seconds, plan seconds, result, problem) of one cold call; a failure
+    counts as the limit."""
+    gc.collect()  # each timing starts from a collected heap (the planner pauses the GC)
+    start = time.perf_counter()
+    pproblem = case.read()
+    if case.probabilistic:
+        result = plan(pproblem, replace(OPTIONS, timeout_s=limit_s), cache=GroundingCache())
+    else:  # the anytime mode's greedy phase: what lama-first runs
+        began = time.perf_counter()
+        task = ground(pproblem, cache=GroundingCache())
+        result, _ = greedy_search(task, SearchOptions(reward=REWARD), NO_SYMMETRIES,
+                                  start + limit_s)
+        result = replace(result, planning_time_s=time.perf_counter() - began)
+    total = time.perf_counter() - start
+    if not result.solved or total > limit_s:
+        return limit_s, limit_s, result, pproblem
+    return total, result.planning_time_s, result, pproblem
+
+
+def fd_input(case: Case, pproblem: ProbabilisticProblem, scratch: Path) -> tuple[Path, Path]:
+    """FD's files: the originals, or for AVS the deterministic compilation written out."""
+    if not case.probabilistic:
+        return case.domain, case.problem
+    writer = PDDLWriter(fd_problem(pproblem, ground(pproblem, cache=GroundingCache())))
+    stem = case.label.replace("/", "-")
+    domain, problem = scratch / f"{stem}-fd-domain.pddl", scratch / f"{stem}-fd-problem.pddl"
+    writer.write_domain(str(domain))
+    writer.write_problem(str(problem))
+    return domain, problem
+
+
+def bench_case(case: Case, runs: int, limit_s: float, scratch: Path) -> dict:
+    """Both sides `runs` times, medians; the warm replan time for AVS (grounding structure
+    and action table cached) and its cold stages beside."""
+    ours = [ours_once(case, limit_s) for _ in range(runs)]
+    result, pproblem = ours[0][2], ours[0][3]
+    domain, problem = fd_input(case, pproblem, scratch)
+    fds: list[FdRun] = [run_fd(domain, problem, limit_s) for _ in range(runs)]
+    row = {"label": case.label, "ours_read_s": statistics.median(o[0] for o in ours),
+           "ours_s": statistics.median(o[1] for o in ours),
+           "fd_own_s": statistics.median(f.own_s for f in fds),
+           "fd_s": statistics.median(f.wall_s for f in fds),
+           "fd_solved": sum(f.solved for f in fds) * 2 > runs,
+           "status": result.status.value, "expanded": result.expanded,
+           "warm_s": math.nan, "stages": {}}
+    if case.probabilistic and result.solved:
+        cache = GroundingCache()
+        plan(pproblem, OPTIONS, cache=cache)
+        warms = [plan(pproblem, OPTIONS, cache=cache).planning_time_s for _ in range(runs)]
+        row["warm_s"], row["stages"] = statistics.median(warms), cold_stages(pproblem, runs)
+    if result.solved:
+        row["ours_valid"] = valid(pproblem.problem, to_up_plan(pproblem.problem, result.plan))
+        row["ours_cost"], row["ours_obj"] = result.cost, result.objective
+    fd_plan = next((f.plan for f in fds if f.solved), None)
     if fd_plan is not None:
+        task = ground(pproblem, cache=GroundingCache())
         row["fd_cost"], _, row["fd_obj"] = true_objective(task, fd_plan)
     return row
 
@@ -202,93 +241,15 @@ def cold_stages(pproblem: ProbabilisticProblem, runs: int) -> dict[str, float]:
     return {stage: statistics.median(t) for stage, t in times.items()}
 
 
-def _fmt(value, spec: str) -> str:
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "-"
-    return format(value, spec)
-
-
-def report(rows: list[dict], title: str, probabilistic: bool) -> list[float]:
-    print(f"\n== {title}")
-    head = f"{'instance':34} {'ours ms':>9} {'warm ms':>8} {'FD ms':>8} {'FD/ours':>8} " \
-           f"{'status':>8} {'exp':>6} {'cost':>7} {'FD cost':>7}"
-    print(head + (f" {'obj':>8} {'FD obj':>8}" if probabilistic else "") + "  valid")
-    ratios = []
-    for r in rows:
-        ratio = r["fd_s"] / r["ours_s"] if r["status"] == "solved" else math.nan
-        if not math.isnan(ratio):
-            ratios.append(ratio)
-        line = (f"{r['label']:34} {r['ours_s'] * 1e3:9.1f} {_fmt(r['warm_s'] * 1e3, '8.1f')} "
-                f"{r['fd_s'] * 1e3:8.1f} {_fmt(ratio, '8.2f')} {r['status'][:8]:>8} "
-                f"{r['expanded']:6d} {_fmt(r.get('ours_cost'), '7.1f')} "
-                f"{_fmt(r.get('fd_cost'), '7.1f')}")
-        if probabilistic:
-            line += f" {_fmt(r.get('ours_obj'), '8.1f')} {_fmt(r.get('fd_obj'), '8.1f')}"
-        print(line + f"  {r.get('ours_valid', '-')}")
-    solved = [r["ours_s"] for r in rows if r["status"] == "solved"]
-    print(f"-- median ours {statistics.median([r['ours_s'] for r in rows]) * 1e3:.1f} ms "
-          f"(solved {len(solved)}/{len(rows)}), median FD/ours ratio "
-          f"{_fmt(statistics.median(ratios) if ratios else math.nan, '.2f')}")
-    if probabilistic:  # issue 3's office scale: the seed's situations and ~20-place ones
-        for name, group in (("seed problems", [r for r in rows if r["label"].startswith("avs/")]),
-                            ("20-place problems", [r for r in rows if "-p20-" in r["label"]])):
-            if group:
-                print(f"-- {name} ({len(group)}): median ours "
-                      f"{statistics.median(r['ours_s'] for r in group) * 1e3:.1f} ms cold, "
-                      f"{statistics.median(r['warm_s'] for r in group) * 1e3:.1f} ms warm, "
-                      f"{statistics.median(r['new_table_s'] for r in group) * 1e3:.1f} ms "
-                      f"warm, new actions")
-                parts = ", ".join(
-                    f"{stage} {statistics.median(r['stages'][stage] for r in group) * 1e3:.1f}"
-                    for stage in STAGES)
-                print(f"   cold by stage (ms, medians): {parts}")
-        line = office_scale(rows)
-        if line:
-            print(line)
-    warm = [r["warm_s"] for r in rows if not math.isnan(r["warm_s"])]
-    if warm:
-        warm_ratios = [r["fd_s"] / r["warm_s"] for r in rows
-                       if r["status"] == "solved" and not math.isnan(r["warm_s"])]
-        print(f"-- warm (a replan from the same state: grounding structure and action table "
-              f"cached): median "
-              f"{statistics.median(warm) * 1e3:.1f} ms, median FD/ours ratio "
-              f"{_fmt(statistics.median(warm_ratios) if warm_ratios else math.nan, '.2f')}")
-    return ratios
-
-
-TARGET_MS = 20.0  # issue 3: median planning time on office-scale AVS problems
-TARGET_RATIO = 5.0  # and at least this many times faster than FD on the same problems
-
-
-def office_scale(rows: list[dict]) -> str | None:
-    """Issue 3's target as written, on the rows it names: the seed's situations
-    (domains/avs/problems) and the generated ~20-place problems together. The median cold
-    time and the median FD/ours ratio over that set, each against its target; None when the
-    run has no such rows. The slowest of them is named too, since a median hides it."""
-    group = [r for r in rows if r["label"].startswith("avs/") or "-p20-" in r["label"]]
-    if not group:
-        return None
-    median_ms = statistics.median(r["ours_s"] for r in group) * 1e3
-    ratios = [r["fd_s"] / r["ours_s"] for r in group if r["status"] == "solved"]
-    ratio = statistics.median(ratios) if ratios else math.nan
-    slowest = max(group, key=lambda r: r["ours_s"])
-    met = (median_ms <= TARGET_MS and len(ratios) == len(group) and ratio >= TARGET_RATIO)
-    return (f"-- office scale, issue 3's target ({len(group)}: seed problems + 20-place): "
-            f"median ours {median_ms:.1f} ms cold (target <= {TARGET_MS:g}), median FD/ours "
-            f"{_fmt(ratio, '.1f')}x (target >= {TARGET_RATIO:g}x), solved "
-            f"{len(ratios)}/{len(group)}: {'met' if met else 'MISSED'}; slowest "
-            f"{slowest['label']} {slowest['ours_s'] * 1e3:.1f} ms")
-
-
 def grounding_times(quick: bool) -> None:
     """UP's grounder and FD's reachability grounder (both through UP) vs ours, cold and warm."""
     from unified_planning.engines import CompilationKind
     from unified_planning.shortcuts import Compiler
 
     print("\n== grounding (ms): UP grounder | FD reachability grounder | ours cold | ours warm")
-    picked = [c for c in ipc_cases(True) if c[0].endswith("instance-1")]
-    picked += avs_cases(True)[:1 if quick else 3]
-    for label, pproblem in picked:
+    picked = [c for c in ipc_cases(True) if c.label.endswith("instance-1")]
+    for case in picked:
+        label, pproblem = case.label, case.read()
         times = []
         for name in ("up_grounder", "fast-downward-reachability-grounder"):
             start = time.perf_counter()
@@ -312,21 +273,32 @@ def grounding_times(quick: bool) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer instances")
-    parser.add_argument("--full", action="store_true",
-                        help="every IPC instance")
-    parser.add_argument("--grounding-only", action="store_true",
-                        help="only compare the grounders")
+    parser.add_argument("--full", action="store_true", help="every IPC instance")
+    parser.add_argument("--building", action="store_true",
+                        help="add the 40-, 80- and 160-place AVS problems")
+    parser.add_argument("--runs", type=int, default=RUNS, help="runs per instance, each side")
+    parser.add_argument("--limit", type=float, default=LIMIT_S,
+                        help="seconds per run; a failure counts as this")
+    parser.add_argument("--only", choices=("avs", "ipc"), default=None)
+    parser.add_argument("--grounding", action="store_true", help="compare the grounders too")
     args = parser.parse_args()
     get_environment().credits_stream = None
-    grounding_times(args.quick)
-    if args.grounding_only:
-        return
-    print(f"options: R={OPTIONS.reward} w={OPTIONS.weight} h={OPTIONS.heuristic} "
-          f"timeout={OPTIONS.timeout_s}s; FD: lama-first through UP")
-    avs = [bench_case(label, p, True) for label, p in avs_cases(args.quick)]
-    report(avs, "AVS problems (probabilistic; FD on -ln p costs)", True)
-    ipc = [bench_case(label, p, False) for label, p in ipc_cases(args.quick, args.full)]
-    report(ipc, "IPC instances (deterministic)", False)
+    require_ipc()
+    if args.grounding:
+        grounding_times(args.quick)
+    print(f"runs {args.runs} per instance on both sides, limit {args.limit:g} s (a failure "
+          f"counts as the limit); ours: R={OPTIONS.reward} w={OPTIONS.weight} "
+          f"h={OPTIONS.heuristic} on AVS, the anytime greedy phase on IPC; FD: lama-first")
+    with tempfile.TemporaryDirectory(prefix="cp-bench-") as scratch:
+        if args.only != "ipc":
+            rows = [bench_case(c, args.runs, args.limit, Path(scratch))
+                    for c in avs_cases(args.quick, args.building, Path(scratch))]
+            report(rows, "AVS problems (probabilistic; FD on -ln p costs)", True)
+        if args.only != "avs":
+            rows = [bench_case(c, args.runs, args.limit, Path(scratch))
+                    for c in ipc_cases(args.quick, args.full)]
+            report(rows, "IPC instances (deterministic)", False)
+    sys.stdout.flush()
 
 
 if __name__ == "__main__":

@@ -1,26 +1,28 @@
-"""The CP bench's office-scale line: issue 3's target on the problems it names."""
+"""The CP bench's summary lines: coverage with failures at the limit, issue 21's targets."""
 
-from bench.cp_bench import office_scale
+from bench.cp_report import building_scale, office_scale, summary
 
 
-def _row(label, ours_ms, fd_ms, status="solved"):
-    return {"label": label, "ours_s": ours_ms / 1e3, "fd_s": fd_ms / 1e3, "status": status}
+def _row(label, ours_ms, fd_own_ms, fd_ms=None, status="solved", fd_solved=True, read_ms=None):
+    return {"label": label, "ours_s": ours_ms / 1e3, "ours_read_s": (read_ms or ours_ms) / 1e3,
+            "fd_own_s": fd_own_ms / 1e3, "fd_s": (fd_ms or fd_own_ms * 2) / 1e3,
+            "status": status, "fd_solved": fd_solved}
 
 
 def test_office_scale_takes_the_seed_and_20_place_problems_only():
-    rows = [_row("avs/corridor", 10, 900), _row("avs/room3", 4, 800),
-            _row("gen/avs-p20-h5-r4-l8-s0", 22, 3000), _row("gen/avs-p20-h5-r4-l8-s1", 30, 3000),
+    rows = [_row("avs/corridor", 10, 900, read_ms=100), _row("avs/room3", 4, 800, read_ms=80),
+            _row("gen/avs-p20-h5-r4-l8-s0", 22, 3000, read_ms=300),
+            _row("gen/avs-p20-h5-r4-l8-s1", 30, 3000, read_ms=300),
             _row("gen/avs-p8-h2-r2-l4-s0", 1, 500)]  # 8 places: not office scale
-    # ratios 90, 200, 136.4, 100
-    line = office_scale(rows)
-    assert line.startswith("-- office scale, issue 3's target (4: seed problems + 20-place): "
-                           "median ours 16.0 ms cold (target <= 20)")
-    assert "median FD/ours 118.2x (target >= 5x), solved 4/4: met" in line
-    assert line.endswith("slowest gen/avs-p20-h5-r4-l8-s1 30.0 ms")
+    line = office_scale(rows)  # own/ours: 90, 200, 136.4, 100 -> 118.2
+    assert line.startswith("-- office scale (4: seed problems + 20-place): median ours+read "
+                           "200.0 ms, FD own/ours (planning) 118.2x (target >= 5x)")
+    assert "FD own/ours+read 10.0x" in line and "solved 4/4: met" in line
+    assert line.endswith("slowest gen/avs-p20-h5-r4-l8-s0 300.0 ms")
 
 
-def test_office_scale_says_missed_for_a_slow_median_or_an_unsolved_problem():
-    slow = [_row("avs/a", 25, 900), _row("gen/avs-p20-h5-r4-l8-s0", 21, 900)]
+def test_office_scale_says_missed_for_a_slow_ratio_or_an_unsolved_problem():
+    slow = [_row("avs/a", 250, 900), _row("gen/avs-p20-h5-r4-l8-s0", 210, 900)]
     assert ": MISSED;" in office_scale(slow)
     unsolved = [_row("avs/a", 5, 900), _row("avs/b", 5, 900, status="timeout")]
     assert "solved 1/2: MISSED;" in office_scale(unsolved)
@@ -28,3 +30,19 @@ def test_office_scale_says_missed_for_a_slow_median_or_an_unsolved_problem():
 
 def test_office_scale_is_silent_without_such_problems():
     assert office_scale([_row("ipc/blocks/instance-1", 3, 300)]) is None
+
+
+def test_coverage_counts_failures_and_names_what_fd_solved_and_we_did_not():
+    rows = [_row("a/1", 10, 100), _row("a/2", 60000, 200, status="timeout"),
+            _row("a/3", 10, 60000, fd_solved=False)]
+    lines = summary(rows, probabilistic=False)
+    assert lines[0] == "-- coverage: ours 2/3, FD 2/3; FD solved and we did not: a/2"
+    assert "ours 10.0 ms" in lines[1]  # median of 10, 60000 (the limit), 10
+
+
+def test_building_scale_against_its_targets():
+    rows = [_row("gen/avs-p80-h16-r16-l8-s0", 40, 100), _row("gen/avs-p160-h32-r32-l8-s0",
+                                                             300, 100)]
+    line = building_scale(rows)
+    assert "80 places 40.0 ms (target <= 50: met)" in line
+    assert "160 places 300.0 ms (target <= 200: MISSED)" in line

@@ -24,7 +24,7 @@ _ERRORS: dict[int | str, dict[str, Any]] = {
 
 
 def _payload(body: PlanCreate, settings: SettingsDep) -> dict[str, Any]:
-    options = body.model_dump(include={"reward", "weight", "timeout_s", "patience"},
+    options = body.model_dump(include={"reward", "weight", "timeout_s", "patience", "anytime"},
                               exclude_none=True)
     cap = settings.plan_time_limit_s * PLANNER_SHARE
     options["timeout_s"] = min(options.get("timeout_s", cap), cap)

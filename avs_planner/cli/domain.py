@@ -15,11 +15,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "check",
         help="lint a domain and its problems",
         description="Report mistakes as FILE:LINE:COL: error|warning: message. "
-        "Exit 0 when there are no errors, 1 otherwise.",
+        "Exit 0 when there are no errors, 1 otherwise (with --strict, warnings count as "
+        "errors).",
     )
     parser.add_argument("domain", help="the domain file")
     parser.add_argument("problems", nargs="*", help="problem files to check with it")
     parser.add_argument("--json", action="store_true", help="print a JSON list of findings")
+    parser.add_argument("--strict", action="store_true",
+                        help="treat warnings as errors (e.g. an undeclared requirement, which "
+                        "`avs plan` accepts as Fast Downward does)")
     parser.set_defaults(func=run)
 
 
@@ -28,6 +32,8 @@ def run(args: argparse.Namespace) -> int:
     from avs_planner.pddl import check
 
     diagnostics = check(args.domain, args.problems)
+    if args.strict:
+        diagnostics = [d.as_error() for d in diagnostics]
     if args.json:
         print(json.dumps([d.to_dict() for d in diagnostics], indent=2))
     else:

@@ -43,6 +43,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="once a plan is found, expansions without a better one before "
                         "the best is returned ('inf': no limit; default 2500 with an "
                         "inadmissible heuristic, no limit with hmax)")
+    parser.add_argument("--anytime", action="store_true",
+                        help="anytime satisficing: greedy best-first with FF and helpful "
+                        "actions (LAMA's first iteration), then weighted A* restarts with "
+                        "w = 5, 3, 2, 1; prints the best plan by objective at --timeout "
+                        "(or when the last restart ends). Probabilistic objectives kept")
     parser.add_argument("--heuristic", default="ff",
                         help="hmax (admissible), hadd, ff (default) or blind")
     parser.add_argument("--min-success", type=float, default=0.0,
@@ -65,10 +70,12 @@ def run(args: argparse.Namespace) -> int:
     options = SearchOptions(
         heuristic=args.heuristic, timeout_s=args.timeout, node_limit=args.node_limit,
         min_success=args.min_success, engine=args.engine, patience=args.patience,
-        threads=args.threads,
+        threads=args.threads, anytime=args.anytime,
         **{k: v for k, v in given.items() if v is not None},
     ).check()
     pproblem = read_files(args.domain, args.problem)
+    for warning in pproblem.warnings:
+        print(warning, file=sys.stderr)
     result = plan(pproblem, options)
     print(json.dumps(result.as_json()) if args.json else _text(result))
     hint = _limit_hint(result, options.heuristic)

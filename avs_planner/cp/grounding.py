@@ -23,6 +23,7 @@ import numpy as np
 from unified_planning.model import FNode, InstantaneousAction, Problem
 
 from avs_planner.cp.action_table import ActionTable
+from avs_planner.cp.compact import compact
 from avs_planner.cp.derived import derived, ids_of, reachable, relevant, task_rows
 from avs_planner.cp.encoding import ConstantExpr, NumericValues
 from avs_planner.cp.schema import LiftedSchema, compile_schemas
@@ -358,10 +359,10 @@ def _ground(
     read_mask = _bits(read[:n])
     cost, probability = np.take(cost, kept_rows), np.take(probability, kept_rows)
     actions, arrays = _action_table(st, kept_rows, cost, probability, read, read_mask, clauses)
-    return GroundTask(
+    return compact(GroundTask(
         facts=structure.facts, fact_index=structure.fact_index, actions=actions,
         init=init, goal=goal, goal_neg=goal_neg, goal_impossible=impossible, arrays=arrays,
-    )
+    ))
 
 
 def _action_table(st: GroundStructure, kept_rows: np.ndarray, cost: np.ndarray,

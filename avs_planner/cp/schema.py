@@ -17,6 +17,7 @@ from unified_planning.model import (
     Type,
 )
 
+from avs_planner.cp.conditional import CondEffect, compile_effect
 from avs_planner.cp.encoding import VectorExpr, compile_vector
 from avs_planner.cp.encoding import term as _term
 from avs_planner.errors import PlanningError
@@ -45,6 +46,7 @@ class LiftedSchema:
     probability: VectorExpr
     complex: tuple[FNode, ...] = ()
     never: bool = False
+    conditional: tuple[CondEffect, ...] = ()
 
 
 def atom_template(node: FNode) -> AtomTemplate:
@@ -79,18 +81,22 @@ def _split_preconditions(action: InstantaneousAction, static: set[str]) -> dict[
     return parts
 
 
-def _split_effects(action: InstantaneousAction) -> tuple[list, list]:
+def _split_effects(action: InstantaneousAction) -> tuple[list, list, list]:
     add: list[AtomTemplate] = []
     delete: list[AtomTemplate] = []
+    conditional: list[CondEffect] = []
     for eff in action.effects:
-        if eff.is_conditional() or eff.is_forall() or not eff.is_assignment():
+        if eff.is_conditional() or eff.is_forall():
+            conditional.append(compile_effect(action.name, eff))
+            continue
+        if not eff.is_assignment():
             raise PlanningError(f"action {action.name}: unsupported effect {eff}")
         if not eff.fluent.fluent().type.is_bool_type():
             raise PlanningError(f"action {action.name}: numeric effect {eff} is not supported")
         if not eff.value.is_bool_constant():
             raise PlanningError(f"action {action.name}: non-constant effect {eff}")
         (add if eff.value.bool_constant_value() else delete).append(atom_template(eff.fluent))
-    return add, delete
+    return add, delete, conditional
 
 
 def _cost_exprs(problem: Problem) -> tuple[dict[str, FNode], FNode | None]:
@@ -120,7 +126,7 @@ def compile_schemas(
         if not isinstance(action, InstantaneousAction):
             raise PlanningError(f"action {action.name}: only instantaneous actions are supported")
         parts = _split_preconditions(action, static)
-        add, delete = _split_effects(action)
+        add, delete, conditional = _split_effects(action)
         cost = compile_vector(costs.get(action.name), f"cost of {action.name}",
                               0.0 if has_metric else 1.0)
         prob = compile_vector(pproblem.success.get(action.name),
@@ -135,7 +141,7 @@ def compile_schemas(
                 equal=tuple(parts["eq"]), not_equal=tuple(parts["ne"]),
                 add=tuple(add), delete=tuple(delete),
                 cost=cost, probability=prob, never=bool(parts["never"]),
-                complex=tuple(parts["complex"]),
+                complex=tuple(parts["complex"]), conditional=tuple(conditional),
             )
         )
     return tuple(schemas)

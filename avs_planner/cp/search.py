@@ -56,6 +56,10 @@ class SearchOptions:
     two on a machine with two or more CPUs when the task is large enough for it to pay
     (at least 1,000 (class, precondition) entries in the relaxed task, as the 8- to 20-place
     AVS problems); one otherwise. The Python engine always uses one."""
+    anytime: bool = False
+    """LAMA-style anytime satisficing (`anytime.py`): greedy best-first with FF and helpful
+    actions on unit costs, then weighted A* restarts (w = 5, 3, 2, 1) on the objective; the
+    best plan by objective when `timeout_s` runs out (or when the last restart ends)."""
     patience: float | None = None
     """Once a plan is found, expansions allowed without finding a better one before the best
     is returned. None: DEFAULT_PATIENCE with an inadmissible heuristic, unlimited

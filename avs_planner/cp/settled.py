@@ -159,7 +159,10 @@ def _limited_adds(problem: Problem, schemas: Sequence[LiftedSchema],
         if schema.never:
             continue
         types = dict(zip(schema.params, schema.param_types, strict=True))
-        for template in schema.add:
+        for effect in schema.conditional:
+            types.update(effect.variables)
+        templates = [*schema.add, *(e.atom for e in schema.conditional if e.adds)]
+        for template in templates:
             if template[0] in adds:
                 adds[template[0]].append(
                     tuple(types[t] if t[0] == "?" else t for t in template[1:]))

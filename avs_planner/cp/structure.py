@@ -21,6 +21,7 @@ from avs_planner.cp.bindings import (
     encode_numpy,
     join_numpy,
 )
+from avs_planner.cp.conditional import Variant, expand_rows, variants
 from avs_planner.cp.encoding import AtomSpace, Columns
 from avs_planner.cp.formulas import FormulaGrounder
 from avs_planner.cp.schema import LiftedSchema
@@ -256,6 +257,34 @@ def _ground_cnf(
     return True, pos, neg, tuple(longer)
 
 
+def expand_conditional(
+    schema: LiftedSchema, space: AtomSpace, columns: Columns, rows: int, keep: np.ndarray,
+    arrays: tuple[np.ndarray, ...], clauses: list[tuple] | None,
+    statics: tuple[frozenset[Atom], frozenset[str]],
+) -> tuple[Columns, int, np.ndarray, tuple[np.ndarray, ...], list[tuple]]:
+    """The schema's rows with its conditional effects compiled in (`conditional.py`): a row
+    per copy, copies of one ground action next to each other."""
+    static, static_names = statics
+
+    def per_binding(binding: dict[str, str]) -> list[Variant]:
+        return variants(schema.conditional, binding, space.encode, static, static_names,
+                        space.names_of)
+
+    index, found = expand_rows(schema.params, columns, rows, space.names, per_binding)
+    pre, neg, add, delete = (a[index] for a in arrays)
+    extra = [[v.pre for v in found], [v.neg for v in found], [v.add for v in found],
+             [v.delete for v in found]]
+    pads = (_PAD_TRUE, _PAD_NONE, _PAD_NONE, _PAD_NONE)
+    pre, neg, add, delete = (np.concatenate([a, _pad(e, pad)], axis=1)
+                             for a, e, pad in zip((pre, neg, add, delete), extra, pads,
+                                                  strict=True))
+    old = clauses if clauses is not None else [()] * rows
+    merged = [tuple(old[r]) + tuple(v.clauses) for r, v in zip(index.tolist(), found,
+                                                             strict=True)]
+    expanded = {p: c[index] for p, c in columns.items()}
+    return expanded, len(index), keep[index], (pre, neg, add, delete), merged
+
+
 def build_structure(
     problem: Problem, schemas: Sequence[LiftedSchema], static: frozenset[Atom],
     assumptive: Mapping[str, bool], static_names: frozenset[str] | None = None,
@@ -305,10 +334,14 @@ def build_structure(
             neg = np.concatenate([neg, more_neg], axis=1)
         else:
             keep = np.ones(rows, dtype=bool)
-        if pre.shape[1] and neg.shape[1]:  # a condition and its negation: never applicable
-            keep &= ~(pre[:, :, None] == neg[:, None, :]).any(axis=(1, 2))
         add = code(schema.add)
         delete = code(schema.delete)
+        if schema.conditional:
+            columns, rows, keep, (pre, neg, add, delete), clauses = expand_conditional(
+                schema, space, columns, rows, keep, (pre, neg, add, delete), clauses,
+                (static, static_names))
+        if pre.shape[1] and neg.shape[1]:  # a condition and its negation: never applicable
+            keep &= ~(pre[:, :, None] == neg[:, None, :]).any(axis=(1, 2))
         if add.shape[1] and delete.shape[1]:  # add wins over delete (PDDL: deletes first)
             delete[(delete[:, :, None] == add[:, None, :]).any(axis=2)] = _PAD_NONE
         if not keep.all():

@@ -39,18 +39,43 @@ class PddlSource:
 
 
 Source = PddlSource | str | Path
+NAME_CLASH = "name-clash"
+# Warnings about what the reader accepts or repairs (what `avs plan` passes on to the user)
+LENIENT = {"missing-requirement", NAME_CLASH, "duplicate-type", "either-type"}
+
+
+@dataclass(frozen=True)
+class Checked:
+    """`check`'s findings plus the domain read (None when it could not be read)."""
+
+    diagnostics: list[Diagnostic]
+    domain: Domain | None = None
+
+    @property
+    def first_error(self) -> Diagnostic | None:
+        return next((d for d in self.diagnostics if d.is_error), None)
+
+    @property
+    def lenient(self) -> tuple[Diagnostic, ...]:
+        """The warnings about what the reader accepted or repaired."""
+        return tuple(d for d in self.diagnostics if d.code in LENIENT)
 
 
 def check(domain: Source, problems: Sequence[Source] = ()) -> list[Diagnostic]:
     """All findings for a domain and its problems; str/Path arguments are file paths."""
+    return check_read(domain, problems).diagnostics
+
+
+def check_read(domain: Source, problems: Sequence[Source] = ()) -> Checked:
+    """`check`, keeping the domain it read (for the reader's repairs)."""
     try:
         domain_source = _source(domain)
     except PddlError as exc:
-        return [Diagnostic.from_error(exc, "unreadable")]
+        return Checked([Diagnostic.from_error(exc, "unreadable")])
     report = Report(domain_source.name)
     parsed = _read_domain(domain_source, report)
     if parsed is None:
-        return report.items
+        return Checked(report.items)
     usage = Usage()
     _check_domain(parsed, report, usage)
     diagnostics = report.items
@@ -61,15 +86,7 @@ def check(domain: Source, problems: Sequence[Source] = ()) -> list[Diagnostic]:
             diagnostics.append(Diagnostic.from_error(exc, "unreadable"))
     diagnostics += check_requirements(parsed, usage)
     diagnostics += _unused_predicates(parsed, usage, report.file)
-    return _sorted(diagnostics)
-
-
-def first_error(
-    domain_text: str, problem_text: str, domain_name: str, problem_name: str
-) -> Diagnostic | None:
-    """The first error `check` finds in this domain/problem pair, or None."""
-    found = check(PddlSource(domain_name, domain_text), [PddlSource(problem_name, problem_text)])
-    return next((d for d in found if d.is_error), None)
+    return Checked(_sorted(diagnostics), parsed)
 
 
 def _sorted(diagnostics: list[Diagnostic]) -> list[Diagnostic]:
@@ -129,7 +146,8 @@ def _parameters(params: list, checker: FormulaChecker, report: Report) -> dict[s
 
 
 def _check_names(domain: Domain, report: Report) -> None:
-    """unified-planning keeps one namespace for types, fluents, actions and objects."""
+    """unified-planning keeps one namespace for types, fluents, actions and objects by
+    default; the reader lifts that rule (UP's `error_used_name`) when names are shared."""
     seen: dict[str, str] = {name: "type" for name in domain.type_atoms}
     groups = [
         ("predicate", domain.predicates),
@@ -142,8 +160,10 @@ def _check_names(domain: Domain, report: Report) -> None:
             if name in seen:
                 report.add(
                     entry.atom,
-                    "name-clash",
-                    f"{kind} '{name}' has the same name as a {seen[name]}; rename one of them",
+                    NAME_CLASH,
+                    f"{kind} '{name}' has the same name as a {seen[name]} (read with "
+                    f"unified-planning's error_used_name lifted; renaming one is clearer)",
+                    warning=True,
                 )
             else:
                 seen[name] = kind

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Iterable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from enum import StrEnum
 
 from avs_planner.errors import PddlError
@@ -39,6 +39,10 @@ class Diagnostic:
         data = asdict(self)
         data["severity"] = self.severity.value
         return data
+
+    def as_error(self) -> Diagnostic:
+        """The same finding with severity error (`avs domain check --strict`)."""
+        return replace(self, severity=Severity.ERROR)
 
     def to_error(self) -> PddlError:
         return PddlError(self.message, self.file, self.line, self.column)

@@ -15,6 +15,8 @@ from fractions import Fraction
 
 from unified_planning.model import FNode, Problem
 
+from avs_planner.pddl.diagnostics import Diagnostic
+
 ASSUMPTIVE_PREFIX = "assume-"
 
 
@@ -26,6 +28,8 @@ class ProbabilisticProblem:
     success: Mapping[str, FNode] = field(default_factory=dict)
     domain_file: str = "<domain>"
     problem_file: str = "<problem>"
+    # What the reader accepted or repaired (undeclared requirements, shared names, ...)
+    warnings: tuple[Diagnostic, ...] = ()
 
     def is_assumptive(self, action_name: str) -> bool:
         """Assumptive actions only set beliefs; the executor does not run them, it watches them."""

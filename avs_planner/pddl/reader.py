@@ -8,15 +8,19 @@ unified-planning's PDDLReader on the translated text; whatever UP still rejects 
 from __future__ import annotations
 
 import re
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from fractions import Fraction
 from pathlib import Path
 
 import pyparsing
 from unified_planning.io import PDDLReader
 from unified_planning.model import Action, FNode, Problem
+from unified_planning.shortcuts import get_environment
 
 from avs_planner.errors import PddlError
-from avs_planner.pddl.check import first_error
+from avs_planner.pddl.check import NAME_CLASH, PddlSource, check_read
 from avs_planner.pddl.model import ProbabilisticProblem
 from avs_planner.pddl.probabilistic import translate_domain
 from avs_planner.pddl.sexpr import Atom, Node, SList, is_number, parse_sexprs
@@ -41,17 +45,51 @@ def read_text(
     problem_name: str = "<problem>",
 ) -> ProbabilisticProblem:
     """Read domain and problem text (e.g. from the HTTP service) into a ProbabilisticProblem."""
-    error = first_error(domain_text, problem_text, domain_name, problem_name)
+    checked = check_read(
+        PddlSource(domain_name, domain_text), [PddlSource(problem_name, problem_text)]
+    )
+    error = checked.first_error
     if error is not None:
         raise error.to_error()
     domain_nodes = parse_sexprs(domain_text, domain_name)
     translation = translate_domain(domain_text, domain_nodes, domain_name)
-    problem = _up_parse(translation.text, problem_text, domain_name, problem_name)
+    repairs = checked.domain.repairs if checked.domain is not None else []
+    text = apply_repairs(translation.text, repairs)
+    shared = any(d.code == NAME_CLASH for d in checked.lenient)
+    with _names_shared(shared):
+        problem = _up_parse(text, problem_text, domain_name, problem_name)
     success = {
         name: _success_expression(problem, name, nodes, domain_name)
         for name, nodes in translation.probabilities.items()
     }
-    return ProbabilisticProblem(problem, success, domain_name, problem_name)
+    return ProbabilisticProblem(problem, success, domain_name, problem_name, checked.lenient)
+
+
+def apply_repairs(text: str, repairs: list[tuple[int, int, str]]) -> str:
+    """Replace each `text[start:end]` by its replacement padded with spaces: offsets, and so
+    UP's own line:column reports, stay right."""
+    chars = list(text)
+    for start, end, replacement in repairs:
+        padded = replacement.ljust(end - start)
+        chars[start:end] = [c if old != "\n" else old for c, old in zip(padded, text[start:end],
+                                                                      strict=True)]
+    return "".join(chars)
+
+
+@contextmanager
+def _names_shared(shared: bool) -> Iterator[None]:
+    """Let a type, predicate and action share a name (IPC floortile's `up`, freecell's
+    `suit`) by lifting UP's `error_used_name` while reading. UP's reader builds the metric
+    in the global environment, so the flag is lifted there, and restored after."""
+    environment = get_environment()
+    before = environment.error_used_name
+    environment.error_used_name = before and not shared
+    try:
+        with warnings.catch_warnings():  # our own name-clash warning says it, with a position
+            warnings.filterwarnings("ignore", "Name .* already defined", UserWarning)
+            yield
+    finally:
+        environment.error_used_name = before
 
 
 def _read(path: str | Path) -> str:

@@ -7,6 +7,7 @@ so one run of `avs domain check` reports as much as it can.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from avs_planner.pddl.diagnostics import Diagnostic, Severity
@@ -99,6 +100,17 @@ class Domain:
     functions: dict[str, Signature] = field(default_factory=dict)
     actions: dict[str, Action] = field(default_factory=dict)
     uses_typing: Node | None = None
+    # Text edits (start, end, replacement) that make the domain readable by unified-planning
+    repairs: list[tuple[int, int, str]] = field(default_factory=list)
+
+    def common_supertype(self, names: list[str]) -> str:
+        """The most specific type every one of `names` descends from."""
+        current: str | None = names[0]
+        while current is not None:
+            if all(self.is_subtype(name, current) for name in names):
+                return current
+            current = self.types.get(current, OBJECT if current != OBJECT else None)
+        return OBJECT
 
     def is_subtype(self, sub: str, sup: str) -> bool:
         """True when `sub` equals `sup` or descends from it (everything is an `object`)."""
@@ -144,17 +156,25 @@ def find_define(nodes: list[Node], kind: str, report: Report) -> SList | None:
     return None
 
 
+Either = Callable[[SList], str]
+
+
 def typed_list(
-    items: list[Node], report: Report, default: str = OBJECT, variables: bool = True
+    items: list[Node],
+    report: Report,
+    default: str = OBJECT,
+    variables: bool = True,
+    either: Either | None = None,
 ) -> list[Typed]:
-    """Parse `a b - t c` into Typed entries; `(either ...)` and stray lists are reported."""
+    """Parse `a b - t c` into Typed entries; stray lists are reported, and so is
+    `(either ...)` unless `either` turns it into one type."""
     result: list[Typed] = []
     pending: list[Atom] = []
     i = 0
     while i < len(items):
         item = items[i]
         if isinstance(item, Atom) and item.text == "-":
-            type_name = _type_after_dash(items, i, report)
+            type_name = _type_after_dash(items, i, report, either)
             type_atom = items[i + 1] if i + 1 < len(items) else None
             type_atom = type_atom if isinstance(type_atom, Atom) else None
             result += [Typed(a, type_name, type_atom) for a in pending]
@@ -170,12 +190,14 @@ def typed_list(
     return result + [Typed(a, default) for a in pending]
 
 
-def _type_after_dash(items: list[Node], i: int, report: Report) -> str:
+def _type_after_dash(items: list[Node], i: int, report: Report, either: Either | None) -> str:
     if i + 1 >= len(items):
         report.add(items[i], "syntax", "'-' must be followed by a type name")
         return OBJECT
     node = items[i + 1]
     if isinstance(node, SList):
+        if node.head() == "either" and either is not None:
+            return either(node)
         if node.head() == "either":
             report.add(
                 node,
@@ -249,17 +271,58 @@ def _requirements(domain: Domain, section: SList, report: Report) -> None:
 
 def _types(domain: Domain, section: SList, report: Report) -> None:
     domain.uses_typing = domain.uses_typing or section
-    for entry in typed_list(section.items[1:], report, variables=False):
-        if entry.name in domain.type_atoms or entry.name == OBJECT:
-            if entry.name != OBJECT:
-                report.add(entry.atom, "duplicate", f"type '{entry.name}' is declared twice")
+    entries = typed_list(section.items[1:], report, variables=False)
+    again: list[Typed] = []
+    for entry in entries:
+        if entry.name == OBJECT:
+            continue
+        if entry.name in domain.type_atoms:
+            again.append(entry)
             continue
         domain.types[entry.name] = entry.type
         domain.type_atoms[entry.name] = entry.atom
     for _name, parent in list(domain.types.items()):
         if parent is not None and parent not in domain.types:
             domain.types[parent] = OBJECT  # an undeclared parent is implicitly a type
+    kept = {id(e.atom): e for e in entries}
+    for entry in again:
+        _declared_again(domain, entry, kept, report)
+    _blank_emptied_groups(domain, section, entries, kept)
     _check_cycles(domain, report)
+
+
+def _declared_again(domain: Domain, entry: Typed, kept: dict[int, Typed], report: Report) -> None:
+    """A type declared twice (IPC storage: `area - object` and `area - surface`), read as
+    Fast Downward does when one parent descends from the other: under the more specific."""
+    first = domain.type_atoms[entry.name]
+    old = domain.types[entry.name] or OBJECT
+    if domain.is_subtype(old, entry.type) or domain.is_subtype(entry.type, old):
+        keep_new = old != entry.type and domain.is_subtype(entry.type, old)
+        dropped = first if keep_new else entry.atom
+        if keep_new:
+            domain.types[entry.name] = entry.type
+            domain.type_atoms[entry.name] = entry.atom
+        kept.pop(id(dropped), None)
+        domain.repairs.append((dropped.offset, dropped.end, ""))
+        report.add(dropped, "duplicate-type",
+                   f"type '{entry.name}' is declared twice; read as '{entry.name} - "
+                   f"{domain.types[entry.name]}'", warning=True)
+        return
+    report.add(entry.atom, "duplicate", f"type '{entry.name}' is declared twice, under "
+               f"'{old}' and '{entry.type}'")
+
+
+def _blank_emptied_groups(
+    domain: Domain, section: SList, entries: list[Typed], kept: dict[int, Typed]
+) -> None:
+    """Blank `- parent` where every name before it was dropped (UP wants a name there)."""
+    items = section.items
+    for i, item in enumerate(items[:-1]):
+        if not (isinstance(item, Atom) and item.text == "-"):
+            continue
+        group = [e for e in entries if e.type_atom is items[i + 1]]
+        if group and not any(id(e.atom) in kept for e in group):
+            domain.repairs.append((item.offset, items[i + 1].end, ""))
 
 
 def _check_cycles(domain: Domain, report: Report) -> None:
@@ -285,7 +348,9 @@ def _typed_into(table: dict[str, Typed], section: SList, report: Report, what: s
             table[entry.name] = entry
 
 
-def _signatures(section: SList, report: Report, functions: bool) -> list[Signature]:
+def _signatures(
+    section: SList, report: Report, functions: bool, either: Either | None = None
+) -> list[Signature]:
     """Predicate or function signatures; function lists may carry `- number` result types."""
     result = []
     items = section.items[1:]
@@ -294,7 +359,8 @@ def _signatures(section: SList, report: Report, functions: bool) -> list[Signatu
         item = items[i]
         if isinstance(item, SList) and item.items and isinstance(item.items[0], Atom):
             check_name(item.items[0], report)
-            result.append(Signature(item.items[0], typed_list(item.items[1:], report)))
+            params = typed_list(item.items[1:], report, either=either)
+            result.append(Signature(item.items[0], params))
         elif functions and isinstance(item, Atom) and item.text == "-":
             after = items[i + 1] if i + 1 < len(items) else item
             if not isinstance(after, Atom) or after.text not in (NUMBER, "int", "float"):
@@ -308,11 +374,30 @@ def _signatures(section: SList, report: Report, functions: bool) -> list[Signatu
 
 
 def _predicates(domain: Domain, section: SList, report: Report) -> None:
-    _signatures_into(domain.predicates, _signatures(section, report, False), report, "predicate")
+    sigs = _signatures(section, report, False, _either(domain, report))
+    _signatures_into(domain.predicates, sigs, report, "predicate")
 
 
 def _functions(domain: Domain, section: SList, report: Report) -> None:
-    _signatures_into(domain.functions, _signatures(section, report, True), report, "function")
+    sigs = _signatures(section, report, True, _either(domain, report))
+    _signatures_into(domain.functions, sigs, report, "function")
+
+
+def _either(domain: Domain, report: Report) -> Either:
+    """`(either a b)` in a predicate or function argument, read as the types' most specific
+    common supertype (the argument's type only checks what may fill it)."""
+
+    def read(node: SList) -> str:
+        names = [a.text for a in node.items[1:] if isinstance(a, Atom)]
+        common = domain.common_supertype(names) if names else OBJECT
+        if len(common) > node.end - node.offset:  # the repair keeps every offset
+            common = OBJECT
+        domain.repairs.append((node.offset, node.end, common))
+        report.add(node, "either-type", f"(either {' '.join(names)}) read as its common "
+                   f"supertype '{common}'", warning=True)
+        return common
+
+    return read
 
 
 def _signatures_into(

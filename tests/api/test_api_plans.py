@@ -52,6 +52,20 @@ def test_plan_solved(client: TestClient) -> None:
     assert body["cost"] == 3 and body["probability"] == 0.5 and body["objective"] == 8
 
 
+def test_undeclared_requirement_is_a_warning_not_a_422(client: TestClient) -> None:
+    domain = DOMAIN.replace(":strips :typing", ":strips")
+    response = client.post("/v1/plans", json={"domain": domain, "problem": PROBLEM})
+    assert response.status_code == 200, response.text
+    body = response.json()
+    assert body["status"] == "solved" and body["plan"] == ["(go hall kitchen)",
+                                                            "(switch-on kitchen)"]
+    (warning,) = body["warnings"]
+    assert warning["severity"] == "warning" and warning["code"] == "missing-requirement"
+    assert (warning["line"], warning["column"]) == (3, 3) and ":typing" in warning["message"]
+    assert client.post("/v1/plans", json={"domain": DOMAIN, "problem": PROBLEM}
+                       ).json()["warnings"] == []
+
+
 def test_plan_unsolvable_is_a_200_answer(client: TestClient) -> None:
     problem = PROBLEM.replace("(:goal (lit kitchen))", "(:goal (lit cellar))")
     body = client.post("/v1/plans", json={"domain": DOMAIN, "problem": problem}).json()

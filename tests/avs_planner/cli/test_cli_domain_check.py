@@ -44,7 +44,8 @@ def test_broken_input_exits_1_and_points_at_the_mistake(
     case: dict, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     domain, problem, expected = _broken_files(case, tmp_path)
-    assert main(["domain", "check", str(domain), str(problem)]) == 1
+    strict = ["--strict"] if case.get("severity") == "warning" else []
+    assert main(["domain", "check", str(domain), str(problem), *strict]) == 1
     out = capsys.readouterr()
     assert any(line.startswith(expected) for line in out.out.splitlines()), out.out
     assert "Traceback" not in out.err
@@ -86,3 +87,26 @@ def test_missing_file_is_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture
     args = ["domain", "check", str(DATA / "base-domain.pddl"), str(missing)]
     assert main(args) == 1
     assert f"{missing}:1:1: error: cannot read file" in capsys.readouterr().out
+
+
+def test_missing_requirement_is_a_warning_unless_strict(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    case = next(c for c in CASES if c["name"] == "missing-requirement")
+    domain, problem, expected = _broken_files(case, tmp_path)
+    assert main(["domain", "check", str(domain), str(problem)]) == 0
+    warning = expected.replace(": error: ", ": warning: ")
+    assert any(line.startswith(warning) for line in capsys.readouterr().out.splitlines())
+    assert main(["domain", "check", str(domain), str(problem), "--strict"]) == 1
+    assert any(line.startswith(expected) for line in capsys.readouterr().out.splitlines())
+
+
+def test_plan_reads_on_and_prints_the_warning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    case = next(c for c in CASES if c["name"] == "missing-requirement")
+    domain, problem, expected = _broken_files(case, tmp_path)
+    assert main(["plan", str(domain), str(problem)]) == 0
+    out = capsys.readouterr()
+    assert out.err.startswith(expected.replace(": error: ", ": warning: ")), out.err
+    assert "; cost:" in out.out

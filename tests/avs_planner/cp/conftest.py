@@ -30,8 +30,6 @@ def avs_and_ipc_makers() -> list[tuple[str, object]]:
     """(name, problem maker) of every AVS example problem and of each IPC domain's
     instance-1 (the domains it reads and solves today), for tests that compare two ways of
     grounding or planning on them."""
-    from unified_planning.io import PDDLReader
-
     from avs_planner.pddl import read_files
 
     cases: list[tuple[str, object]] = [
@@ -42,8 +40,7 @@ def avs_and_ipc_makers() -> list[tuple[str, object]]:
         domain = IPC / name / "domain.pddl"
         instance = domain.parent / "instance-1.pddl"
         if instance.exists():
-            cases.append((domain.parent.name, lambda d=domain, i=instance: ProbabilisticProblem(
-                PDDLReader().parse_problem(str(d), str(i)))))
+            cases.append((domain.parent.name, lambda d=domain, i=instance: read_files(d, i)))
     return cases
 
 

@@ -180,7 +180,8 @@ def test_a_few_rows_are_built_as_the_numpy_path_builds_them(monkeypatch):
 
     for name, make in avs_and_ipc_makers():
         task = ground(make(), cache=GroundingCache())
-        st, rows = task.actions._st, task.actions._rows.tolist()
+        table = getattr(task.actions, "table", task.actions)  # under a compacted fact table
+        st, rows = table._st, table._rows.tolist()
         sample = random.Random(name).sample(rows, min(40, len(rows)))
         built = []
         for few in (structure._FEW_ROWS, -1):

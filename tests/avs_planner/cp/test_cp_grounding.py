@@ -7,6 +7,7 @@ from unified_planning.shortcuts import (
     BoolType,
     Fluent,
     InstantaneousAction,
+    Or,
     Problem,
     UserType,
 )
@@ -57,10 +58,13 @@ def test_unsupported_effects_are_named():
     thing = UserType("thing")
     flag = Fluent("flag", BoolType(), x=thing)
     action = InstantaneousAction("toggle", x=thing)
-    action.add_effect(flag(action.parameter("x")), True, condition=flag(action.parameter("x")))
+    other = Fluent("other", BoolType(), x=thing)
+    x = action.parameter("x")
+    action.add_effect(flag(x), True, condition=Or(flag(x), other(x)))
     problem = Problem("p")
     problem.add_fluent(flag, default_initial_value=False)
+    problem.add_fluent(other, default_initial_value=False)
     problem.add_action(action)
     problem.add_goal(flag(problem.add_object("a", thing)))
-    with pytest.raises(PlanningError, match="toggle: unsupported effect"):
+    with pytest.raises(PlanningError, match="toggle: conditional effect .* only conjunctions"):
         ground(ProbabilisticProblem(problem), cache=GroundingCache())

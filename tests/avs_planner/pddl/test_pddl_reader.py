@@ -146,3 +146,36 @@ def test_up_errors_are_attributed_to_the_right_file(
     with pytest.raises(PddlError) as exc:
         _up_parse(domain, problem, "d.pddl", "p.pddl")
     assert (exc.value.file, exc.value.line, exc.value.column) == expected
+
+
+def _codes_at(task) -> set[tuple[str, int, int]]:
+    return {(w.code, w.line, w.column) for w in task.warnings}
+
+
+@pytest.mark.skipif(not IPC.exists(), reason="IPC benchmark set not available")
+def test_storage_repairs_are_read_as_fd_reads_them_and_said() -> None:
+    """`area` is declared under `object` and again under `surface`; `in` takes
+    `(either storearea crate)`: read as `area - surface` and `surface`."""
+    task = read_files(IPC / "storage" / "domain.pddl", IPC / "storage" / "instance-1.pddl")
+    area = task.problem.user_type("area")
+    assert area.father is not None and area.father.name == "surface"
+    (param, _place) = task.problem.fluent("in").signature
+    assert param.type.name == "surface"
+    assert {("duplicate-type", 6, 29), ("either-type", 12, 16)} <= _codes_at(task)
+
+
+@pytest.mark.skipif(not IPC.exists(), reason="IPC benchmark set not available")
+def test_shared_names_read_with_the_flag_lifted_only_while_reading() -> None:
+    from unified_planning.shortcuts import get_environment
+
+    task = read_files(IPC / "floortile" / "domain.pddl", IPC / "floortile" / "instance-1.pddl")
+    assert task.problem.has_fluent("up") and task.problem.action("up").name == "up"
+    assert any(w.code == "name-clash" for w in task.warnings)
+    assert any(w.code == "missing-requirement" and ":action-costs" in w.message
+               for w in task.warnings)
+    assert get_environment().error_used_name is True
+
+
+def test_avs_problems_read_without_warnings() -> None:
+    for problem in sorted((AVS / "problems").glob("*.pddl")):
+        assert read_files(AVS / "domain.pddl", problem).warnings == ()

@@ -1,0 +1,111 @@
+"""Anytime satisficing search (`SearchOptions.anytime`, `avs plan --anytime`).
+
+LAMA's schedule on our objective: first a greedy best-first search with the FF heuristic,
+helpful actions first (alternating with a round without them) and deferred evaluation, on
+unit action costs (LAMA's first
+iteration: plan length guides it, so it finds a plan fast); then weighted A* restarted with
+decreasing weights (5, 3, 2, 1) on the real objective c + R(1 - p). Every plan is judged by
+that objective and the best so far is kept; at the deadline (`timeout_s`) it is returned,
+with `stopped_by = "timeout"` when a later iteration was still running. Probabilistic tasks
+keep their objective: the greedy phase keeps the R(1 - p) term in f, and the restarts use
+it unchanged. The optimal mode (weight 1 with h^max, no `anytime`) is untouched.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from avs_planner.cp.search import PlanResult, PlanStatus, SearchOptions, search
+from avs_planner.cp.symmetry import NO_SYMMETRIES, Symmetries
+from avs_planner.cp.task import GroundTask
+
+GREEDY_WEIGHT = 1e6  # f = c + w h: with h in plan steps, g only breaks ties (greedy)
+WEIGHTS = (5.0, 3.0, 2.0, 1.0)  # LAMA's restarts after its greedy iteration
+FIRST_BUDGET = 2000  # expansions of the first greedy round
+BUDGET_GROWTH = 4
+
+
+def unit_cost(task: GroundTask) -> GroundTask:
+    """The same task with every action costing 1 (its plans' steps keep their real cost)."""
+    if task.arrays is None:
+        return task  # hand-built tuples of actions: searched as they are
+    actions = copy.copy(task.actions)
+    if hasattr(actions, "memo"):
+        actions.memo = {}  # the packed native task is per cost vector
+    arrays = replace(task.arrays, cost=np.ones(len(task.arrays.cost)))
+    return replace(task, actions=actions, arrays=arrays)
+
+
+def anytime_search(
+    task: GroundTask, options: SearchOptions, symmetries: Symmetries = NO_SYMMETRIES
+) -> PlanResult:
+    """Greedy first, then restarting weighted A*; the best plan by objective at the end."""
+    start = time.perf_counter()
+    deadline = None if options.timeout_s is None else start + options.timeout_s
+    best, expanded = greedy_search(task, options, symmetries, deadline)
+    history = [_entry("greedy", best, start)] if best.solved else []
+    if not best.solved and best.status not in (PlanStatus.TIMEOUT, PlanStatus.NODE_LIMIT):
+        return _done(best, options, start, expanded, history, None)
+    stopped = None if best.solved else "timeout"
+    for weight in WEIGHTS:
+        left = None if deadline is None else deadline - time.perf_counter()
+        if left is not None and left <= 0:
+            stopped = "timeout"
+            break
+        result = search(task, replace(options, anytime=False, weight=weight, timeout_s=left),
+                        symmetries)
+        expanded += result.expanded
+        if result.solved and result.objective < best.objective - 1e-9:
+            best = result
+            history.append(_entry(weight, result, start))
+        if result.status is PlanStatus.TIMEOUT or result.stopped_by == "timeout":
+            stopped = "timeout"
+            break
+    if not best.solved:
+        return _done(best, options, start, expanded, history, None)
+    return _done(best, options, start, expanded, history, stopped)
+
+
+def greedy_search(task: GroundTask, options: SearchOptions, symmetries: Symmetries,
+                  deadline: float | None) -> tuple[PlanResult, int]:
+    """Greedy best-first on unit costs, with and without the helpful-actions queue in turn,
+    each under an expansion budget that grows fourfold per round until one finds a plan or proves
+    there is none: helpful actions make barman easy and mislead on tetris, and the rounds
+    cost at most a small factor over the better of the two."""
+    unit = unit_cost(task)
+    greedy = replace(options, anytime=False, weight=GREEDY_WEIGHT, lazy=True, patience=0)
+    budget, expanded = FIRST_BUDGET, 0
+    result = PlanResult(PlanStatus.TIMEOUT)
+    while True:
+        for preferred in (True, False):
+            left = None if deadline is None else deadline - time.perf_counter()
+            if left is not None and left <= 0:
+                return result, expanded
+            limit = budget if options.node_limit is None else min(budget, options.node_limit)
+            result = search(unit, replace(greedy, preferred=preferred, node_limit=limit,
+                                          timeout_s=left), symmetries)
+            expanded += result.expanded
+            if result.status is not PlanStatus.NODE_LIMIT:
+                return result, expanded
+            if options.node_limit is not None and limit >= options.node_limit:
+                return result, expanded
+        budget *= BUDGET_GROWTH
+
+
+def _entry(weight: float | str, result: PlanResult, start: float) -> dict:
+    return {"weight": weight, "objective": result.objective, "cost": result.cost,
+            "time_s": time.perf_counter() - start}
+
+
+def _done(best: PlanResult, options: SearchOptions, start: float, expanded: int,
+          history: list[dict], stopped: str | None) -> PlanResult:
+    extra = {**best.extra, "anytime": history}
+    return replace(best, planning_time_s=time.perf_counter() - start, expanded=expanded,
+                   weight=options.weight, extra=extra,
+                   stopped_by=stopped if best.solved else None,
+                   objective=best.objective if best.solved else math.inf)
