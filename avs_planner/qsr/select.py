@@ -98,7 +98,8 @@ def select_view(
     """Algorithm 1: the best of n sampled poses for `method`, and its ranked frustums.
 
     `points` are the supporting-plane voxel centres (m, 3); `density` is P_QSR over them
-    (required for `qsr`, ignored by the other methods, which use a uniform density).
+    (required for `qsr`); the other methods use a uniform density, or `density` when one is
+    given (a search's belief: uniform, less where it has already looked).
     """
     method = ViewMethod(method)
     options = options or ViewOptions()
@@ -110,7 +111,7 @@ def select_view(
 
 
 def _density(method: ViewMethod, points: np.ndarray, density: np.ndarray | None) -> np.ndarray:
-    if method is not ViewMethod.QSR:
+    if method is not ViewMethod.QSR and density is None:
         return np.full(points.shape[0], 1.0 / max(1, points.shape[0]))
     if density is None:
         raise ViewSelectionError("the qsr method needs a density over the plane voxels")
