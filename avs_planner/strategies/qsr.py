@@ -228,7 +228,7 @@ class QsrSearch:
                                rng=self.rng, options=ViewOptions(
                                    n_poses=self.opt["n_poses"],
                                    pan_sweep=math.radians(self.opt["pan_sweep_deg"]),
-                                   start=pose[:2]))  # fmt: skip
+                                   start=pose[:2], occlusion=ctx.mind.voxels))  # fmt: skip
             if not view.selected:
                 return self._end(Outcome.GAVE_UP, f"view selection: {view.status.value}")
             best = view.best
