@@ -51,7 +51,7 @@ from conceptual_map.qsr import (
     load_qsr,
 )
 
-OPEN_SIDE_RADIUS = 1.5  # m around a landmark in which standable cells set its facing
+OPEN_SIDE_RADIUS = 1.2  # m around a landmark in which standable cells set its facing
 MAX_DRIVE_FAILURES = 5  # selected poses the robot could not reach before giving up
 
 
@@ -149,8 +149,10 @@ def open_side(grid: OccupancyGrid, xy: np.ndarray, robot_radius: float,
 
 def landmarks_from(tracker: LandmarkTracker, grid: OccupancyGrid, robot_radius: float
                    ) -> list[Landmark]:  # fmt: skip
-    """The confirmed landmarks with their facing (the open side; failing that, towards where
-    the robot saw them from)."""
+    """The confirmed landmarks with their facing: the open side (failing that, towards where
+    the robot saw them from). (Snapping it to the long axis of the supporting-plane segment
+    under the landmark was tried and made it worse: the segments seen from a few stops are
+    fragments of the desk tops.)"""
     out = []
     for i, c in enumerate(tracker.confirmed()):
         xy = c.position[:2]
