@@ -1,0 +1,110 @@
+"""Seed 002's simulated experiments (Kunze et al., Tables II and III) on our desk scene.
+
+Variant A (`sim/worlds/qsr_desks_a.yaml`): three cups where the default QSR knowledge says cups
+are; B: two of them removed; C: the remaining one moved to a non-QSR location. Table II runs the
+three methods (`random`, `supporting-planes`, `qsr`) on A; Table III runs `qsr` on A, B and C.
+Every cell is `--trials` searches for a cup (seeds 0..N-1) through
+`avs_planner.episode.run_episode`, learning switched off so that trials are independent.
+
+As in the seed, time and poses are means over the successful trials only; "found" counts
+searches that ended with a confirmed cup that is a cup in the world. Time is the search
+monitor's time (simulated seconds after the survey, which stands in for the seed's given maps
+and landmark poses); the survey's own time is printed beside it.
+Run: `python -m bench.qsr_experiment [--trials 10]`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+from typing import Any
+
+from avs_planner.episode import run_episode
+
+TABLE_II = {"random": (6, 68.5, 4.8), "supporting-planes": (10, 33.6, 2.3),
+            "qsr": (10, 15.6, 1.1)}  # fmt: skip
+TABLE_III = {"A": (10, 15.6, 1.1), "B": (8, 55.0, 3.1), "C": (6, 65.0, 3.2)}
+SEED_TRIALS = 10
+
+
+def run_cell(method: str, variant: str, trials: int, options: dict[str, Any]
+             ) -> list[dict[str, Any]]:  # fmt: skip
+    out = []
+    for seed in range(trials):
+        summary = run_episode({
+            "target": "cup", "world": f"qsr_desks_{variant.lower()}", "strategy": method,
+            "seed": seed, "strategy_options": {"learn": False, **options},
+        })  # fmt: skip
+        d = summary["details"]
+        out.append({"seed": seed, "outcome": summary["outcome"], "correct": summary["correct"],
+                    "search_time_s": d["search_time_s"], "survey_time_s": d["survey_time_s"],
+                    "poses": d["poses"], "views": summary["views_processed"],
+                    "landmarks": len(d["landmarks"]), "wall_s": summary["wall_time_s"]})
+    return out
+
+
+def stats(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    ok = [r for r in runs if r["outcome"] == "found" and r["correct"]]
+
+    def mean(key: str, rows: list[dict[str, Any]]) -> float | None:
+        return statistics.fmean(r[key] for r in rows) if rows else None
+
+    return {"found": len(ok), "trials": len(runs), "time": mean("search_time_s", ok),
+            "poses": mean("poses", ok), "survey": mean("survey_time_s", runs),
+            "wrong": sum(r["outcome"] == "found" and not r["correct"] for r in runs),
+            "wall": mean("wall_s", runs)}
+
+
+def _fmt(value: float | None, digits: int = 1) -> str:
+    return "-" if value is None else f"{value:.{digits}f}"
+
+
+def print_table(title: str, rows: list[tuple[str, dict[str, Any], tuple[int, float, float]]]
+                ) -> None:  # fmt: skip
+    print(title)
+    print(f"{'':<20} {'found':>7} {'time s':>7} {'poses':>6} | {'seed found':>10} "
+          f"{'time s':>7} {'poses':>6} | {'survey s':>8} {'wrong':>5}")
+    for name, s, (f, t, p) in rows:
+        print(f"{name:<20} {s['found']:>3}/{s['trials']:<3} {_fmt(s['time']):>7} "
+              f"{_fmt(s['poses'], 2):>6} | {f:>6}/{SEED_TRIALS:<3} {t:>7.1f} {p:>6.1f} | "
+              f"{_fmt(s['survey']):>8} {s['wrong']:>5}")
+    print()
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--trials", type=int, default=10, help="searches per cell (seeds 0..N-1)")
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+                        help="a strategy option for every run, e.g. frustums=4 (repeatable)")
+    parser.add_argument("--json", help="also write every run and the tables to this file")
+    args = parser.parse_args(argv)
+    options = {}
+    for text in args.option:
+        key, _, value = text.partition("=")
+        options[key] = value
+    start = time.perf_counter()
+    cells: dict[str, list[dict[str, Any]]] = {}
+    for method in ("random", "supporting-planes", "qsr"):
+        cells[f"{method}/A"] = run_cell(method, "A", args.trials, options)
+    for variant in ("B", "C"):
+        cells[f"qsr/{variant}"] = run_cell("qsr", variant, args.trials, options)
+    table = {key: stats(runs) for key, runs in cells.items()}
+    print(f"seed 002 experiments, {args.trials} trials per cell (seeds 0..{args.trials - 1}), "
+          f"options {options or 'default'}; ours beside the seed's (10 trials); time and poses "
+          f"over successful trials; wall {time.perf_counter() - start:.0f} s\n")
+    print_table("Table II: search methods, variant A",
+                [(m, table[f"{m}/A"], TABLE_II[m]) for m in ("random", "supporting-planes",
+                                                             "qsr")])
+    print_table("Table III: qsr under false beliefs",
+                [(f"{v} ({w})", table[f"qsr/{v}"], TABLE_III[v]) for v, w in
+                 (("A", "correct QSRs"), ("B", "partially correct"), ("C", "wrong QSRs"))])
+    if args.json:
+        with open(args.json, "w", encoding="utf-8") as fh:
+            json.dump({"options": options, "tables": table, "runs": cells}, fh, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
