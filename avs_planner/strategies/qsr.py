@@ -57,6 +57,7 @@ MAX_DRIVE_FAILURES = 5  # selected poses the robot could not reach before giving
 
 # knowledge learnt in this process, for searches whose task carries no descriptions
 _LEARNT: dict[str, QsrKnowledge] = {}
+_PROCESS = "process"
 
 
 def run_qsr(ctx: SearchContext) -> SearchResult:
@@ -192,14 +193,16 @@ class QsrSearch:
     # -- knowledge --
 
     def _knowledge(self) -> tuple[QsrKnowledge, str]:
+        """The task's descriptions; else `learn_file` when it exists; else (when learning)
+        what this process learnt; else the default knowledge."""
         ctx = self.ctx
         if ctx.qsr is not None:
             return ctx.qsr, "task"
         path = str(self.opt.get("learn_file") or "")
         if path and Path(path).exists():
             return load_qsr(path), path
-        if path in _LEARNT:
-            return _LEARNT[path], "learnt in this process"
+        if self.opt["learn"] and _PROCESS in _LEARNT:
+            return _LEARNT[_PROCESS], "learnt in this process"
         return load_qsr(), "default"
 
     # -- the loop --
@@ -381,9 +384,9 @@ class QsrSearch:
         self.ctx.trace.emit("belief", qsr_learnt=[d.text() for d in update.credited])
         if not update.credited:
             return
-        path = str(self.opt.get("learn_file") or "")
         if self.knowledge_from != "task":
-            _LEARNT[path] = update.knowledge
+            _LEARNT[_PROCESS] = update.knowledge
+        path = str(self.opt.get("learn_file") or "")
         if path:
             import yaml
 
