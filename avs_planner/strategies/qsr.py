@@ -38,7 +38,7 @@ from avs_planner.episode.outcome import Outcome, SearchResult, StepStatus
 from avs_planner.qsr import ViewMethod, ViewOptions, in_frustums, select_view
 from avs_planner.strategies.baselines import explore
 from avs_planner.strategies.context import SearchContext
-from avs_planner.strategies.looking import LOOK_DISTANCE, SUPPORT_HEIGHT, _look
+from avs_planner.strategies.looking import LOOK_DISTANCE, SUPPORT_HEIGHT, _confirm
 from conceptual_map.metric import OccupancyGrid
 from conceptual_map.qsr import (
     Landmark,
@@ -335,10 +335,34 @@ class QsrSearch:
             x, y, yaw = ctx.robot.pose
             self.looks.append(_Look(np.array([x, y, body.camera_height]), yaw + f.pan, f.tilt))
             self._depth()
-            found = _look(ctx)
+            found = self.look()
             if found is not None:
                 return found
         return None
+
+    def look(self) -> KnownObject | None:
+        """One view: a detection of the target, confirmed when one of up to `confirm_frames`
+        further frames sees it again within the executor's agreement distance (a miss of the
+        second frame alone does not throw a real detection away)."""
+        ctx = self.ctx
+        ex, label = ctx.executor, ctx.target
+        ex.stats.views += 1
+        first = [s for s in ctx.robot.detect([label]) if s.label == label]
+        for s in first:
+            ex.stats.detections.append((s.position[0], s.position[1], label, True))
+        if not first:
+            ctx.trace.emit("observation", label=label, detected=False)
+            return None
+        agree = ex.config.agree[0]
+        again: list = []
+        for _ in range(self.opt["confirm_frames"]):
+            again = [s for s in ctx.robot.detect([label]) if s.label == label
+                     and math.dist(s.position, first[0].position) <= agree]
+            if again:
+                break
+        ctx.trace.emit("observation", label=label, detected=bool(again),
+                       position=[round(v, 2) for v in first[0].position])
+        return _confirm(ctx, first[0]) if again else None
 
     # -- belief --
 
