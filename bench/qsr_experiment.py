@@ -10,13 +10,15 @@ As in the seed, time and poses are means over the successful trials only; "found
 searches that ended with a confirmed cup that is a cup in the world. Time is the search
 monitor's time (simulated seconds after the survey, which stands in for the seed's given maps
 and landmark poses); the survey's own time is printed beside it.
-Run: `python -m bench.qsr_experiment [--trials 10]`.
+"±" is the half-width of a normal 95% confidence interval of the mean (over successful trials).
+Run: `python -m bench.qsr_experiment [--trials 10] [--tables II,III] [--option KEY=VALUE]`.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import statistics
 import time
 from typing import Any
@@ -51,8 +53,15 @@ def stats(runs: list[dict[str, Any]]) -> dict[str, Any]:
     def mean(key: str, rows: list[dict[str, Any]]) -> float | None:
         return statistics.fmean(r[key] for r in rows) if rows else None
 
+    def ci(key: str, rows: list[dict[str, Any]]) -> float | None:
+        """Half-width of a normal 95% confidence interval of the mean."""
+        if len(rows) < 2:
+            return None
+        return 1.96 * statistics.stdev(r[key] for r in rows) / math.sqrt(len(rows))
+
     return {"found": len(ok), "trials": len(runs), "time": mean("search_time_s", ok),
             "poses": mean("poses", ok), "survey": mean("survey_time_s", runs),
+            "time_ci": ci("search_time_s", ok), "poses_ci": ci("poses", ok),
             "wrong": sum(r["outcome"] == "found" and not r["correct"] for r in runs),
             "wall": mean("wall_s", runs)}
 
@@ -64,12 +73,14 @@ def _fmt(value: float | None, digits: int = 1) -> str:
 def print_table(title: str, rows: list[tuple[str, dict[str, Any], tuple[int, float, float]]]
                 ) -> None:  # fmt: skip
     print(title)
-    print(f"{'':<20} {'found':>7} {'time s':>7} {'poses':>6} | {'seed found':>10} "
+    print(f"{'':<22} {'found':>7} {'time s':>13} {'poses':>12} | {'seed found':>10} "
           f"{'time s':>7} {'poses':>6} | {'survey s':>8} {'wrong':>5}")
     for name, s, (f, t, p) in rows:
-        print(f"{name:<20} {s['found']:>3}/{s['trials']:<3} {_fmt(s['time']):>7} "
-              f"{_fmt(s['poses'], 2):>6} | {f:>6}/{SEED_TRIALS:<3} {t:>7.1f} {p:>6.1f} | "
-              f"{_fmt(s['survey']):>8} {s['wrong']:>5}")
+        time_s = f"{_fmt(s['time'])} ±{_fmt(s['time_ci'])}"
+        poses = f"{_fmt(s['poses'], 2)} ±{_fmt(s['poses_ci'], 2)}"
+        print(f"{name:<22} {s['found']:>3}/{s['trials']:<3} {time_s:>13} {poses:>12} | "
+              f"{f:>6}/{SEED_TRIALS:<3} {t:>7.1f} {p:>6.1f} | {_fmt(s['survey']):>8} "
+              f"{s['wrong']:>5}")
     print()
 
 
@@ -79,27 +90,31 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
                         help="a strategy option for every run, e.g. frustums=4 (repeatable)")
     parser.add_argument("--json", help="also write every run and the tables to this file")
+    parser.add_argument("--tables", default="II,III", help="which tables: II, III or II,III")
     args = parser.parse_args(argv)
     options = {}
     for text in args.option:
         key, _, value = text.partition("=")
         options[key] = value
     start = time.perf_counter()
+    tables = {t.strip().upper() for t in args.tables.split(",")}
     cells: dict[str, list[dict[str, Any]]] = {}
-    for method in ("random", "supporting-planes", "qsr"):
+    for method in ("random", "supporting-planes", "qsr") if "II" in tables else ("qsr",):
         cells[f"{method}/A"] = run_cell(method, "A", args.trials, options)
-    for variant in ("B", "C"):
+    for variant in ("B", "C") if "III" in tables else ():
         cells[f"qsr/{variant}"] = run_cell("qsr", variant, args.trials, options)
     table = {key: stats(runs) for key, runs in cells.items()}
     print(f"seed 002 experiments, {args.trials} trials per cell (seeds 0..{args.trials - 1}), "
           f"options {options or 'default'}; ours beside the seed's (10 trials); time and poses "
           f"over successful trials; wall {time.perf_counter() - start:.0f} s\n")
-    print_table("Table II: search methods, variant A",
-                [(m, table[f"{m}/A"], TABLE_II[m]) for m in ("random", "supporting-planes",
-                                                             "qsr")])
-    print_table("Table III: qsr under false beliefs",
-                [(f"{v} ({w})", table[f"qsr/{v}"], TABLE_III[v]) for v, w in
-                 (("A", "correct QSRs"), ("B", "partially correct"), ("C", "wrong QSRs"))])
+    if "II" in tables:
+        print_table("Table II: search methods, variant A",
+                    [(m, table[f"{m}/A"], TABLE_II[m]) for m in ("random", "supporting-planes",
+                                                                 "qsr")])
+    if "III" in tables:
+        print_table("Table III: qsr under false beliefs",
+                    [(f"{v} ({w})", table[f"qsr/{v}"], TABLE_III[v]) for v, w in
+                     (("A", "correct QSRs"), ("B", "partially correct"), ("C", "wrong QSRs"))])
     if args.json:
         with open(args.json, "w", encoding="utf-8") as fh:
             json.dump({"options": options, "tables": table, "runs": cells}, fh, indent=1)
