@@ -112,3 +112,17 @@ def test_landmarks_need_two_sightings_and_face_the_open_side():
     grid._touch()
     facing = open_side(grid, np.array([3.0, 5.5]), 0.3)
     assert facing == pytest.approx(-math.pi / 2, abs=math.radians(3))
+
+
+def test_simulate_qsr_file_errors_exit_1_before_the_run(tmp_path, capsys):
+    from avs_planner.cli import main
+
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("- {target: cup, relations: [left, close], of: sofa, count: 1}\n")
+    base = ["simulate", "--world", "qsr_desks", "--target", "cup", "--strategy", "qsr",
+            "--out", str(tmp_path / "out")]
+    assert main([*base, "--qsr", str(bad)]) == 1
+    assert "qsr: descriptions[0].of: unknown landmark label 'sofa'" in capsys.readouterr().err
+    assert main([*base, "--qsr", str(tmp_path / "missing.yaml")]) == 1
+    assert "cannot read" in capsys.readouterr().err
+    assert not (tmp_path / "out" / "summary.json").exists()
