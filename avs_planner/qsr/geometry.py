@@ -63,23 +63,24 @@ def line_of_sight(
     if len(todo) == 0:
         return out
     res = voxels.resolution
-    origin = np.asarray(voxels.origin, dtype=float)
+    origin = np.asarray(voxels.origin, dtype=np.float32)
     shape = np.asarray(voxels.shape)
-    occupied = voxels.logodds >= voxels.model.occupied_at
-    step = res / 2.0
+    occupied = (voxels.logodds >= voxels.model.occupied_at).ravel()
+    strides = np.array([shape[1] * shape[2], shape[2], 1], dtype=np.int64)
+    step = res  # one sample per voxel length: a blocking wall or monitor is thicker than that
     for lo in range(0, len(todo), chunk):
         part = todo[lo : lo + chunk]
-        a, b = origins[part[:, 0]], points[part[:, 1]]
+        a = origins[part[:, 0]].astype(np.float32)
+        b = points[part[:, 1]].astype(np.float32)
         length = np.linalg.norm(b - a, axis=1)
         reach = np.maximum(length - skip, 0.0)
         count = int(np.ceil(reach.max() / step)) + 1
-        s = np.arange(count) * step  # metres along each segment
-        valid = s[None, :] <= reach[:, None]
+        s = np.arange(count, dtype=np.float32) * np.float32(step)  # metres along each segment
         direction = (b - a) / np.maximum(length, 1e-9)[:, None]
-        samples = a[:, None, :] + s[None, :, None] * direction[:, None, :]
-        cells = np.floor((samples - origin) / res).astype(np.int64)
-        inside = valid & np.all((cells >= 0) & (cells < shape), axis=2)
-        cells = np.where(inside[:, :, None], cells, 0)
-        hit = occupied[cells[:, :, 0], cells[:, :, 1], cells[:, :, 2]] & inside
+        cells = np.floor((a[:, None, :] - origin + s[None, :, None] * direction[:, None, :])
+                         / np.float32(res)).astype(np.int64)
+        inside = (s[None, :] <= reach[:, None]) & np.all((cells >= 0) & (cells < shape), axis=2)
+        flat = np.where(inside, cells @ strides, 0)
+        hit = occupied[flat] & inside
         out[part[:, 0], part[:, 1]] = ~hit.any(axis=1)
     return out
