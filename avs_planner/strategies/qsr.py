@@ -35,7 +35,14 @@ import numpy as np
 
 from avs_planner.episode.mind import KnownObject
 from avs_planner.episode.outcome import Outcome, SearchResult, StepStatus
-from avs_planner.qsr import ViewMethod, ViewOptions, in_frustums, select_view
+from avs_planner.qsr import (
+    ViewMethod,
+    ViewOptions,
+    in_frustums,
+    line_of_sight,
+    rank_frustums,
+    select_view,
+)
 from avs_planner.strategies.baselines import explore
 from avs_planner.strategies.context import SearchContext
 from avs_planner.strategies.looking import LOOK_DISTANCE, SUPPORT_HEIGHT, _confirm
@@ -250,7 +257,7 @@ class QsrSearch:
                 continue
             ctx.robot.turn_to(best.yaw)
             self.poses += 1
-            found = self.perceive(view.frustums)
+            found = self.perceive(self.frustums_here(planes.points, density))
             ctx.trace.emit("action", action=f"(view-pose {self.method.value})", status="done",
                            poses=self.poses, search_time_s=round(self.search_time(), 2))
             if found is not None:
@@ -321,6 +328,15 @@ class QsrSearch:
         size = (self.opt["depth_columns"], self.opt["depth_rows"])
         self.ctx.mind.integrate_depth(self.ctx.robot.depth(size))
 
+    def frustums_here(self, points: np.ndarray, density: np.ndarray):  # noqa: ANN201
+        """The nine frustums ranked again where the robot really stands (the executor stops
+        within its arrival distance of the pose), with line of sight from there."""
+        body, mind = self.ctx.body, self.ctx.mind
+        pose = np.asarray(self.ctx.robot.pose, dtype=float)
+        camera = np.array([[pose[0], pose[1], body.camera_height]])
+        visible = line_of_sight(mind.voxels, camera, points)[0]
+        return rank_frustums(pose, points, density, body, body.detect_range, 0.0, visible)
+
     def perceive(self, frustums) -> KnownObject | None:  # noqa: ANN001 - Frustum tuple
         """Look with the best frustums (a depth frame each, for the 3D map), detect the
         target and confirm it with a second frame."""
@@ -332,6 +348,8 @@ class QsrSearch:
             if self.search_time() >= self.opt["abort_s"]:
                 break
             ctx.robot.look(f.pan, f.tilt)
+            ctx.trace.emit("action", action="(look)", pan=round(f.pan, 3), tilt=round(f.tilt, 3),
+                           score=round(f.score, 4))
             x, y, yaw = ctx.robot.pose
             self.looks.append(_Look(np.array([x, y, body.camera_height]), yaw + f.pan, f.tilt))
             self._depth()
