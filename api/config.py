@@ -10,6 +10,8 @@ from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 DEFAULT_EPISODE_RUNNER = "avs_planner.jobs:run_episode"
+DEFAULT_PLAN_RUNNER = "avs_planner.jobs:plan"
+DEFAULT_TASK_CHECKER = "avs_planner.episode.validate:check_task"
 
 
 class Settings(BaseSettings):
@@ -22,7 +24,7 @@ class Settings(BaseSettings):
     port: int = Field(8000, ge=0, le=65535)
     data_dir: Path = Path(".avs-data")
     workers: int = Field(2, ge=1, le=64, description="processes running episodes")
-    plan_workers: int = Field(1, ge=1, le=64, description="processes running plans/checks")
+    plan_workers: int = Field(2, ge=1, le=64, description="processes running plans/checks")
     queue_size: int = Field(16, ge=1, description="queued tasks accepted before 503")
     plan_queue_size: int = Field(8, ge=1, description="waiting plan/check jobs before 503")
     task_time_limit_s: float = Field(900.0, gt=0, description="wall clock per episode")
@@ -37,9 +39,19 @@ class Settings(BaseSettings):
     episode_runner: str = Field(
         DEFAULT_EPISODE_RUNNER, description="'module:function' or '/path/file.py:function'"
     )
+    plan_runner: str = Field(DEFAULT_PLAN_RUNNER, description="the plan job's function "
+                             "('module:function' or '/path/file.py:function')")
     warm_workers: bool = Field(True, description="start episode workers before the first task")
     preload_planner: bool = Field(True, description="import the planner in job workers at start")
     worlds_dir: Path | None = Field(None, description="built-in worlds; default: sim/worlds")
+    task_checker: str | None = Field(
+        DEFAULT_TASK_CHECKER, description="'module:function' checking a task against its world "
+        "and the knowledge base at submission (422); empty: no check")
+    forwarded_allow_ips: str | None = Field(
+        None, description="comma-separated proxy addresses whose X-Forwarded-For/-Proto are "
+        "trusted ('*' for any); default: none, the TCP peer is the client")
+    plan_results_kept: int = Field(100, ge=1, le=10_000, description="finished async plan jobs "
+                                   "kept for polling (oldest dropped first)")
 
     @property
     def db_path(self) -> Path:

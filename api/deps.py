@@ -8,7 +8,7 @@ from typing import Annotated
 from fastapi import Depends, Header, HTTPException, Path, Request, status
 
 from api.config import Settings
-from api.manager import TaskManager
+from api.manager import TaskChecker, TaskManager
 from api.security import RateLimiter, key_matches, owner_of
 from api.store import TaskRecord, TaskStore
 
@@ -25,7 +25,12 @@ async def get_store(request: Request) -> TaskStore:
     return request.app.state.manager.store
 
 
+async def get_task_checker(request: Request) -> TaskChecker | None:
+    return request.app.state.manager.task_checker
+
+
 SettingsDep = Annotated[Settings, Depends(get_settings)]
+TaskCheckerDep = Annotated[TaskChecker | None, Depends(get_task_checker)]
 ManagerDep = Annotated[TaskManager, Depends(get_manager)]
 StoreDep = Annotated[TaskStore, Depends(get_store)]
 

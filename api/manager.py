@@ -11,13 +11,15 @@ import logging
 import threading
 import time
 import uuid
+from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from api.config import Settings
 from api.schemas import TaskState
 from api.store import TaskRecord, TaskStore
-from api.worker_process import PRELOAD_JOBS
+from api.worker_process import PRELOAD_JOBS, resolve
 from api.workers import Job, JobOutcome, JobResult, WorkerPool
 
 log = logging.getLogger("avs.api.tasks")
@@ -35,6 +37,9 @@ _JOB_STATES = {
 }
 
 
+TaskChecker = Callable[[dict[str, Any], Path | None], list[Any]]  # -> [FieldProblem(field, msg)]
+
+
 class QueueFullError(Exception):
     """No room for another job; the client should retry later (HTTP 503)."""
 
@@ -47,6 +52,17 @@ class NotCancellableError(Exception):
     """The task already ended (HTTP 409)."""
 
 
+class ClientGoneError(Exception):
+    """The client of a synchronous plan/check disconnected; its job was cancelled."""
+
+
+class StoppingError(Exception):
+    """The service is stopping; the job was cancelled (HTTP 503, retry after the restart)."""
+
+
+_DISCONNECT_POLL_S = 0.25
+
+
 @dataclass(frozen=True)
 class Submission:
     task: TaskRecord
@@ -56,25 +72,31 @@ class Submission:
 class TaskManager:
     """Owns the store and both worker pools; every route goes through it."""
 
-    def __init__(self, settings: Settings, store: TaskStore):
+    def __init__(self, settings: Settings, store: TaskStore,
+                 draining: threading.Event | None = None):
         self.settings = settings
         self.store = store
+        self.draining = draining or threading.Event()  # set when the service begins to stop
         self.episodes = WorkerPool(
-            "episodes", settings.workers, settings.memory_limit_mb, settings.episode_runner,
+            "episodes", settings.workers, settings.memory_limit_mb,
+            {"episode": settings.episode_runner},
             settings.cancel_grace_s, nice=settings.worker_nice, warm=settings.warm_workers,
         )
         self.jobs = WorkerPool(
-            "jobs", settings.plan_workers, settings.memory_limit_mb, settings.episode_runner,
+            "jobs", settings.plan_workers, settings.memory_limit_mb, {"plan": settings.plan_runner},
             settings.cancel_grace_s, preload=PRELOAD_JOBS if settings.preload_planner else (),
             nice=settings.worker_nice, warm=settings.preload_planner,
         )
         self._cancels: dict[str, threading.Event] = {}
         self._lock = threading.Lock()
+        self.task_checker: TaskChecker | None = None
 
     # -- life cycle -------------------------------------------------------------------------
 
     def start(self) -> None:
         """Account for tasks a previous run left behind, then start the workers."""
+        if self.settings.task_checker:
+            self.task_checker = resolve(self.settings.task_checker)  # imported now, not per call
         self._recover()
         self.episodes.start()
         self.jobs.start()
@@ -89,7 +111,8 @@ class TaskManager:
         for task_id in self.store.ids_in_state(TaskState.RUNNING):
             if self.settings.on_restart == "requeue":
                 self.store.requeue(task_id)
-                self._state_event(task_id, TaskState.QUEUED, "requeued after a service restart")
+                self._state_event(task_id, TaskState.QUEUED, "requeued after a service restart; "
+                                  "its next run starts again from the beginning")
                 log.warning("task %s was running when the service stopped: requeued", task_id)
             else:
                 message = "interrupted: the service stopped while the task was running"
@@ -140,12 +163,13 @@ class TaskManager:
         if task is None:
             return
         cancel = self._cancels.setdefault(task_id, threading.Event())
+        output_dir = str((self.settings.tasks_dir / task_id).resolve()) + "/"
         job = Job(
             kind="episode",
             payload=self._episode_spec(task),
             time_limit_s=self.settings.task_time_limit_s,
             on_start=lambda: self._claim(task_id),
-            on_event=lambda event: self.store.add_event(task_id, event),
+            on_event=lambda event: self.store.add_event(task_id, _relative(event, output_dir)),
             cancel=cancel,
         )
         future = self.episodes.submit(job)
@@ -159,7 +183,9 @@ class TaskManager:
     def _claim(self, task_id: str) -> bool:
         if not self.store.claim(task_id):
             return False
-        self._state_event(task_id, TaskState.RUNNING)
+        task = self.store.get(task_id)
+        attempt = task.attempts if task is not None else 1
+        self._state_event(task_id, TaskState.RUNNING, attempt=attempt)
         return True
 
     def _finished(self, task_id: str, result: JobResult) -> None:
@@ -170,28 +196,58 @@ class TaskManager:
         if self.store.finish(task_id, state, summary, error):
             self._state_event(task_id, state, error)
 
-    def _state_event(self, task_id: str, state: TaskState, message: str | None = None) -> None:
+    def _state_event(self, task_id: str, state: TaskState, message: str | None = None,
+                     attempt: int | None = None) -> None:
         event: dict[str, Any] = {"type": "state", "state": state.value, "time": time.time()}
         if message:
             event["message"] = message
+        if attempt is not None:
+            event["attempt"] = attempt  # 2, 3, ...: a requeued task's events after this are new
         self.store.add_event(task_id, event)
 
     # -- plans and checks ---------------------------------------------------------------------
 
-    async def run_job(self, kind: str, payload: dict[str, Any]) -> JobResult:
-        """Run a plan/check job in the job pool and wait for it without blocking the loop."""
+    def check_job_room(self) -> None:
+        """`QueueFullError` when the plan/check queue is full."""
         if self.jobs.pending() >= self.settings.plan_queue_size:
             raise QueueFullError(f"{self.settings.plan_queue_size} plan/check jobs waiting")
-        job = Job(kind=kind, payload=payload, time_limit_s=self.settings.plan_time_limit_s)
-        future = self.jobs.submit(job)
+
+    async def run_job(
+        self, kind: str, payload: dict[str, Any],
+        disconnected: Callable[[], Awaitable[bool]] | None = None,
+        on_start: Callable[[], bool] = lambda: True,
+    ) -> JobResult:
+        """Run a plan/check job in the job pool and wait for it without blocking the loop.
+
+        The job is cancelled (its process killed at once) when the waiting coroutine is
+        cancelled, `disconnected()` turns true (`ClientGoneError`) or the service begins to stop
+        (`StoppingError`)."""
+        self.check_job_room()
+        job = Job(kind=kind, payload=payload, time_limit_s=self.settings.plan_time_limit_s,
+                  on_start=on_start, grace_s=0.0)
+        waiting = asyncio.wrap_future(self.jobs.submit(job))
         try:
-            return await asyncio.wrap_future(future)
-        except asyncio.CancelledError:
-            job.cancel.set()  # the client went away: stop the work too
+            while True:
+                done, _ = await asyncio.wait({waiting}, timeout=_DISCONNECT_POLL_S)
+                if done:
+                    return waiting.result()
+                if self.draining.is_set():
+                    raise StoppingError(kind)
+                if disconnected is not None and await disconnected():
+                    raise ClientGoneError(kind)
+        except (asyncio.CancelledError, ClientGoneError, StoppingError):
+            job.cancel.set()  # the client went away: free the worker too
             raise
 
     def counts(self) -> tuple[int, int]:
         return self.store.count_state(TaskState.QUEUED), self.store.count_state(TaskState.RUNNING)
+
+
+def _relative(event: dict[str, Any], root: str) -> dict[str, Any]:
+    """The event with paths inside the task's own directory made relative to it (clients get
+    `timeout-1.pddl`, never the server's file system layout)."""
+    return {k: v[len(root):] if isinstance(v, str) and v.startswith(root) else v
+            for k, v in event.items()}
 
 
 def _task_outcome(result: JobResult) -> tuple[TaskState, dict[str, Any] | None, str | None]:

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 from enum import StrEnum
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 NAME_PATTERN = r"^[A-Za-z][A-Za-z0-9_-]{0,63}$"
 MAX_TEXT = 500_000
+OptionValue = bool | int | float | Annotated[str, Field(max_length=200)] | None
 
 
 class TaskState(StrEnum):
@@ -28,9 +29,12 @@ class TaskState(StrEnum):
 
 
 class TaskCreate(BaseModel):
-    """Find `target` (a label) [in a room of `category`] in a world, with a robot."""
+    """Find `target` (a label) [in a room of `category`] in a world, with a robot.
 
-    model_config = ConfigDict(extra="forbid")
+    Checked at submission against the knowledge base (target, category), the world (start
+    room, start pose free and inside a room) and the strategy registry: 422 naming the field."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     target: str = Field(pattern=NAME_PATTERN, examples=["cerealbox"])
     category: str | None = Field(None, pattern=NAME_PATTERN, examples=["kitchen"])
@@ -38,13 +42,19 @@ class TaskCreate(BaseModel):
     world_file: str | None = Field(
         None, max_length=MAX_TEXT, description="an inline world file (YAML text)"
     )
-    robot: Literal["pioneer", "pr2"] = "pioneer"
+    robot: Literal["pioneer", "pr2"] | None = Field(
+        None, description="robot model; default: the one the world file names")
     start_room: str | None = Field(None, pattern=NAME_PATTERN)
     start: tuple[float, float, float] | None = Field(
-        None, description="start pose x, y, yaw (m, m, rad); default: the world's"
+        None, description="start pose x, y, yaw (m, m, rad), finite, inside a room and clear of "
+        "furniture; default: the world's"
     )
     seed: int = Field(0, ge=0, le=2**31 - 1)
     time_budget_s: float = Field(600.0, gt=0, le=86_400, description="simulated seconds")
+    strategy: str = Field("switching", pattern=NAME_PATTERN,
+                          description="search strategy (GET /v1/strategies lists them)")
+    strategy_options: dict[str, OptionValue] = Field(
+        default_factory=dict, max_length=50, description="the strategy's options by name")
 
     @model_validator(mode="after")
     def _one_world(self) -> TaskCreate:
@@ -67,6 +77,7 @@ class TaskPublic(BaseModel):
     summary: dict[str, Any] | None = None
     error: str | None = None
     events: int = 0
+    attempts: int = Field(0, description="times it started running (2 after a requeue)")
 
 
 class TasksPublic(BaseModel):
@@ -106,6 +117,32 @@ class PlanPublic(BaseModel):
         "plan in hand, which is the best found so far")
 
 
+class PlanJobState(StrEnum):
+    QUEUED = "queued"
+    RUNNING = "running"
+    SUCCEEDED = "succeeded"
+    FAILED = "failed"
+    CANCELLED = "cancelled"
+
+
+class JobError(BaseModel):
+    """What the synchronous call would have answered instead of 200: its status and detail."""
+
+    status: int
+    detail: Any
+
+
+class PlanJobPublic(BaseModel):
+    """An asynchronous plan job (`POST /v1/plans?wait=false`); poll `GET /v1/plans/{id}`."""
+
+    id: str
+    state: PlanJobState
+    created_at: float
+    finished_at: float | None = None
+    result: PlanPublic | None = None
+    error: JobError | None = None
+
+
 class DomainCheckCreate(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
@@ -141,6 +178,17 @@ class WorldsPublic(BaseModel):
     count: int
 
 
+class StrategyPublic(BaseModel):
+    name: str
+    summary: str
+    options: dict[str, Any]
+
+
+class StrategiesPublic(BaseModel):
+    data: list[StrategyPublic]
+    count: int
+
+
 class Health(BaseModel):
     status: Literal["ok"]
     version: str
@@ -152,3 +200,8 @@ class Health(BaseModel):
 
 class Message(BaseModel):
     detail: Any
+
+
+TOO_LARGE: dict[int | str, dict[str, Any]] = {
+    413: {"model": Message, "description": "body larger than AVS_MAX_BODY_BYTES"},
+}

@@ -28,6 +28,7 @@ CREATE TABLE IF NOT EXISTS tasks (
     result TEXT,
     error TEXT,
     events INTEGER NOT NULL DEFAULT 0,
+    attempts INTEGER NOT NULL DEFAULT 0,
     UNIQUE (owner, idempotency_key)
 );
 CREATE INDEX IF NOT EXISTS tasks_state ON tasks (state, created_at);
@@ -56,6 +57,7 @@ class TaskRecord:
     result: dict[str, Any] | None
     error: str | None
     events: int
+    attempts: int = 0  # times it started running (more than 1 after a requeue)
 
 
 @dataclass(frozen=True)
@@ -73,6 +75,7 @@ class TaskStore:
         self._conn.execute("PRAGMA journal_mode=WAL")
         self._conn.execute("PRAGMA synchronous=NORMAL")
         self._conn.executescript(_SCHEMA)
+        _migrate(self._conn)
         self._lock = threading.Lock()
 
     def close(self) -> None:
@@ -148,7 +151,8 @@ class TaskStore:
         """queued → running, atomically; False if the task is no longer queued (e.g. cancelled)."""
         with self._tx() as db:
             cur = db.execute(
-                "UPDATE tasks SET state=?, started_at=? WHERE id=? AND state=?",
+                "UPDATE tasks SET state=?, started_at=?, attempts=attempts+1"
+                " WHERE id=? AND state=?",
                 (TaskState.RUNNING.value, time.time(), task_id, TaskState.QUEUED.value),
             )
             return cur.rowcount == 1
@@ -199,7 +203,7 @@ class TaskStore:
 
 _SELECT = (
     "SELECT t.id, t.state, t.request, t.owner, t.idempotency_key, t.request_hash, t.created_at,"
-    " t.started_at, t.finished_at, t.result, t.error, t.events FROM tasks t"
+    " t.started_at, t.finished_at, t.result, t.error, t.events, t.attempts FROM tasks t"
 )
 
 
@@ -208,5 +212,12 @@ def _decode(row: tuple[Any, ...]) -> TaskRecord:
         id=row[0], state=TaskState(row[1]), request=json.loads(row[2]), owner=row[3],
         idempotency_key=row[4], request_hash=row[5], created_at=row[6], started_at=row[7],
         finished_at=row[8], result=json.loads(row[9]) if row[9] else None, error=row[10],
-        events=int(row[11]),
+        events=int(row[11]), attempts=int(row[12]),
     )
+
+
+def _migrate(conn: sqlite3.Connection) -> None:
+    """Bring a store written by an older version up to this schema."""
+    columns = {row[1] for row in conn.execute("PRAGMA table_info(tasks)")}
+    if "attempts" not in columns:
+        conn.execute("ALTER TABLE tasks ADD COLUMN attempts INTEGER NOT NULL DEFAULT 0")

@@ -72,11 +72,12 @@ class _Channel:
         return self.stopped
 
 
-def _run_job(channel: _Channel, episode_runner: str, kind: str, payload: dict[str, Any]) -> Any:
+def _run_job(channel: _Channel, runners: dict[str, str], kind: str, payload: dict[str, Any]
+             ) -> Any:
     if kind == "episode":
-        runner = resolve(episode_runner)
+        runner = resolve(runners["episode"])
         return runner(payload, channel.emit, channel.should_stop)
-    function = resolve(JOB_FUNCTIONS[kind])
+    function = resolve(runners.get(kind) or JOB_FUNCTIONS[kind])
     return function(**payload)
 
 
@@ -102,8 +103,8 @@ def exit_with_parent(interval_s: float = 1.0) -> None:
 
 
 def worker_main(
-    conn: Connection, memory_limit_mb: int, episode_runner: str, modules: tuple[str, ...] = (),
-    nice: int = 0,
+    conn: Connection, memory_limit_mb: int, runners: dict[str, str],
+    modules: tuple[str, ...] = (), nice: int = 0,
 ) -> None:
     """Serve jobs until the pipe closes or a None job arrives."""
     exit_with_parent()
@@ -123,7 +124,7 @@ def worker_main(
         kind, payload = message
         channel = _Channel(conn)
         try:
-            value = _run_job(channel, episode_runner, kind, payload)
+            value = _run_job(channel, runners, kind, payload)
             conn.send(("result", value))
         except MemoryError:
             conn.send(("error", "MemoryError", f"memory limit of {memory_limit_mb} MB exceeded"))

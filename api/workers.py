@@ -55,6 +55,7 @@ class Job:
     on_event: Callable[[dict[str, Any]], None] = lambda event: None
     cancel: threading.Event = field(default_factory=threading.Event)
     future: Future[JobResult] = field(default_factory=Future)
+    grace_s: float | None = None  # after a cancel, time to stop before a kill; None: the pool's
 
 
 class _Slot:
@@ -74,7 +75,7 @@ class _Slot:
         parent, child = ctx.Pipe(duplex=True)
         self.process = ctx.Process(
             target=worker_main,
-            args=(child, self.pool.memory_limit_mb, self.pool.episode_runner, self.pool.preload,
+            args=(child, self.pool.memory_limit_mb, self.pool.runners, self.pool.preload,
                   self.pool.nice),
             name=f"avs-{self.pool.name}-{self.index}",
             daemon=True,
@@ -110,7 +111,8 @@ class _Slot:
             if job.cancel.is_set() and stop_sent_at is None:
                 stop_sent_at = time.monotonic()
                 _send_quietly(conn, STOP)
-            if stop_sent_at is not None and time.monotonic() - stop_sent_at > self.pool.grace_s:
+            grace = self.pool.grace_s if job.grace_s is None else job.grace_s
+            if stop_sent_at is not None and time.monotonic() - stop_sent_at >= grace:
                 self.kill()
                 return JobResult(JobOutcome.CANCELLED, error="cancelled; worker killed")
             if time.monotonic() > deadline:
@@ -153,6 +155,9 @@ class _Slot:
                 return
             if not job.future.set_running_or_notify_cancel():
                 continue
+            if job.cancel.is_set():  # cancelled while it waited: never started
+                job.future.set_result(JobResult(JobOutcome.CANCELLED, error="cancelled"))
+                continue
             if not job.on_start():
                 job.future.set_result(JobResult(JobOutcome.SKIPPED))
                 continue
@@ -182,7 +187,7 @@ class WorkerPool:
     """N worker processes fed from one FIFO of jobs."""
 
     def __init__(
-        self, name: str, size: int, memory_limit_mb: int, episode_runner: str, grace_s: float,
+        self, name: str, size: int, memory_limit_mb: int, runners: dict[str, str], grace_s: float,
         preload: tuple[str, ...] = (), nice: int = 0, warm: bool = True,
     ):
         self.name = name
@@ -190,7 +195,7 @@ class WorkerPool:
         self.preload = preload
         self.nice = nice
         self.memory_limit_mb = memory_limit_mb
-        self.episode_runner = episode_runner
+        self.runners = runners  # job kind -> 'module:function' (defaults: JOB_FUNCTIONS)
         self.grace_s = grace_s
         self.jobs: queue.Queue[Job | None] = queue.Queue()
         self.stopping = threading.Event()

@@ -22,12 +22,21 @@ def default_worlds_dir() -> Path | None:
     return Path(next(iter(spec.submodule_search_locations))) / "worlds"
 
 
-def list_worlds(directory: Path | None) -> list[WorldPublic]:
-    """The worlds in `directory` (`*.yaml`, `*.yml`), sorted by name."""
+def world_files(directory: Path | None) -> list[Path]:
+    """The world files in `directory` (`*.yaml`, `*.yml`), sorted by name."""
     if directory is None or not directory.is_dir():
         return []
-    files = sorted([*directory.glob("*.yaml"), *directory.glob("*.yml")])
-    return [WorldPublic(name=f.stem, rooms=_room_names(f)) for f in files]
+    return sorted([*directory.glob("*.yaml"), *directory.glob("*.yml")])
+
+
+def world_path(directory: Path | None, name: str) -> Path | None:
+    """The file of the built-in world `name`, or None if there is none."""
+    return next((f for f in world_files(directory) if f.stem == name), None)
+
+
+def list_worlds(directory: Path | None) -> list[WorldPublic]:
+    """The worlds in `directory`, sorted by name."""
+    return [WorldPublic(name=f.stem, rooms=_room_names(f)) for f in world_files(directory)]
 
 
 def _room_names(path: Path) -> list[str]:

@@ -144,7 +144,8 @@ def start_service(
 ) -> tuple[subprocess.Popen[bytes], int]:
     port = _free_port()
     env = {**os.environ, "AVS_EPISODE_RUNNER": runner, "AVS_PRELOAD_PLANNER": "false",
-           "AVS_WORKERS": "2", "AVS_RATE_LIMIT_BURST": "1000"}
+           "AVS_WORKERS": "2", "AVS_RATE_LIMIT_BURST": "1000",
+           "AVS_TASK_CHECKER": ""}  # the probes' targets ("calm", "busy") are no labels
     if worlds_dir is not None:
         env["AVS_WORLDS_DIR"] = str(worlds_dir)
     env.pop("AVS_API_KEY", None)

@@ -22,3 +22,7 @@ class PathBlockedError(MotionError):
 
 class JointLimitError(MotionError):
     """A torso or head target lies outside the robot's joint limits."""
+
+
+class GenerationError(SimError):
+    """A floor plan cannot be generated: bad arguments or a broken placement table."""

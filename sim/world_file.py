@@ -79,13 +79,20 @@ def load_world_spec(source: str | Path) -> WorldSpec:
     path = resolve_world(source)
     label = path.name if path.parent == WORLDS_DIR else str(path)
     try:
-        data = yaml.load(path.read_text(encoding="utf-8"), Loader=_WorldLoader)
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise WorldFileError(f"{label}: cannot read: {exc}") from None
+    return load_world_text(text, label)
+
+
+def load_world_text(text: str, label: str) -> WorldSpec:
+    """Read and validate a world file's YAML text; errors name `label` and the entry."""
+    try:
+        data = yaml.load(text, Loader=_WorldLoader)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark
         where = f":{mark.line + 1}:{mark.column + 1}" if mark is not None else ""
         raise WorldFileError(f"{label}{where}: YAML error: {exc.problem}") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise WorldFileError(f"{label}: cannot read: {exc}") from None
     spec = parse_world(data, label)
     check_world(spec)
     return spec

@@ -2,27 +2,47 @@
 
 from __future__ import annotations
 
+from collections.abc import Awaitable, Callable
 from typing import Any
 
 from fastapi import HTTPException, status
 
-from api.manager import QueueFullError, TaskManager
+from api.manager import ClientGoneError, QueueFullError, StoppingError, TaskManager
 from api.workers import JobOutcome
 
 UNAVAILABLE = "JobUnavailableError"
+CLIENT_CLOSED = 499  # nginx's code for "the client closed the request"; nobody receives it
 
 
-async def run_job(manager: TaskManager, kind: str, payload: dict[str, Any]) -> Any:
-    """The job's return value; 503 when busy or the planner is missing, 504 on the wall clock."""
+def queue_full(exc: QueueFullError) -> HTTPException:
+    return HTTPException(
+        status.HTTP_503_SERVICE_UNAVAILABLE, detail=f"too many jobs waiting ({exc}); retry",
+        headers={"Retry-After": "2"},
+    )
+
+
+async def run_job(
+    manager: TaskManager, kind: str, payload: dict[str, Any],
+    disconnected: Callable[[], Awaitable[bool]] | None = None,
+    on_start: Callable[[], bool] = lambda: True,
+) -> Any:
+    """The job's return value; 503 when busy or the planner is missing, 504 on the wall clock.
+    A client that disconnects has its job cancelled (the worker is freed at once)."""
     try:
-        result = await manager.run_job(kind, payload)
+        result = await manager.run_job(kind, payload, disconnected, on_start)
     except QueueFullError as exc:
+        raise queue_full(exc) from exc
+    except ClientGoneError as exc:
+        raise HTTPException(CLIENT_CLOSED, detail="client disconnected") from exc
+    except StoppingError as exc:
         raise HTTPException(
-            status.HTTP_503_SERVICE_UNAVAILABLE, detail=f"too many jobs waiting ({exc}); retry",
-            headers={"Retry-After": "2"},
+            status.HTTP_503_SERVICE_UNAVAILABLE, detail="the service is stopping; retry",
+            headers={"Retry-After": "5"},
         ) from exc
     if result.outcome is JobOutcome.DONE:
         return result.value
+    if result.outcome is JobOutcome.CANCELLED:
+        raise HTTPException(status.HTTP_409_CONFLICT, detail=f"{kind} cancelled")
     if result.outcome is JobOutcome.TIMEOUT:
         raise HTTPException(status.HTTP_504_GATEWAY_TIMEOUT, detail=f"{kind}: {result.error}")
     if result.error_type in (UNAVAILABLE, "MemoryError") or result.outcome is JobOutcome.SHUTDOWN:

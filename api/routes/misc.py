@@ -1,11 +1,11 @@
-"""/worlds and /health."""
+"""/worlds, /strategies and /health."""
 
 from __future__ import annotations
 
 from fastapi import APIRouter, HTTPException, status
 
 from api.deps import ManagerDep, SettingsDep
-from api.schemas import Health, Message, WorldsPublic
+from api.schemas import Health, Message, StrategiesPublic, StrategyPublic, WorldsPublic
 from api.worlds import list_worlds
 from avs_planner import __version__
 
@@ -17,6 +17,15 @@ def read_worlds(settings: SettingsDep) -> WorldsPublic:
     """The built-in worlds a task may name."""
     worlds = list_worlds(settings.worlds_dir)
     return WorldsPublic(data=worlds, count=len(worlds))
+
+
+@router.get("/strategies")
+def read_strategies() -> StrategiesPublic:
+    """The search strategies a task may name, with their options and defaults."""
+    from avs_planner.episode.validate import strategies
+
+    data = [StrategyPublic.model_validate(s) for s in strategies()]
+    return StrategiesPublic(data=data, count=len(data))
 
 
 @router.get("/health", responses={503: {"model": Message, "description": "not ready"}})

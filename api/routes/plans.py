@@ -1,41 +1,95 @@
-"""/plans: plan a probabilistic PDDL problem (the same planner `avs plan` runs)."""
+"""/plans: plan a probabilistic PDDL problem (the same planner `avs plan` runs), waiting for the
+answer or (`?wait=false`) as an asynchronous job to poll."""
 
 from __future__ import annotations
 
-from fastapi import APIRouter, HTTPException, status
+from collections.abc import Callable
+from typing import Annotated, Any
+
+from fastapi import APIRouter, HTTPException, Path, Query, Request, Response, status
 
 from api.deps import ManagerDep, SettingsDep, WriteAccess
-from api.routes.jobs import pddl_422, run_job
-from api.schemas import Message, PlanCreate, PlanPublic
+from api.manager import QueueFullError, TaskManager
+from api.plan_jobs import PlanJobs
+from api.routes.jobs import pddl_422, queue_full, run_job
+from api.schemas import TOO_LARGE, Message, PlanCreate, PlanJobPublic, PlanPublic
 
 router = APIRouter(prefix="/plans", tags=["plans"])
 
 PLANNER_SHARE = 0.8  # of the job's wall-clock limit; the rest is reading and grounding
+JobId = Annotated[str, Path(max_length=64, description="a plan job id")]
+_ERRORS: dict[int | str, dict[str, Any]] = {
+    401: {"model": Message}, 429: {"model": Message}, 503: {"model": Message},
+}
 
 
-@router.post(
-    "",
-    responses={
-        401: {"model": Message}, 422: {"model": Message, "description": "bad input or PDDL"},
-        429: {"model": Message}, 503: {"model": Message}, 504: {"model": Message},
-    },
-)
-async def create_plan(
-    body: PlanCreate, owner: WriteAccess, manager: ManagerDep, settings: SettingsDep
-) -> PlanPublic:
-    """Plan: 200 with status (solved, unsolvable, timeout, ...) and the plan; 422 for bad PDDL.
-
-    The planner's own timeout is capped below the job's wall-clock limit, so a long search
-    ends as status `timeout` rather than a killed job (504)."""
+def _payload(body: PlanCreate, settings: SettingsDep) -> dict[str, Any]:
     options = body.model_dump(include={"reward", "weight", "timeout_s", "patience"},
                               exclude_none=True)
     cap = settings.plan_time_limit_s * PLANNER_SHARE
     options["timeout_s"] = min(options.get("timeout_s", cap), cap)
-    payload = {"domain_text": body.domain, "problem_text": body.problem, "options": options}
-    value = await run_job(manager, "plan", payload)
+    return {"domain_text": body.domain, "problem_text": body.problem, "options": options}
+
+
+async def _plan(manager: TaskManager, payload: dict[str, Any], request: Request | None = None,
+                on_start: Callable[[], bool] = lambda: True) -> PlanPublic:
+    disconnected = request.is_disconnected if request is not None else None
+    value = await run_job(manager, "plan", payload, disconnected, on_start)
     if value.get("status") == "invalid":
         raise pddl_422(value.get("errors", []))
     if value.get("status") == "unsupported":
         detail = f"the planner cannot handle this problem: {value.get('message')}"
         raise HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, detail=detail)
     return PlanPublic.model_validate(value)
+
+
+@router.post(
+    "",
+    responses={
+        **_ERRORS, **TOO_LARGE,
+        202: {"model": PlanJobPublic, "description": "wait=false: the job, queued"},
+        422: {"model": Message, "description": "bad input or PDDL"}, 504: {"model": Message},
+    },
+)
+async def create_plan(
+    body: PlanCreate, owner: WriteAccess, manager: ManagerDep, settings: SettingsDep,
+    request: Request, response: Response,
+    wait: Annotated[bool, Query(description="false: answer 202 at once with a job to poll "
+                                            "at /v1/plans/{id}")] = True,
+) -> PlanPublic | PlanJobPublic:
+    """Plan: 200 with status (solved, unsolvable, timeout, ...) and the plan; 422 for bad PDDL.
+
+    The planner's own timeout is capped below the job's wall-clock limit, so a long search
+    ends as status `timeout` rather than a killed job (504). A client that disconnects has its
+    job cancelled. With `wait=false` the answer is 202 and a job id: the job's `result` (or
+    `error`, with the status the waiting call would have had) appears at `GET /v1/plans/{id}`."""
+    payload = _payload(body, settings)
+    if wait:
+        return await _plan(manager, payload, request)
+    jobs: PlanJobs = request.app.state.plan_jobs
+    try:
+        job = jobs.start(owner, lambda started: _plan(manager, payload, on_start=started))
+    except QueueFullError as exc:
+        raise queue_full(exc) from exc
+    response.status_code = status.HTTP_202_ACCEPTED
+    response.headers["Location"] = f"/v1/plans/{job.id}"
+    return job
+
+
+@router.get("/{job_id}", responses={404: {"model": Message}})
+async def read_plan_job(job_id: JobId, request: Request) -> PlanJobPublic:
+    """An asynchronous plan job: its state, then its `result` or `error`."""
+    job = request.app.state.plan_jobs.get(job_id)
+    if job is None:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, detail=f"no plan job with id {job_id}")
+    return job
+
+
+@router.delete("/{job_id}", responses={**_ERRORS, 404: {"model": Message}})
+async def cancel_plan_job(job_id: JobId, owner: WriteAccess, request: Request) -> PlanJobPublic:
+    """Cancel an asynchronous plan job (its worker is freed at once); an ended job is returned
+    as it is."""
+    job = request.app.state.plan_jobs.cancel(job_id)
+    if job is None:
+        raise HTTPException(status.HTTP_404_NOT_FOUND, detail=f"no plan job with id {job_id}")
+    return job

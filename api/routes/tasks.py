@@ -8,19 +8,30 @@ import json
 from collections.abc import AsyncIterable
 from typing import Annotated
 
-from fastapi import APIRouter, Header, HTTPException, Query, Response, status
+from fastapi import APIRouter, Header, HTTPException, Query, Request, Response, status
 from fastapi.responses import FileResponse
 from fastapi.sse import EventSourceResponse, ServerSentEvent
 
-from api.deps import ManagerDep, SettingsDep, StoreDep, TaskDep, TaskId, WriteAccess
+from api.deps import (
+    ManagerDep,
+    SettingsDep,
+    StoreDep,
+    TaskCheckerDep,
+    TaskDep,
+    TaskId,
+    WriteAccess,
+)
 from api.manager import IdempotencyConflictError, NotCancellableError, QueueFullError
-from api.schemas import Message, TaskCreate, TaskPublic, TasksPublic, TaskState
+from api.schemas import TOO_LARGE, Message, TaskCreate, TaskPublic, TasksPublic, TaskState
 from api.store import TaskRecord
-from api.worlds import list_worlds, world_file_problem
+from api.worlds import world_file_problem, world_files, world_path
 
 router = APIRouter(prefix="/tasks", tags=["tasks"])
 
 _EVENT_POLL_S = 0.2
+_RETRY_MS = 5000
+_SHUTDOWN = {"type": "shutdown", "message": "the service is stopping; reconnect with "
+             "Last-Event-ID set to the last id received to resume"}
 _ERRORS = {
     401: {"model": Message, "description": "missing or wrong X-API-Key"},
     429: {"model": Message, "description": "rate limit exceeded"},
@@ -35,32 +46,40 @@ def to_public(task: TaskRecord, full: bool = True) -> TaskPublic:
     return TaskPublic(
         id=task.id, state=task.state, request=request, created_at=task.created_at,
         started_at=task.started_at, finished_at=task.finished_at, summary=task.result,
-        error=task.error, events=task.events,
+        error=task.error, events=task.events, attempts=task.attempts,
     )
 
 
-def _invalid(field: str, message: str) -> HTTPException:
-    """A 422 shaped like FastAPI's own validation errors, naming the field."""
-    detail = [{"type": "value_error", "loc": ["body", field], "msg": message}]
+def _invalid(problems: list[tuple[str, str]], where: str = "body") -> HTTPException:
+    """A 422 shaped like FastAPI's own validation errors, naming each field."""
+    detail = [{"type": "value_error", "loc": [where, field], "msg": message}
+              for field, message in problems]
     return HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, detail=detail)
 
 
-def _check_world(body: TaskCreate, settings: SettingsDep) -> None:
+def _check_task(body: TaskCreate, request: dict, settings: SettingsDep,
+                checker: TaskCheckerDep) -> None:
+    """422 for a task that could never run: unknown world, then whatever the checker finds."""
+    path = None
     if body.world_file is not None:
         problem = world_file_problem(body.world_file)
         if problem:
-            raise _invalid("world_file", problem)
-        return
-    names = [w.name for w in list_worlds(settings.worlds_dir)]
-    if body.world not in names:
-        known = ", ".join(names) or "none installed"
-        raise _invalid("world", f"unknown world {body.world!r}; built-in worlds: {known}")
+            raise _invalid([("world_file", problem)])
+    else:
+        path = world_path(settings.worlds_dir, str(body.world))
+        if path is None:
+            known = ", ".join(f.stem for f in world_files(settings.worlds_dir)) or "none"
+            raise _invalid([("world", f"unknown world {body.world!r}; built-in worlds: {known}")])
+    if checker is not None:
+        problems = checker(request, path)
+        if problems:
+            raise _invalid([(p.field, p.message) for p in problems])
 
 
 @router.post(
     "",
     status_code=status.HTTP_202_ACCEPTED,
-    responses={**_ERRORS, 503: {"model": Message, "description": "queue full"}},
+    responses={**_ERRORS, **TOO_LARGE, 503: {"model": Message, "description": "queue full"}},
 )
 def create_task(
     body: TaskCreate,
@@ -68,19 +87,20 @@ def create_task(
     owner: WriteAccess,
     manager: ManagerDep,
     settings: SettingsDep,
-    idempotency_key: Annotated[str | None, Header(max_length=200)] = None,
+    checker: TaskCheckerDep,
+    idempotency_key: Annotated[str | None, Header(min_length=1, max_length=200)] = None,
 ) -> TaskPublic:
-    """Queue a search for `target`; 202 with the task (poll it or stream its events)."""
-    _check_world(body, settings)
+    """Queue a search for `target`; 202 with the task (poll it or stream its events).
+
+    422 when any field is wrong, checked now against the world and the knowledge base."""
     request = body.model_dump(mode="json")
+    _check_task(body, request, settings, checker)
     digest = hashlib.sha256(json.dumps(request, sort_keys=True).encode()).hexdigest()
     try:
         submission = manager.submit(request, owner, idempotency_key, digest)
     except IdempotencyConflictError as exc:
-        raise HTTPException(
-            status.HTTP_422_UNPROCESSABLE_CONTENT,
-            detail=f"Idempotency-Key {exc} was already used with a different request body",
-        ) from exc
+        message = f"Idempotency-Key {exc} was already used with a different request body"
+        raise _invalid([("idempotency-key", message)], where="header") from exc
     except QueueFullError as exc:
         raise HTTPException(
             status.HTTP_503_SERVICE_UNAVAILABLE, detail=f"task queue is full ({exc}); retry later",
@@ -132,11 +152,17 @@ def cancel_task(task_id: TaskId, owner: WriteAccess, manager: ManagerDep) -> Tas
 async def stream_events(
     task: TaskDep,
     store: StoreDep,
+    request: Request,
     last_event_id: Annotated[int | None, Header(alias="Last-Event-ID", ge=0, le=2**62)] = None,
 ) -> AsyncIterable[ServerSentEvent]:
-    """The task's events as Server-Sent Events, from after `Last-Event-ID`; ends with the task."""
+    """The task's events as Server-Sent Events, from after `Last-Event-ID`; ends with the task,
+    or with a `shutdown` event (no id) when the service stops: reconnect with Last-Event-ID."""
     after = last_event_id or 0
+    draining = request.app.state.draining
     while True:
+        if draining.is_set():
+            yield ServerSentEvent(data=_SHUTDOWN, event="shutdown", retry=_RETRY_MS)
+            return
         events = store.events_after(task.id, after)
         for event in events:
             after = event.seq

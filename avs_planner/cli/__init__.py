@@ -5,13 +5,16 @@ Subcommands live in sibling modules of this package; each module defines
 taking the parsed args and returning an exit code). Modules are discovered, so adding a
 subcommand never edits this file.
 
-Exit codes: 0 ok, 1 bad input, 2 no plan / unsolvable, 3 timeout, 4 internal error.
+Exit codes: 0 ok, 1 bad input, 2 no plan / unsolvable, 3 timeout, 4 internal error,
+5 `avs serve`: the data dir is in use by another live instance, 141 the reader of the output
+went away (e.g. `avs plan --json | head`), silently, as a SIGPIPE'd Unix tool does.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import pkgutil
 import sys
 from collections.abc import Sequence
@@ -24,6 +27,7 @@ EXIT_BAD_INPUT = 1
 EXIT_NO_PLAN = 2
 EXIT_TIMEOUT = 3
 EXIT_INTERNAL = 4
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE
 
 
 class _Parser(argparse.ArgumentParser):
@@ -63,6 +67,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except AvsError as exc:
         print(f"avs: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except BrokenPipeError:
+        _silence_stdout()
+        return EXIT_BROKEN_PIPE
     except KeyboardInterrupt:
         print("avs: interrupted", file=sys.stderr)
         return 130
@@ -70,6 +77,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"avs: internal error: {type(exc).__name__}: {exc}", file=sys.stderr)
         print("avs: this is a bug; please report it with the command you ran.", file=sys.stderr)
         return EXIT_INTERNAL
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush does not fail again."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+    finally:
+        os.close(devnull)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import logging
 import os
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -12,6 +13,8 @@ from avs_planner.errors import AvsError
 
 if TYPE_CHECKING:
     from api.config import Settings
+
+EXIT_DATA_DIR_BUSY = 5  # another live `avs serve` holds the data dir's lock
 
 
 class ServeError(AvsError):
@@ -55,8 +58,20 @@ def run(args: argparse.Namespace) -> int:
             f"refusing to listen on {settings.host} without an API key: set AVS_API_KEY "
             "(clients send it in X-API-Key) or use a loopback host such as 127.0.0.1"
         )
-    _check_data_dir(settings)
-    return _serve(settings, args.log_level)
+    from api import lock
+
+    try:
+        held = lock.acquire(settings.data_dir)  # before anything touches the store
+    except lock.DataDirBusyError as exc:
+        print(f"avs: error: {exc}", file=sys.stderr)
+        return EXIT_DATA_DIR_BUSY
+    except OSError as exc:
+        raise ServeError(f"cannot use data dir {settings.data_dir}: {exc}") from exc
+    try:
+        _check_data_dir(settings)
+        return _serve(settings, args.log_level)
+    finally:
+        lock.release(held)
 
 
 def _check_data_dir(settings: Settings) -> None:
@@ -72,13 +87,17 @@ def _check_data_dir(settings: Settings) -> None:
 
 
 def _serve(settings: Settings, log_level: str) -> int:
-    import uvicorn
-
     from api.main import create_app
+    from api.server import bind, serve
 
+    try:
+        sock = bind(settings.host, settings.port)
+    except OSError as exc:
+        raise ServeError(f"cannot listen on {settings.host}:{settings.port}: {exc}") from exc
     logging.basicConfig(level=log_level.upper(), format="%(levelname)s %(name)s: %(message)s")
     app = create_app(settings)
     print(f"avs: serving on http://{settings.host}:{settings.port} (docs at /docs, data in "
           f"{settings.data_dir}, pid {os.getpid()})", flush=True)
-    uvicorn.run(app, host=settings.host, port=settings.port, log_level=log_level)
+    with sock:
+        serve(app, settings, sock, log_level)
     return 0

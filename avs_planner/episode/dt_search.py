@@ -89,14 +89,8 @@ class ViewConeSearch:
             return near and top + low <= seen.position[2] <= top + high
         if self.ex.mind.room_at(seen.position[:2]) != location:
             return False
-        return not self._known(seen)
+        return not self.ex.known_near(seen)  # not a desk it found before
 
-    def _known(self, seen: SeenLike) -> bool:
-        """A detection of an object the mind already knows (a room search for another desk
-        must not confirm the desk it found before)."""
-        reach = self.ex.config.same_object
-        return any(obj.label == seen.label and math.dist(obj.position[:2], seen.position[:2])
-                   <= reach for obj in self.ex.mind.objects.values())
 
     def _conclude(self, result, label: str, relation: str, location: str,  # noqa: ANN001
                   made: ConeSet) -> StepOutcome:

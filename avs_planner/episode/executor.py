@@ -15,10 +15,11 @@ from typing import Any
 import numpy as np
 
 from avs_planner.cp.search import PlanStep
+from avs_planner.cp.task import Atom
 from avs_planner.dt import DetectorModel
 from avs_planner.episode.dt_search import ViewConeSearch
-from avs_planner.episode.mind import Mind
-from avs_planner.episode.outcome import StepOutcome, StepStatus
+from avs_planner.episode.mind import KnownObject, Mind
+from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
 from avs_planner.episode.state_builder import AvsState, StateBuilder
 from avs_planner.episode.viewcones import CameraModel, ConeSet, room_cones, support_cones
 from conceptual_map.errors import MapError
@@ -51,6 +52,10 @@ class ExecutorConfig:
     same_object: float = 1.0  # m: a detection this near a known object of its label is it
     above_support: tuple[float, float] = (-0.15, 0.45)  # m around the support's top
     doorway_clearance: float = 0.6  # m from a mapped door: no place classification there
+    # a target seen outside a DT search (while moving; the baselines) is reported only when
+    # this many of the next frames see it again at the same spot
+    confirm_needed: int = 2
+    confirm_frames: int = 3
 
 
 @dataclass
@@ -76,22 +81,30 @@ class Executor:
         self.cones: dict[tuple[str, str, str], ConeSet] = {}
         self.found_sids: dict[str, int] = {}
         self.stats = Stats()
+        self.watching = True  # the detector looks for the target as the robot moves
+        self.seen_while_moving: dict[str, set[Atom]] = {}
+        self._unplaced: list[SeenLike] = []
 
     # ---- sensing along the way --------------------------------------------------------------
 
     def look_around(self) -> None:
         """Scan, turn half round, scan again: the first view of a place (the place map is
-        updated once, after both scans)."""
+        updated once, after both scans); the detector watches both ways."""
         self.mind.integrate(self.robot.scan())
+        self.watch()
         self.robot.turn_to(self.robot.pose[2] + math.pi)
-        self._sense([self.robot.pose])
+        self._sense([self.robot.pose], watch=True)
 
-    def _sense(self, poses: list[tuple[float, float, float]]) -> None:
+    def _sense(self, poses: list[tuple[float, float, float]], watch: bool = False) -> None:
         before = self.mind.place_map.current_place
         events = self.mind.sense(self.robot.scan(), poses, self.robot.clock)
         place = self.mind.place_map.current_place
         if place is not None and (place != before or place not in self.mind.classified):
             self._classify()
+        if watch or (place is not None and place != before):
+            self.watch()
+        if self._unplaced:
+            self._place_seen()
         if events:
             kinds: dict[str, int] = {}
             for e in events:
@@ -99,6 +112,70 @@ class Executor:
                 kinds[key] = kinds.get(key, 0) + 1
             self.emit("belief", map_events=kinds)
         self._record_pose()
+
+    def watch(self) -> KnownObject | None:
+        """Keep the detector on while moving: look ahead for the target (a second frame must
+        repeat a detection); a new confirmed target becomes a known object whose atoms reach
+        the monitor with the next step's outcome (it may match a virtual object)."""
+        if not self.watching:
+            return None
+        label = self.builder.task.target
+        self.robot.look(0.0, self._ahead_tilt)
+        first = [s for s in self.robot.detect([label]) if s.label == label]
+        if not first or self.known_near(first[0]):
+            return None
+        seen = first[0]
+        again = self.confirm(seen)
+        self.emit("observation", label=label, detected=bool(again), watching=True,
+                  position=[round(v, 2) for v in seen.position])
+        if not again:
+            return None
+        self._unplaced.append(seen)
+        return self._place_seen()
+
+    def confirm(self, seen: SeenLike) -> bool:
+        """`confirm_needed` more frames (of up to `confirm_frames`) see the label again within
+        `agree` metres. Without the DT's belief, a report rests on this: a phantom (5% of
+        frames, anywhere in view) that repeats twice at the same spot is practically never
+        seen, while a real object missed in 1 frame of 5 still passes 9 times in 10."""
+        agree, cfg = self.config.agree[0], self.config
+        hits = 0
+        for k in range(cfg.confirm_frames):
+            if any(s.label == seen.label and math.dist(s.position, seen.position) <= agree
+                   for s in self.robot.detect([seen.label])):
+                hits += 1
+            if hits >= cfg.confirm_needed:
+                return True
+            if hits + cfg.confirm_frames - k - 1 < cfg.confirm_needed:
+                return False
+        return False
+
+    def _place_seen(self) -> KnownObject | None:
+        """Confirmed detections become known objects once the place map has a room for them
+        (the very first look comes before the first place)."""
+        obj = None
+        for seen in list(self._unplaced):
+            if self.mind.room_at(seen.position[:2]) is None:
+                continue
+            self._unplaced.remove(seen)
+            obj = self.mind.add_object(seen.label, seen.position)
+            self.found_sids[obj.id] = seen.id
+            self.seen_while_moving[obj.id] = {
+                ("label-of", obj.id, seen.label), ("detected", obj.id),
+                ("related", obj.id, "in", obj.room)}
+        return obj
+
+    def known_near(self, seen: SeenLike) -> bool:
+        """A detection of an object the mind already knows (same label, within
+        `same_object` metres)."""
+        reach = self.config.same_object
+        return any(obj.label == seen.label and math.dist(obj.position[:2], seen.position[:2])
+                   <= reach for obj in self.mind.objects.values())
+
+    @property
+    def _ahead_tilt(self) -> float:
+        return -math.atan2(self.camera.height - self.camera.support_height,
+                           self.camera.look_distance)
 
     def _classify(self) -> None:
         """Ask the place classifier, unless the robot stands in a doorway (it would see the
@@ -127,7 +204,16 @@ class Executor:
 
     def run(self, step: PlanStep, state: AvsState,
             assumed: dict[str, str] | None = None) -> StepOutcome:
-        """Execute one step; `assumed` maps rooms to the category the plan assumes for them."""
+        """Execute one step; `assumed` maps rooms to the category the plan assumes for them.
+        Targets the detector confirmed on the way come back in the outcome's `observed`."""
+        outcome = self._run(step, state, assumed)
+        if self.seen_while_moving:
+            outcome.observed = {**self.seen_while_moving, **outcome.observed}
+            self.seen_while_moving = {}
+        return outcome
+
+    def _run(self, step: PlanStep, state: AvsState,
+             assumed: dict[str, str] | None = None) -> StepOutcome:
         name = step.name.lower()
         if name == "move":
             return self.move(step.args[1], state)

@@ -45,6 +45,9 @@ class LoopConfig:
     # before giving up, room categories believed below this are doubted once (see
     # SwitchingLoop._doubt_categories); the state builder's own threshold is 0.9
     doubt_category: float = 0.999
+    # the detector looks for the target as the robot drives (Executor.watch); False searches
+    # only through the DT's view cones, as the seed's system did
+    watch: bool = True
 
 
 class SwitchingLoop:
@@ -61,6 +64,7 @@ class SwitchingLoop:
         self.visited_rooms: set[str] = set()
 
     def run(self) -> SearchResult:
+        self.executor.watching = self.config.watch
         self.executor.look_around()
         state = self.builder.build()
         self.planner = ContinualPlanner(state.skeleton(), self._options(),

@@ -8,8 +8,10 @@ from avs_planner.episode.outcome import StepStatus
 
 
 def explore(executor: Executor, max_moves: int = 60) -> int:
-    """Visit placeholders nearest-first; returns how many drives were made."""
+    """Visit placeholders nearest-first; returns how many drives were made. The robot is not
+    searching yet (seed 003: driven by joystick), so its detector does not watch."""
     mind = executor.mind
+    executor.watching = False
     executor.look_around()
     moves = 0
     while moves < max_moves:
@@ -24,4 +26,5 @@ def explore(executor: Executor, max_moves: int = 60) -> int:
         if outcome.status is StepStatus.DONE:
             executor.look_around()
     mind.tried_placeholders.clear()
+    executor.watching = True
     return moves

@@ -14,9 +14,8 @@ def generated_targets(seed: int, style: str = "office", rooms: int | None = None
                       present: int = 2, absent: int = 1, surprise: float = 0.25
                       ) -> list[tuple[str, bool]]:
     """(label, present in the world) for a benchmark on the generated world `seed`."""
-    from sim.generate import generate_world
-
     from sim.errors import SimError
+    from sim.generate import generate_world
 
     try:
         world = generate_world(seed, style, rooms, surprise)

@@ -3,7 +3,13 @@
 from conceptual_map.metric.errors import PathQueryError, SensorDataError
 from conceptual_map.metric.grid2d import OccupancyGrid
 from conceptual_map.metric.logodds import CellState, SensorModel, UpdateSummary
-from conceptual_map.metric.path_planning import PathResult, PathStatus, distance_field, plan_path
+from conceptual_map.metric.path_planning import (
+    PathResult,
+    PathStatus,
+    distance_field,
+    distance_fields,
+    plan_path,
+)
 from conceptual_map.metric.sensors import DepthFrameLike, LaserScanLike, Rays
 from conceptual_map.metric.voxels import VoxelMap
 
@@ -21,5 +27,6 @@ __all__ = [
     "UpdateSummary",
     "VoxelMap",
     "distance_field",
+    "distance_fields",
     "plan_path",
 ]

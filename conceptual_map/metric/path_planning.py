@@ -207,6 +207,27 @@ def distance_field(
     return dist.reshape(grid.shape)
 
 
+def distance_fields(
+    grid: OccupancyGrid,
+    starts: list[tuple[float, float]],
+    robot_radius: float = 0.25,
+    allow_unknown: bool = False,
+) -> np.ndarray:
+    """`distance_field` from several starts at once (k, rows, cols): one graph, one C call."""
+    cells = [grid.cell_of(s) for s in starts]
+    for s, cell in zip(starts, cells, strict=True):
+        if not grid.contains(cell):
+            raise PathQueryError(f"start ({s[0]:.2f}, {s[1]:.2f}) is outside the map")
+    mask = grid.traversable(robot_radius, allow_unknown)
+    for cell in cells:
+        if not mask[cell]:
+            mask = mask | _escape_zone(grid, cell, robot_radius)
+    graph = _grid_graph(mask) * grid.resolution
+    sources = [i * grid.shape[1] + j for i, j in cells]
+    dist = csgraph.dijkstra(graph, indices=sources)
+    return dist.reshape((len(starts),) + grid.shape)
+
+
 def _grid_graph(mask: np.ndarray) -> sparse.csr_matrix:
     rows, cols = mask.shape
     index = np.arange(rows * cols).reshape(rows, cols)

@@ -88,6 +88,14 @@ class VoxelMap(LogOddsGrid):
             keep |= border & (self.states()[index] == CellState.UNKNOWN)
         return self.to_world(cells[keep])
 
+    def cells_in_box(self, lo: tuple[float, ...], hi: tuple[float, ...]) -> np.ndarray:
+        """Integer coordinates (N, 3) of the cells whose centres lie in the box [lo, hi]."""
+        return self._box_cells(lo, hi)
+
+    def states_at(self, flat: np.ndarray) -> np.ndarray:
+        """CellState (uint8) of the cells with the given flat indices."""
+        return self._classify(self.logodds.reshape(-1)[np.asarray(flat, dtype=np.int64)])
+
     def _cells_in_state(self, lo: tuple[float, ...], hi: tuple[float, ...], state: int):
         cells = self._box_cells(lo, hi)
         if cells.shape[0] == 0:

@@ -12,7 +12,7 @@ class PlaceMapConfig:
     place_spacing: float = 1.0  # a new place once the robot is this far from every place
     robot_radius: float = 0.25  # for reachability and straight-line edges
     edge_max_length: float = 1.6  # straight-line edges between places up to this long
-    door_max_width: float = 1.1  # openings narrower than this are door hypotheses
+    door_max_width: float = 1.5  # openings narrower than this are door hypotheses
     door_min_width: float = 0.5
     door_max_depth: float = 0.35  # a door is a short narrowing (a wall), not a narrow corridor
     door_merge_distance: float = 0.5
@@ -22,6 +22,10 @@ class PlaceMapConfig:
     min_open_space: float = 0.5  # m^2 of unknown behind a frontier for a placeholder
     open_space_radius: float = 3.0
     placeholder_match_distance: float = 1.0
+    # free space beyond a mapped door from every place, or this far from all places, is
+    # unvisited; a region of at least this area is a placeholder (a room seen, not entered)
+    visit_radius: float = 3.0
+    min_unvisited_area: float = 1.5
     trajectory_step: float = 0.05
 
     def __post_init__(self) -> None:

@@ -2,9 +2,9 @@
 
 At each probe point, chords through the point are probed in many directions up to the first
 occupied cell. The shortest chord is the opening's width across; it is a door when it is
-narrower than ~1.1 m, widens again a wall's thickness before and after (a narrow corridor or
-a gap beside a long piece of furniture stays narrow for longer), and its jambs continue as
-walls along the chord's line.
+narrower than ~1.5 m (double doors included), widens again a wall's thickness before and after
+(a narrow corridor or a gap beside a long piece of furniture stays narrow for longer), and its
+jambs continue as walls along the chord's line.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ from conceptual_map.metric.logodds import CellState
 from conceptual_map.places.config import PlaceMapConfig
 
 _EIGHT = np.ones((3, 3), dtype=bool)
-_STANDPOINT_MARGIN = 0.1  # prefer standpoints this far beyond the robot radius from obstacles
+STANDPOINT_MARGIN = 0.1  # prefer standpoints this far beyond the robot radius from obstacles
 
 
 @dataclass(frozen=True)
@@ -64,7 +64,7 @@ def frontier_regions(
     labels, _ = ndimage.label(frontier, structure=_EIGHT)
     sizes = np.bincount(labels.ravel())
     unknown_labels, _ = ndimage.label(grid.state_grid() == CellState.UNKNOWN)
-    roomy = reachable & (grid.clearance() >= config.robot_radius + _STANDPOINT_MARGIN)
+    roomy = reachable & (grid.clearance() >= config.robot_radius + STANDPOINT_MARGIN)
     offset = np.array([window[0].start, window[1].start])
     regions = []
     for k, box in enumerate(ndimage.find_objects(labels), start=1):
@@ -99,7 +99,7 @@ def _describe(
     window = int(np.ceil(2 * config.reach_tolerance / grid.resolution))
     stand = None
     for mask in stand_masks:
-        stand = _nearest_true(mask, medoid, window)
+        stand = nearest_true(mask, medoid, window)
         if stand is not None:
             break
     if stand is None:
@@ -115,7 +115,7 @@ def _describe(
     )
 
 
-def _nearest_true(mask: np.ndarray, cell: np.ndarray, radius: int) -> np.ndarray | None:
+def nearest_true(mask: np.ndarray, cell: np.ndarray, radius: int) -> np.ndarray | None:
     """The True cell of `mask` nearest to `cell` within a square window of `radius` cells."""
     i0, j0 = max(cell[0] - radius, 0), max(cell[1] - radius, 0)
     found = np.argwhere(mask[i0 : cell[0] + radius + 1, j0 : cell[1] + radius + 1])

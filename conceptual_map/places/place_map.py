@@ -28,6 +28,7 @@ from conceptual_map.places.model import (
 )
 from conceptual_map.places.rooms import free_regions, place_groups, room_geometry
 from conceptual_map.places.tracking import match_by_distance, match_by_overlap
+from conceptual_map.places.unvisited import unvisited_regions
 
 Pose = tuple[float, float, float]
 
@@ -256,6 +257,11 @@ class PlaceMap:
         self, grid: OccupancyGrid, robot: tuple[float, float], time: float
     ) -> list[MapEvent]:
         regions = frontier_regions(grid, robot, self.config) if self.places else []
+        regions += unvisited_regions(
+            grid, robot, [p.position for p in self.places.values()],
+            [d.ends for d in self.doors.values()], self.config,
+            covered=[r.standpoint for r in regions],
+        )
         old = {k: v.frontier_centre for k, v in self.placeholders.items()}
         matched = match_by_distance(
             old, [r.centre for r in regions], self.config.placeholder_match_distance

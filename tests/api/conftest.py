@@ -31,7 +31,7 @@ def make_settings(tmp_path: Path) -> Callable[..., Settings]:
             "data_dir": tmp_path / "data", "worlds_dir": worlds, "workers": 1,
             "plan_workers": 1, "episode_runner": FAKE_RUNNER, "cancel_grace_s": 0.5,
             "api_key": None, "memory_limit_mb": 0,
-            "preload_planner": False, "warm_workers": False,
+            "preload_planner": False, "warm_workers": False, "task_checker": None,
         }
         values.update(overrides)
         return Settings(**values)

@@ -1,7 +1,9 @@
-"""Property test over the OpenAPI schema (schemathesis): no generated request gets a 5xx.
+"""Property test over the OpenAPI schema (schemathesis): no generated request gets a 5xx or a
+status code its operation does not document.
 
 Valid (positive) and invalid (negative) requests for every operation, plus the task routes on
-a real task id. The default run is small; `-m slow` runs a larger one.
+real tasks in several states (ended, running, queued), so their life cycle is fuzzed too. The
+default run is small; `-m slow` runs a larger one.
 """
 
 from __future__ import annotations
@@ -29,7 +31,8 @@ def _fuzz_all(make_settings: Callable[..., Settings], examples: int) -> tuple[li
     failures: list[str] = []
     sent = [0]
     with TestClient(app) as client:
-        task = client.post("/v1/tasks", json={"target": "quick", "world": "office"}).json()
+        tasks = [client.post("/v1/tasks", json={"target": target, "world": "office"}).json()
+                 for target in ("quick", "slow", "ticker")]
         for result in schema.get_all_operations():
             operation = result.ok()
             for mode in MODES:
@@ -37,9 +40,8 @@ def _fuzz_all(make_settings: Callable[..., Settings], examples: int) -> tuple[li
                     _fuzz(client, operation.as_strategy(mode), failures, sent, examples)
                 except Unsatisfiable:  # nothing to make invalid (e.g. GET /health)
                     assert mode is schemathesis.GenerationMode.NEGATIVE
-            if "{task_id}" in operation.path:
-                ids = {"task_id": task["id"]}
-                strategy = operation.as_strategy(path_parameters=ids)
+            for task in tasks if "{task_id}" in operation.path else ():
+                strategy = operation.as_strategy(path_parameters={"task_id": task["id"]})
                 _fuzz(client, strategy, failures, sent, examples)
     return failures, sent[0]
 
@@ -58,9 +60,11 @@ def _fuzz(
             kwargs["content"] = kwargs.pop("data")
         response = client.request(**kwargs)
         sent[0] += 1
-        if response.status_code >= 500:
-            failures.append(f"{case.method} {case.formatted_path} -> {response.status_code}: "
-                            f"{response.text[:300]}\n  {kwargs}")
+        documented = set(case.operation.definition.raw.get("responses", {}))
+        if response.status_code >= 500 or str(response.status_code) not in documented:
+            failures.append(f"{case.method} {case.formatted_path} -> {response.status_code} "
+                            f"(documented: {sorted(documented)}): {response.text[:300]}\n"
+                            f"  {kwargs}")
 
     run()
 

@@ -61,15 +61,21 @@ def _call(url: str, body: dict | None = None) -> dict:
         return json.loads(response.read())
 
 
-@contextmanager
-def _server(data_dir: Path, port: int) -> Iterator[subprocess.Popen[bytes]]:
-    env = {**os.environ, "AVS_EPISODE_RUNNER": FAKE_RUNNER, "AVS_PRELOAD_PLANNER": "false",
-           "AVS_WORLDS_DIR": str(data_dir / "worlds"),
-           "AVS_WORKERS": "1", "AVS_PLAN_WORKERS": "1"}
-    env.pop("AVS_API_KEY", None)
+def serve_command(data_dir: Path, port: int, **env: str) -> tuple[list[str], dict[str, str]]:
+    """`avs serve` on `data_dir` with the fake runner and no task checker, and its environment."""
+    environ = {**os.environ, "AVS_EPISODE_RUNNER": FAKE_RUNNER, "AVS_PRELOAD_PLANNER": "false",
+               "AVS_WORLDS_DIR": str(data_dir / "worlds"), "AVS_TASK_CHECKER": "",
+               "AVS_WORKERS": "1", "AVS_PLAN_WORKERS": "1", **env}
+    environ.pop("AVS_API_KEY", None)
     command = [sys.executable, "-m", "avs_planner", "serve", "--port", str(port),
                "--data-dir", str(data_dir), "--log-level", "warning"]
-    process = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL,
+    return command, environ
+
+
+@contextmanager
+def _server(data_dir: Path, port: int, **env: str) -> Iterator[subprocess.Popen[bytes]]:
+    command, environ = serve_command(data_dir, port, **env)
+    process = subprocess.Popen(command, env=environ, stdout=subprocess.DEVNULL,
                                stderr=subprocess.DEVNULL)
     try:
         deadline = time.monotonic() + 30
@@ -124,3 +130,27 @@ def test_unusable_data_dir_is_bad_input(tmp_path: Path) -> None:
     (tmp_path / "data" / "avs.sqlite3").write_text("this is not a database, just text " * 100)
     with pytest.raises(serve.ServeError, match="cannot use data dir"):
         serve.run(_args("--data-dir", str(tmp_path / "data")))
+
+
+def test_busy_port_is_bad_input_before_the_app_starts(tmp_path: Path) -> None:
+    """Exit 1 with a message (not uvicorn's 3, which the CLI uses for timeouts)."""
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        with pytest.raises(serve.ServeError, match="cannot listen on 127.0.0.1"):
+            serve.run(_args("--port", str(port), "--data-dir", str(tmp_path / "data")))
+
+
+def test_data_dir_held_by_another_process_exits_5(tmp_path: Path) -> None:
+    holder = subprocess.Popen(
+        [sys.executable, "-c", "import sys, time; from pathlib import Path; from api import lock; "
+         "lock.acquire(Path(sys.argv[1])); print('held', flush=True); time.sleep(60)",
+         str(tmp_path)], stdout=subprocess.PIPE, cwd=Path(__file__).resolve().parents[2])
+    try:
+        assert holder.stdout is not None and holder.stdout.readline() == b"held\n"
+        assert main(["serve", "--data-dir", str(tmp_path), "--port", "0"]) == 5
+        assert not (tmp_path / "avs.sqlite3").exists()  # no recovery ran
+    finally:
+        holder.kill()
+        holder.wait()

@@ -103,7 +103,9 @@ def test_idempotency_key_replays_and_conflicts(client: TestClient) -> None:
     assert first.json()["id"] == second.json()["id"]
     assert second.headers.get("Idempotent-Replayed") == "true"
     conflict = client.post("/v1/tasks", json=task_body("quick", seed=3), headers=headers)
-    assert conflict.status_code == 422 and "Idempotency-Key" in conflict.json()["detail"]
+    assert conflict.status_code == 422
+    error = conflict.json()["detail"][0]
+    assert error["loc"] == ["header", "idempotency-key"] and "already used" in error["msg"]
     assert client.get("/v1/tasks").json()["count"] == 1
 
 

@@ -1,0 +1,104 @@
+"""Task input is checked at submission (issue 22, item 5): each wrong field is a 422 naming it,
+against the real knowledge base, built-in worlds and strategy registry."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from api.config import DEFAULT_TASK_CHECKER, Settings
+from api.main import create_app
+
+Make = Callable[..., Settings]
+GOOD = {"target": "cerealbox", "category": "kitchen", "world": "office"}
+PR2_WORLD = """name: tiny
+size: [6.0, 4.0]
+rooms:
+  - {name: lab, category: office, rect: [0, 0, 6, 4]}
+robot: {model: pr2, start: [1.0, 1.0, 0.0]}
+"""
+
+
+@pytest.fixture(scope="module")
+def client(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestClient]:
+    data = tmp_path_factory.mktemp("checks")
+    settings = Settings(data_dir=data, api_key=None, workers=1, plan_workers=1, queue_size=100,
+                        task_checker=DEFAULT_TASK_CHECKER, preload_planner=False,
+                        warm_workers=False, rate_limit_burst=1000,
+                        episode_runner="tests/api/api_fake_runner.py:run")
+    with TestClient(create_app(settings)) as test_client:
+        yield test_client
+
+
+def _loc(client: TestClient, **fields: Any) -> list[list[Any]]:
+    response = client.post("/v1/tasks", json={**GOOD, **fields})
+    assert response.status_code == 422, response.text
+    return [error["loc"] for error in response.json()["detail"]]
+
+
+@pytest.mark.parametrize(("fields", "loc"), [
+    ({"target": "unicorn"}, ["body", "target"]),
+    ({"category": "attic"}, ["body", "category"]),
+    ({"start_room": "ballroom"}, ["body", "start_room"]),
+    ({"start": [100.0, 100.0, 0.0]}, ["body", "start"]),  # off the map
+    ({"start": [2.0, 6.0, 0.0]}, ["body", "start"]),  # inside table1
+    ({"strategy": "teleport"}, ["body", "strategy"]),
+    ({"strategy_options": {"bogus": 1}}, ["body", "strategy_options"]),
+    ({"strategy_options": {"max_steps": "many"}}, ["body", "strategy_options"]),
+    ({"world": "atlantis"}, ["body", "world"]),
+])
+def test_each_bad_field_is_422_naming_it(client: TestClient, fields: dict, loc: list) -> None:
+    assert loc in _loc(client, **fields)
+
+
+def test_non_finite_start_is_422_not_stored_as_null(client: TestClient) -> None:
+    body = b'{"target": "cerealbox", "world": "office", "start": [NaN, 1.0, 0.0]}'
+    response = client.post("/v1/tasks", content=body,
+                           headers={"Content-Type": "application/json"})
+    assert response.status_code == 422
+    assert response.json()["detail"][0]["loc"] == ["body", "start", 0]
+    inf = client.post("/v1/tasks", content=body.replace(b"NaN", b"Infinity"),
+                      headers={"Content-Type": "application/json"})
+    assert inf.status_code == 422
+
+
+def test_every_problem_is_reported_at_once(client: TestClient) -> None:
+    locs = _loc(client, target="unicorn", category="attic", start_room="ballroom")
+    assert {"target", "category", "start_room"} <= {loc[-1] for loc in locs}
+
+
+def test_inline_world_is_checked_too(client: TestClient) -> None:
+    body = {"target": "cerealbox", "world_file": "name: x\nsize: [1, 1]\n"}
+    response = client.post("/v1/tasks", json=body)
+    assert response.status_code == 422 and response.json()["detail"][0]["loc"] == [
+        "body", "world_file"]
+
+
+def test_good_task_is_accepted_and_keeps_the_worlds_robot(client: TestClient) -> None:
+    accepted = client.post("/v1/tasks", json={**GOOD, "strategy": "exhaustive",
+                                              "strategy_options": {"headings": 4}})
+    assert accepted.status_code == 202, accepted.text
+    assert accepted.json()["request"]["robot"] is None  # the episode takes the world's robot
+    inline = client.post("/v1/tasks", json={"target": "cup", "world_file": PR2_WORLD,
+                                            "start": [3.0, 2.0, 0.0]})
+    assert inline.status_code == 202, inline.text
+    assert inline.json()["request"]["robot"] is None
+
+
+def test_strategies_are_listed(client: TestClient) -> None:
+    names = [s["name"] for s in client.get("/v1/strategies").json()["data"]]
+    assert "switching" in names and "exhaustive" in names
+
+
+def test_default_robot_comes_from_the_world_file(tmp_path: Path) -> None:
+    from avs_planner.episode.robot import load_spec
+    from avs_planner.episode.runner import EpisodeSpec
+
+    world = tmp_path / "tiny.yaml"
+    world.write_text(PR2_WORLD)
+    spec = EpisodeSpec.from_dict({"target": "cup", "world": str(world), "robot": None})
+    assert load_spec(spec.world, spec.robot).robot.model == "pr2"
