@@ -45,7 +45,12 @@ from avs_planner.qsr import (
 )
 from avs_planner.strategies.baselines import explore
 from avs_planner.strategies.context import SearchContext
-from avs_planner.strategies.looking import LOOK_DISTANCE, SUPPORT_HEIGHT, _confirm
+from avs_planner.strategies.looking import (
+    LOOK_DISTANCE,
+    SUPPORT_HEIGHT,
+    _confirm,
+    known_target,
+)
 from conceptual_map.metric import OccupancyGrid
 from conceptual_map.qsr import (
     Landmark,
@@ -217,7 +222,12 @@ class QsrSearch:
     def run(self) -> SearchResult:
         ctx = self.ctx
         start = ctx.robot.clock
-        self.survey()
+        watching = getattr(ctx.executor, "watching", False)
+        ctx.executor.watching = False  # the survey does not look for the target
+        try:
+            self.survey()
+        finally:
+            ctx.executor.watching = watching and self.opt["watch"]
         self.survey_s = ctx.robot.clock - start
         self.search_start = ctx.robot.clock
         self._prepare_mixture()
@@ -257,7 +267,9 @@ class QsrSearch:
                 continue
             ctx.robot.turn_to(best.yaw)
             self.poses += 1
-            found = self.perceive(self.frustums_here(planes.points, density))
+            found = known_target(ctx)  # seen while driving there (option watch)
+            if found is None:
+                found = self.perceive(self.frustums_here(planes.points, density))
             ctx.trace.emit("action", action=f"(view-pose {self.method.value})", status="done",
                            poses=self.poses, search_time_s=round(self.search_time(), 2))
             if found is not None:

@@ -19,6 +19,7 @@ OPTIONS: dict[str, Any] = {
     "survey_headings": 8,  # directions looked at per survey stop
     "depth_columns": 64,  # depth frame size (columns x rows)
     "depth_rows": 48,
+    "watch": False,  # the detector watches for the target while driving to a view pose
     "learn": True,  # after a found object, update the knowledge kept for the next search
     "learn_file": "",  # QSR YAML read at start (when it exists) and written after learning
 }
