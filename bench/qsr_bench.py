@@ -18,7 +18,7 @@ from collections.abc import Callable
 import numpy as np
 
 from avs_planner.body import JointRange, RobotBody
-from avs_planner.qsr import sample_poses, score_cones, select_view
+from avs_planner.qsr import ViewOptions, sample_poses, score_cones, select_view
 from bench import qsr_scene
 from conceptual_map.qsr import build_mixture, extract_supporting_planes, load_qsr
 
@@ -79,6 +79,9 @@ def main(argv: list[str] | None = None) -> int:
     cold_ms = timed(cold, repeats)
     warm_ms = timed(lambda i: select_view(grid, planes.points, density, PIONEER, "qsr", rng=i),
                     repeats)  # fmt: skip
+    occluded = ViewOptions(occlusion=voxels)
+    occluded_ms = timed(lambda i: select_view(grid, planes.points, density, PIONEER, "qsr",
+                                              rng=i, options=occluded), max(3, repeats // 5))
     poses = sample_poses(grid, planes.points, 20, 0.25, 4.0, np.random.default_rng(0))
     half = PIONEER.hfov / 2
     ours_score = timed(lambda i: score_cones(poses, planes.points, density, half, 4.0), repeats)
@@ -97,6 +100,8 @@ def main(argv: list[str] | None = None) -> int:
     rows = [
         ("view selection, 20 poses + 9 frustums (cold)", med(cold_ms), target),
         ("view selection, 20 poses + 9 frustums (warm)", med(warm_ms), target),
+        ("view selection with occlusion (strategies)", med(occluded_ms),
+         "no target (line of sight per pair)"),
         ("eq. 2 scores of 20 cones (numpy)", med(ours_score),
          f"{med(ref_score):.1f} ms literal loop ({med(ref_score) / med(ours_score):.0f}x)"),
         ("supporting-plane extraction", med(plane_ms), "no target"),

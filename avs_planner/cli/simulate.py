@@ -39,6 +39,10 @@ def register(subparsers: Any) -> None:
                         "them all)")
     parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
                         help="a strategy option, e.g. --option reward=800 (repeatable)")
+    parser.add_argument("--qsr", metavar="FILE",
+                        help="QSR descriptions for the qsr strategy: a YAML list (or a mapping "
+                             "with a 'descriptions' list) in the format of "
+                             "conceptual_map/qsr/README.md; default: the built-in knowledge")
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--start-room", help="start at the centre of this room")
     where.add_argument("--start", help="start pose x,y,yaw (metres, radians)")
@@ -50,7 +54,7 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from avs_planner.episode import EpisodeError, run_episode
+    from avs_planner.episode import EpisodeError, EpisodeSpec, run_episode
     from avs_planner.episode.scenarios import load_scenario
 
     try:
@@ -58,6 +62,7 @@ def run(args: argparse.Namespace) -> int:
         if args.scenario:
             base = load_scenario(args.scenario).spec
         spec = _spec(args, base)
+        EpisodeSpec.from_dict(spec)  # bad options or QSR descriptions: exit 1 before the run
     except (EpisodeError, ValueError) as exc:
         print(f"avs: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -91,10 +96,27 @@ def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
         spec["strategy"] = args.strategy
     if args.option:
         spec["strategy_options"] = dict(_option(text) for text in args.option)
+    if args.qsr:
+        spec["qsr"] = _qsr_file(args.qsr)
     if not spec.get("target"):
         raise ValueError("--target LABEL (or --scenario) is required")
     spec["output_dir"] = args.out
     return spec
+
+
+def _qsr_file(path: str) -> Any:
+    """The descriptions of a --qsr file (validated with the episode spec)."""
+    import yaml
+
+    try:
+        data = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise ValueError(f"--qsr {path}: cannot read: {exc.strerror}") from None
+    except yaml.YAMLError as exc:
+        raise ValueError(f"--qsr {path}: YAML error: {exc}") from None
+    if isinstance(data, dict) and "descriptions" in data:
+        data = data["descriptions"]
+    return data
 
 
 def _option(text: str) -> tuple[str, str]:

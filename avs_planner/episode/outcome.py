@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import Enum
-from typing import Protocol
+from typing import Any, Protocol
 
 from avs_planner.cp.task import Atom
 from avs_planner.episode.mind import KnownObject
@@ -26,7 +26,7 @@ class Outcome(Enum):
 @dataclass
 class SearchResult:
     """How a search ended; `plans`, `replans` and `cp_times` stay empty for strategies that
-    do not plan with the CP."""
+    do not plan with the CP; `details` go to the summary under `details`."""
 
     outcome: Outcome
     reason: str
@@ -34,6 +34,7 @@ class SearchResult:
     plans: int = 0
     replans: int = 0
     cp_times: list[float] = field(default_factory=list)
+    details: dict[str, Any] = field(default_factory=dict)  # strategy-specific summary fields
 
 
 class StepStatus(Enum):

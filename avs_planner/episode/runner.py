@@ -33,7 +33,7 @@ Emit = Callable[[dict[str, Any]], None]
 
 _KEYS = {"target", "category", "world", "world_file", "robot", "start_room", "start", "seed",
          "time_budget_s", "wall_budget_s", "task_id", "output_dir", "pre_explore", "dt_policy",
-         "strategy", "strategy_options", "generate"}
+         "strategy", "strategy_options", "generate", "qsr"}
 
 
 @dataclass(frozen=True)
@@ -56,6 +56,8 @@ class EpisodeSpec:
     strategy_options: Mapping[str, Any] = field(default_factory=dict)
     generate: Mapping[str, Any] | None = None  # {seed, style, rooms}: a generated world
     world_text: str | None = field(default=None, repr=False)
+    qsr: Any = field(default=None, repr=False)  # QsrKnowledge with the task's descriptions
+
 
     @classmethod
     def from_dict(cls, spec: Mapping[str, Any]) -> EpisodeSpec:
@@ -88,7 +90,28 @@ class EpisodeSpec:
             output_dir=spec.get("output_dir"), pre_explore=bool(spec.get("pre_explore")),
             dt_policy=str(spec.get("dt_policy") or "pouct"), strategy=strategy.name,
             strategy_options=options, generate=generate, world_text=spec.get("world_file"),
+            qsr=_qsr(spec.get("qsr")),
         )
+
+
+def _qsr(data: Any) -> Any:
+    """The task's QSR descriptions (a list in the format of conceptual_map/qsr/README.md)
+    validated against the default knowledge's relations and landmarks; None when not given."""
+    if data is None:
+        return None
+    from conceptual_map.errors import KnowledgeError
+    from conceptual_map.qsr import load_qsr, parse_descriptions
+
+    if isinstance(data, Mapping) and set(data) == {"descriptions"}:
+        data = data["descriptions"]
+    if not isinstance(data, list) or not data:
+        raise EpisodeError(f"episode spec: 'qsr' must be a non-empty list of QSR descriptions "
+                           f"like [{{target: cup, relations: [right, close], of: keyboard, "
+                           f"count: 1}}], got {data!r}")
+    try:
+        return parse_descriptions(data, load_qsr(), source="episode spec: qsr")
+    except KnowledgeError as exc:
+        raise EpisodeError(str(exc)) from None
 
 
 def _number(value: Any, key: str) -> float:
@@ -135,7 +158,8 @@ class Episode:
             executor=self.executor, trace=self.trace, target=spec.target,
             category=spec.category, time_budget_s=spec.time_budget_s,
             wall_budget_s=spec.wall_budget_s, options=spec.strategy_options,
-            should_stop=should_stop or (lambda: False), dump_dir=spec.output_dir)
+            should_stop=should_stop or (lambda: False), dump_dir=spec.output_dir,
+            qsr=spec.qsr)
 
     def _world_spec(self):  # noqa: ANN202 - sim.WorldSpec
         spec = self.spec
@@ -204,7 +228,7 @@ class Episode:
             "dt_decision_time_s": [round(t, 4) for t in stats.dt_decisions],
             "views_processed": stats.views, "seed": self.spec.seed,
             "world": self.world_spec.name, "robot": self.robot.model,
-            "strategy": self.spec.strategy,
+            "strategy": self.spec.strategy, "details": result.details,
             "wall_time_s": round(self.trace.wall, 2),
         }
 

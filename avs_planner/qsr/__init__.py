@@ -1,6 +1,6 @@
 """QSR view selection (Kunze et al., eq. 2 and Algorithm 1): where to stand and where to look."""
 
-from avs_planner.qsr.geometry import in_frustums, in_view_cones
+from avs_planner.qsr.geometry import in_frustums, in_view_cones, line_of_sight
 from avs_planner.qsr.poses import candidate_cells, reachable, sample_poses
 from avs_planner.qsr.select import (
     Frustum,
@@ -28,6 +28,7 @@ __all__ = [
     "cone_half_angle",
     "in_frustums",
     "in_view_cones",
+    "line_of_sight",
     "rank_frustums",
     "reachable",
     "sample_poses",

@@ -13,12 +13,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from enum import Enum
+from typing import Any
 
 import numpy as np
 
 from avs_planner.body import RobotBody
 from avs_planner.errors import AvsError
-from avs_planner.qsr.geometry import in_frustums, in_view_cones
+from avs_planner.qsr.geometry import in_frustums, in_view_cones, line_of_sight
 from avs_planner.qsr.poses import sample_poses
 from conceptual_map.metric import OccupancyGrid
 
@@ -69,6 +70,7 @@ class ViewOptions:
     max_range: float | None = None
     torso: float = 0.0  # m of torso lift used for the frustums' camera height
     start: tuple[float, float] | None = None  # the robot's position: only poses reachable from it
+    occlusion: Any = None  # a VoxelMap: voxels hidden behind occupied ones are not in view
 
 
 @dataclass(frozen=True)
@@ -98,7 +100,8 @@ def select_view(
     """Algorithm 1: the best of n sampled poses for `method`, and its ranked frustums.
 
     `points` are the supporting-plane voxel centres (m, 3); `density` is P_QSR over them
-    (required for `qsr`, ignored by the other methods, which use a uniform density).
+    (required for `qsr`); the other methods use a uniform density, or `density` when one is
+    given (a search's belief: uniform, less where it has already looked).
     """
     method = ViewMethod(method)
     options = options or ViewOptions()
@@ -110,7 +113,7 @@ def select_view(
 
 
 def _density(method: ViewMethod, points: np.ndarray, density: np.ndarray | None) -> np.ndarray:
-    if method is not ViewMethod.QSR:
+    if method is not ViewMethod.QSR and density is None:
         return np.full(points.shape[0], 1.0 / max(1, points.shape[0]))
     if density is None:
         raise ViewSelectionError("the qsr method needs a density over the plane voxels")
@@ -136,10 +139,19 @@ def _select(
                          options.start)  # fmt: skip
     if poses.shape[0] == 0:
         return ViewSelection(SelectionStatus.NO_POSES, method, None, (), ())
-    scores = score_cones(poses, points, weights, half, reach)
+    visible = None
+    if options.occlusion is not None:
+        camera_z = body.camera_height + body.torso.clip(options.torso)
+        cameras = np.column_stack([poses[:, :2], np.full(len(poses), camera_z)])
+        cones = in_view_cones(poses, points, half, reach)
+        visible = line_of_sight(options.occlusion, cameras, points, cones)
+        scores = (cones & visible).astype(float) @ weights
+    else:
+        scores = score_cones(poses, points, weights, half, reach)
     k = int(rng.integers(len(poses))) if method is ViewMethod.RANDOM else int(np.argmax(scores))
     scored = tuple(ScoredPose(*map(float, p), float(s)) for p, s in zip(poses, scores, strict=True))
-    frustums = rank_frustums(poses[k], points, weights, body, reach, options.torso)
+    frustums = rank_frustums(poses[k], points, weights, body, reach, options.torso,
+                             None if visible is None else visible[k])
     return ViewSelection(SelectionStatus.SELECTED, method, scored[k], scored, frustums)
 
 
@@ -187,13 +199,16 @@ def _aim_point(
 
 def rank_frustums(
     pose: np.ndarray, points: np.ndarray, density: np.ndarray, body: RobotBody,
-    max_range: float, torso: float = 0.0,
+    max_range: float, torso: float = 0.0, visible: np.ndarray | None = None,
 ) -> tuple[Frustum, ...]:  # fmt: skip
-    """The frustums at `pose`, best first, scored like eq. 2 with In_3D."""
+    """The frustums at `pose`, best first, scored like eq. 2 with In_3D (and only the voxels
+    set in `visible`, when given: those not hidden from the pose)."""
     camera_z = body.camera_height + body.torso.clip(torso)
     pans, tilts = frustum_settings(pose, points, density, body, camera_z, max_range)
     camera = np.array([pose[0], pose[1], camera_z])
     mask = in_frustums(camera, pose[2] + pans, tilts, points, (body.hfov, body.vfov), max_range)
+    if visible is not None:
+        mask &= visible[None, :]
     scores = mask.astype(float) @ density
     order = np.argsort(-scores, kind="stable")
     return tuple(Frustum(float(pans[i]), float(tilts[i]), float(scores[i])) for i in order)

@@ -33,6 +33,7 @@ class SearchContext:
     should_stop: Callable[[], bool] = lambda: False
     dump_dir: str | None = None
     start_clock: float = 0.0
+    qsr: Any = None  # QsrKnowledge with the task's own QSR descriptions, or None (defaults)
 
     def budget_spent(self) -> str | None:
         """Why the search must stop now (a request, the simulated or wall budget), or None."""

@@ -11,6 +11,7 @@ from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.loop import LoopConfig
 from avs_planner.episode.outcome import SearchResult
 from avs_planner.strategies.context import SearchContext
+from avs_planner.strategies.qsr_options import OPTIONS as _QSR_OPTIONS
 
 Run = Callable[[SearchContext], SearchResult]
 
@@ -83,6 +84,15 @@ STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
              "fully; unexplored space competes as a hypothetical room",
              "avs_planner.strategies.baselines:run_most_likely_room",
              {"headings": 6, "sweep_spacing": 1.5, "max_stops": 400}),
+    Strategy("qsr", "indirect search (Kunze et al.): survey landmarks and supporting planes, "
+             "then views where the QSR mixture (target relative to landmarks) is densest; "
+             "abort after 120 s of search",
+             "avs_planner.strategies.qsr:run_qsr", _QSR_OPTIONS),
+    Strategy("supporting-planes", "QSR baseline: as qsr, views scored by a uniform density "
+             "over the supporting planes",
+             "avs_planner.strategies.qsr:run_supporting_planes", _QSR_OPTIONS),
+    Strategy("random", "QSR baseline: as qsr, but a random one of the 20 sampled view poses",
+             "avs_planner.strategies.qsr:run_random", _QSR_OPTIONS),
 )}
 
 

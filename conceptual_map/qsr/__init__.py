@@ -4,7 +4,13 @@ become Gaussian mixtures over supporting-plane voxels of the 3D map."""
 from conceptual_map.qsr.calculus import Landmark, relative_angle, relative_radius, virtual_robot
 from conceptual_map.qsr.errors import QsrError
 from conceptual_map.qsr.learning import LearningUpdate, classify, learn_from_observation
-from conceptual_map.qsr.loader import DEFAULT_QSR_PATH, load_qsr, parse_descriptions, parse_qsr
+from conceptual_map.qsr.loader import (
+    DEFAULT_QSR_PATH,
+    dump_qsr,
+    load_qsr,
+    parse_descriptions,
+    parse_qsr,
+)
 from conceptual_map.qsr.mixture import Gaussian2D, GaussianMixture, fit_gaussian
 from conceptual_map.qsr.model import (
     DIRECTIONS,
@@ -43,6 +49,7 @@ __all__ = [
     "SupportingPlanes",
     "build_mixture",
     "classify",
+    "dump_qsr",
     "extract_supporting_planes",
     "fit_gaussian",
     "learn_from_observation",

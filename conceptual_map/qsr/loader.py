@@ -205,3 +205,35 @@ def _step(reader: _Reader, spec: Mapping[str, Any], entry: str) -> QsrStep:
             raise reader.fail(f"{entry}.relations", f"more than one {what} relation in "
                                                     f"{relations} (use separate descriptions)")
     return QsrStep(tuple(sorted(relations, key=RELATION_NAMES.index)), of)
+
+
+def dump_qsr(knowledge: QsrKnowledge) -> dict[str, Any]:
+    """`knowledge` as the YAML document `parse_qsr` reads (e.g. after learning)."""
+    p = knowledge.parameters
+    relations: dict[str, Any] = {}
+    for name in RELATION_NAMES:
+        model = knowledge.relations[name]
+        if name in DIRECTIONS:
+            relations[name] = {"mean_deg": round(math.degrees(model.mean), 6),
+                               "std_deg": round(math.degrees(model.std), 6)}
+        else:
+            relations[name] = {"mean": model.mean, "std": model.std}
+    descriptions = []
+    for d in knowledge.descriptions:
+        first, *via = d.chain
+        entry: dict[str, Any] = {"target": d.target, "relations": list(first.relations),
+                                 "of": first.of}
+        if via:
+            entry["via"] = [{"relations": list(s.relations), "of": s.of} for s in via]
+        entry["count"] = d.count
+        descriptions.append(entry)
+    return {
+        "version": 1,
+        "model": {"origin_distance": p.origin_distance, "close_ratio": p.close_ratio,
+                  "default_distance": p.default_distance, "samples": p.samples,
+                  "learn_radius": p.learn_radius},
+        "relations": relations,
+        "landmarks": {label: {"front_deg": round(math.degrees(front), 6)}
+                      for label, front in knowledge.fronts.items()},
+        "descriptions": descriptions,
+    }  # fmt: skip

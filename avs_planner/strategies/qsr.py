@@ -1,0 +1,448 @@
+"""QSR indirect search (Kunze et al., seed 002) as three strategies on one loop.
+
+`qsr`, `supporting-planes` and `random` differ only in the density view selection uses (the QSR
+mixture over the supporting planes, uniform over them, a random one of the sampled poses). The
+loop follows the seed's control program: a search monitor (found? more than `abort_s` simulated
+seconds of search? then stop), the search method (Algorithm 1: `select_view`), navigation to
+the chosen pose, and perception with the best frustums there (pan/tilt, a depth frame into the
+3D map, detection confirmed by a second frame). Voxels a frustum has covered lose density
+(`seen_weight` per look), so the next selection looks elsewhere.
+
+The seed starts with its 2D and 3D maps and the landmarks' poses given. Here the robot gets
+them itself first, in a *survey* that does not look for the target: it looks all round at its
+start and at a few frontier stops, integrating laser scans, depth frames (the mind's voxel map)
+and detections of the knowledge's landmark labels. A landmark is a label detected at least
+twice (in two frames) at positions within the executor's agreement distance; its position is
+the mean of those detections. Its *facing* (the direction of its intrinsic front) is an
+assumption written down here and in `conceptual_map/qsr/README.md`: a landmark faces the open
+side, the mean direction from it to the cells of the 2D map where the robot can stand within
+`OPEN_SIDE_RADIUS` (desks stand against walls or each other and are used from the free side;
+monitors and keyboards on them face the same way). The search monitor's clock starts when the
+survey ends (the seed's time is search time with known maps); summaries carry both times.
+
+After a found object, the knowledge learns from it (`learn_from_observation` with the surveyed
+landmarks): kept in this process for the next search without task descriptions, and written to
+`learn_file` when that option names a file.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from avs_planner.episode.mind import KnownObject
+from avs_planner.episode.outcome import Outcome, SearchResult, StepStatus
+from avs_planner.qsr import (
+    ViewMethod,
+    ViewOptions,
+    in_frustums,
+    line_of_sight,
+    rank_frustums,
+    select_view,
+)
+from avs_planner.strategies.baselines import explore
+from avs_planner.strategies.context import SearchContext
+from avs_planner.strategies.looking import (
+    LOOK_DISTANCE,
+    SUPPORT_HEIGHT,
+    _confirm,
+    known_target,
+)
+from conceptual_map.metric import OccupancyGrid
+from conceptual_map.qsr import (
+    Landmark,
+    QsrKnowledge,
+    SupportingPlanes,
+    build_mixture,
+    dump_qsr,
+    extract_supporting_planes,
+    learn_from_observation,
+    load_qsr,
+)
+
+OPEN_SIDE_RADIUS = 1.2  # m around a landmark in which standable cells set its facing
+MAX_DRIVE_FAILURES = 5  # selected poses the robot could not reach before giving up
+
+
+# knowledge learnt in this process, for searches whose task carries no descriptions
+_LEARNT: dict[str, QsrKnowledge] = {}
+_PROCESS = "process"
+
+
+def run_qsr(ctx: SearchContext) -> SearchResult:
+    return QsrSearch(ctx, ViewMethod.QSR).run()
+
+
+def run_supporting_planes(ctx: SearchContext) -> SearchResult:
+    return QsrSearch(ctx, ViewMethod.SUPPORTING_PLANES).run()
+
+
+def run_random(ctx: SearchContext) -> SearchResult:
+    return QsrSearch(ctx, ViewMethod.RANDOM).run()
+
+
+def forget_learnt() -> None:
+    """Drop what this process learnt (tests, fresh experiments)."""
+    _LEARNT.clear()
+
+
+# ---- landmarks -----------------------------------------------------------------------------
+
+
+@dataclass
+class _Cluster:
+    label: str
+    total: np.ndarray
+    n: int = 1
+    seen_from: list[tuple[float, float]] = field(default_factory=list)
+
+    @property
+    def position(self) -> np.ndarray:
+        return self.total / self.n
+
+
+class LandmarkTracker:
+    """Detections of landmark labels grouped per label by distance: a group seen in two
+    frames or more is a landmark (a phantom rarely repeats at one spot)."""
+
+    def __init__(self, labels: tuple[str, ...], agree: float, agree_large: float,
+                 large: tuple[str, ...] = ("desk", "table")):  # fmt: skip
+        self.labels = labels
+        self.agree, self.agree_large, self.large = agree, agree_large, large
+        self.clusters: list[_Cluster] = []
+
+    def add(self, label: str, position: tuple[float, float, float],
+            robot_xy: tuple[float, float]) -> None:  # fmt: skip
+        reach = self.agree_large if label in self.large else self.agree
+        point = np.asarray(position, dtype=float)
+        best, best_d = None, reach
+        for c in self.clusters:
+            d = float(np.linalg.norm(c.position - point))
+            if c.label == label and d <= best_d:
+                best, best_d = c, d
+        if best is None:
+            self.clusters.append(_Cluster(label, point.copy(), 1, [robot_xy]))
+        else:
+            best.total += point
+            best.n += 1
+            best.seen_from.append(robot_xy)
+
+    def confirmed(self) -> list[_Cluster]:
+        return [c for c in self.clusters if c.n >= 2]
+
+
+def open_side(grid: OccupancyGrid, xy: np.ndarray, robot_radius: float,
+              radius: float = OPEN_SIDE_RADIUS) -> float | None:  # fmt: skip
+    """The mean direction from `xy` to the cells within `radius` where the robot can stand
+    (None when there are none or they surround it evenly)."""
+    res = grid.resolution
+    centre = np.asarray(grid.cell_of((float(xy[0]), float(xy[1]))))
+    reach = int(math.ceil(radius / res))
+    lo = np.maximum(centre - reach, 0)
+    hi = np.minimum(centre + reach + 1, np.asarray(grid.shape))
+    if np.any(hi <= lo):
+        return None
+    free = grid.traversable(robot_radius)[lo[0] : hi[0], lo[1] : hi[1]]
+    cells = np.argwhere(free) + lo
+    if len(cells) == 0:
+        return None
+    offsets = grid.to_world(cells) - np.asarray(xy[:2])
+    dist = np.linalg.norm(offsets, axis=1)
+    keep = (dist > 1e-6) & (dist <= radius)
+    if not keep.any():
+        return None
+    mean = (offsets[keep] / dist[keep, None]).mean(axis=0)
+    if np.linalg.norm(mean) < 0.05:
+        return None
+    return float(math.atan2(mean[1], mean[0]))
+
+
+def landmarks_from(tracker: LandmarkTracker, grid: OccupancyGrid, robot_radius: float
+                   ) -> list[Landmark]:  # fmt: skip
+    """The confirmed landmarks with their facing: the open side (failing that, towards where
+    the robot saw them from). (Snapping it to the long axis of the supporting-plane segment
+    under the landmark was tried and made it worse: the segments seen from a few stops are
+    fragments of the desk tops.)"""
+    out = []
+    for i, c in enumerate(tracker.confirmed()):
+        xy = c.position[:2]
+        facing = open_side(grid, xy, robot_radius)
+        if facing is None:
+            seen = np.mean(np.asarray(c.seen_from), axis=0) - xy
+            facing = float(math.atan2(seen[1], seen[0]))
+        out.append(Landmark(c.label, float(xy[0]), float(xy[1]), facing, f"{c.label}#{i + 1}"))
+    return out
+
+
+# ---- the search ----------------------------------------------------------------------------
+
+
+@dataclass
+class _Look:
+    camera: np.ndarray
+    heading: float
+    tilt: float
+
+
+class QsrSearch:
+    """One search with one method: survey, then the monitor / select / drive / perceive loop."""
+
+    def __init__(self, ctx: SearchContext, method: ViewMethod):
+        self.ctx, self.method, self.opt = ctx, method, ctx.options
+        self.rng = np.random.default_rng(ctx.executor.seed)
+        self.looks: list[_Look] = []
+        self.poses = 0
+        self.survey_s = 0.0
+        self.search_start = 0.0
+        self.landmarks: list[Landmark] = []
+        self.knowledge, self.knowledge_from = self._knowledge()
+        self.mixture = None
+        self.result = SearchResult(Outcome.GAVE_UP, "")
+
+    # -- knowledge --
+
+    def _knowledge(self) -> tuple[QsrKnowledge, str]:
+        """The task's descriptions; else `learn_file` when it exists; else (when learning)
+        what this process learnt; else the default knowledge."""
+        ctx = self.ctx
+        if ctx.qsr is not None:
+            return ctx.qsr, "task"
+        path = str(self.opt.get("learn_file") or "")
+        if path and Path(path).exists():
+            return load_qsr(path), path
+        if self.opt["learn"] and _PROCESS in _LEARNT:
+            return _LEARNT[_PROCESS], "learnt in this process"
+        return load_qsr(), "default"
+
+    # -- the loop --
+
+    def run(self) -> SearchResult:
+        ctx = self.ctx
+        start = ctx.robot.clock
+        watching = getattr(ctx.executor, "watching", False)
+        ctx.executor.watching = False  # the survey does not look for the target
+        try:
+            self.survey()
+        finally:
+            ctx.executor.watching = watching and self.opt["watch"]
+        self.survey_s = ctx.robot.clock - start
+        self.search_start = ctx.robot.clock
+        self._prepare_mixture()
+        failures = 0
+        while True:
+            stop = ctx.budget_spent()
+            if stop:
+                return self._end(Outcome.TIMEOUT, stop)
+            if self.search_time() >= self.opt["abort_s"]:
+                return self._end(Outcome.GAVE_UP, f"search monitor: nothing found in "
+                                                  f"{self.opt['abort_s']:g} s of search")
+            if self.poses >= self.opt["max_poses"]:
+                return self._end(Outcome.GAVE_UP, f"{self.poses} view poses searched")
+            planes = extract_supporting_planes(ctx.mind.voxels)
+            if len(planes) == 0:
+                return self._end(Outcome.GAVE_UP, "no supporting planes perceived")
+            density = self.density(planes)
+            pose = ctx.robot.pose
+            view = select_view(ctx.mind.grid, planes.points, density, ctx.body, self.method,
+                               rng=self.rng, options=ViewOptions(
+                                   n_poses=self.opt["n_poses"],
+                                   pan_sweep=math.radians(self.opt["pan_sweep_deg"]),
+                                   start=pose[:2], occlusion=ctx.mind.voxels))  # fmt: skip
+            if not view.selected:
+                return self._end(Outcome.GAVE_UP, f"view selection: {view.status.value}")
+            best = view.best
+            ctx.trace.emit("action", action=f"(view-pose {self.method.value})", status="start",
+                           pose=[round(best.x, 2), round(best.y, 2), round(best.yaw, 3)],
+                           score=round(best.score, 4), plane_voxels=len(planes))
+            outcome = ctx.executor.drive_to((best.x, best.y))
+            if outcome.status is not StepStatus.DONE:
+                failures += 1
+                ctx.trace.emit("action", action=f"(view-pose {self.method.value})",
+                               status="failed", detail=outcome.detail)
+                if failures >= MAX_DRIVE_FAILURES:
+                    return self._end(Outcome.GAVE_UP, f"{failures} view poses unreachable")
+                continue
+            ctx.robot.turn_to(best.yaw)
+            self.poses += 1
+            found = known_target(ctx)  # seen while driving there (option watch)
+            if found is None:
+                found = self.perceive(self.frustums_here(planes.points, density))
+            ctx.trace.emit("action", action=f"(view-pose {self.method.value})", status="done",
+                           poses=self.poses, search_time_s=round(self.search_time(), 2))
+            if found is not None:
+                self.learn(found)
+                self.result.found = found
+                where = ", ".join(f"{v:.2f}" for v in found.position)
+                return self._end(Outcome.FOUND, f"{found.label} at ({where}) in {found.room}")
+
+    def search_time(self) -> float:
+        return self.ctx.robot.clock - self.search_start
+
+    def _end(self, outcome: Outcome, reason: str) -> SearchResult:
+        self.result.details = {
+            "method": self.method.value, "poses": self.poses,
+            "search_time_s": round(self.search_time(), 2),
+            "survey_time_s": round(self.survey_s, 2),
+            "landmarks": [{"label": lm.label, "x": round(lm.x, 2), "y": round(lm.y, 2),
+                           "facing_deg": round(math.degrees(lm.facing), 1)}
+                          for lm in self.landmarks],
+            "knowledge": self.knowledge_from,
+        }  # fmt: skip
+        return self.ctx.end(self.result, outcome, reason)
+
+    # -- perception --
+
+    def survey(self) -> None:
+        """Look round here and at a few frontier stops: maps, voxels, landmarks (not the
+        target)."""
+        ctx = self.ctx
+        labels = tuple(sorted(self.knowledge.fronts))
+        agree = ctx.executor.config.agree
+        tracker = LandmarkTracker(labels, agree[0], agree[1])
+        ctx.trace.emit("action", action="(survey)", status="start", labels=list(labels))
+        ctx.executor.look_around()
+        self._look_round(tracker)
+        for _ in range(self.opt["survey_stops"]):
+            if ctx.budget_spent():
+                break
+            target = ctx.executor.nearest_placeholder()
+            if target is None:
+                break
+            explore(ctx, target)
+            self._look_round(tracker)
+        self.landmarks = landmarks_from(tracker, ctx.mind.grid, ctx.mind.config.robot_radius)
+        ctx.trace.emit("action", action="(survey)", status="done",
+                       landmarks={lb: sum(lm.label == lb for lm in self.landmarks)
+                                  for lb in labels})
+
+    def _look_round(self, tracker: LandmarkTracker) -> None:
+        """Depth frames and two landmark detections in each of `survey_headings` directions."""
+        ctx = self.ctx
+        robot, mind = ctx.robot, ctx.mind
+        tilt = -math.atan2(ctx.body.camera_height - SUPPORT_HEIGHT, LOOK_DISTANCE)
+        headings = self.opt["survey_headings"]
+        yaw = robot.pose[2]
+        for k in range(headings):
+            robot.turn_to(yaw + 2 * math.pi * k / headings)
+            robot.look(0.0, tilt)
+            mind.integrate(robot.scan())
+            self._depth()
+            for _ in range(2):
+                for seen in robot.detect(list(tracker.labels)):
+                    if seen.label in tracker.labels:
+                        tracker.add(seen.label, seen.position, robot.pose[:2])
+        ctx.executor._sense([robot.pose])
+
+    def _depth(self) -> None:
+        size = (self.opt["depth_columns"], self.opt["depth_rows"])
+        self.ctx.mind.integrate_depth(self.ctx.robot.depth(size))
+
+    def frustums_here(self, points: np.ndarray, density: np.ndarray):  # noqa: ANN201
+        """The nine frustums ranked again where the robot really stands (the executor stops
+        within its arrival distance of the pose), with line of sight from there."""
+        body, mind = self.ctx.body, self.ctx.mind
+        pose = np.asarray(self.ctx.robot.pose, dtype=float)
+        camera = np.array([[pose[0], pose[1], body.camera_height]])
+        visible = line_of_sight(mind.voxels, camera, points)[0]
+        return rank_frustums(pose, points, density, body, body.detect_range, 0.0, visible)
+
+    def perceive(self, frustums) -> KnownObject | None:  # noqa: ANN001 - Frustum tuple
+        """Look with the best frustums (a depth frame each, for the 3D map), detect the
+        target and confirm it with a second frame."""
+        ctx = self.ctx
+        body = ctx.body
+        for i, f in enumerate(frustums[: self.opt["frustums"]]):
+            if i > 0 and f.score <= 0.0:
+                break
+            if self.search_time() >= self.opt["abort_s"]:
+                break
+            ctx.robot.look(f.pan, f.tilt)
+            ctx.trace.emit("action", action="(look)", pan=round(f.pan, 3), tilt=round(f.tilt, 3),
+                           score=round(f.score, 4))
+            x, y, yaw = ctx.robot.pose
+            self.looks.append(_Look(np.array([x, y, body.camera_height]), yaw + f.pan, f.tilt))
+            self._depth()
+            found = self.look()
+            if found is not None:
+                return found
+        return None
+
+    def look(self) -> KnownObject | None:
+        """One view: a detection of the target, confirmed when one of up to `confirm_frames`
+        further frames sees it again within the executor's agreement distance (a miss of the
+        second frame alone does not throw a real detection away)."""
+        ctx = self.ctx
+        ex, label = ctx.executor, ctx.target
+        ex.stats.views += 1
+        first = [s for s in ctx.robot.detect([label]) if s.label == label]
+        for s in first:
+            ex.stats.detections.append((s.position[0], s.position[1], label, True))
+        if not first:
+            ctx.trace.emit("observation", label=label, detected=False)
+            return None
+        agree = ex.config.agree[0]
+        again: list = []
+        for _ in range(self.opt["confirm_frames"]):
+            again = [s for s in ctx.robot.detect([label]) if s.label == label
+                     and math.dist(s.position, first[0].position) <= agree]
+            if again:
+                break
+        ctx.trace.emit("observation", label=label, detected=bool(again),
+                       position=[round(v, 2) for v in first[0].position])
+        return _confirm(ctx, first[0]) if again else None
+
+    # -- belief --
+
+    def _prepare_mixture(self) -> None:
+        if self.method is not ViewMethod.QSR:
+            return
+        result = build_mixture(self.knowledge, self.ctx.target, self.landmarks,
+                               rng=self.ctx.executor.seed)
+        self.ctx.trace.emit("belief", qsr_mixture=result.status.value,
+                            components=len(result.mixture) if result.built else 0,
+                            knowledge=self.knowledge_from)
+        self.mixture = result.mixture if result.built else None
+
+    def density(self, planes: SupportingPlanes) -> np.ndarray:
+        """The method's density over the plane voxels, times `seen_weight` per covering look."""
+        uniform = planes.uniform_density()
+        base = uniform
+        if self.method is ViewMethod.QSR and self.mixture is not None:
+            qsr = planes.density(self.mixture)
+            if qsr.sum() > 0.0:
+                floor = self.opt["uniform_floor"]
+                base = (1.0 - floor) * qsr + floor * uniform
+        weights = base * self.seen_factor(planes.points)
+        total = weights.sum()
+        return weights / total if total > 0.0 else uniform
+
+    def seen_factor(self, points: np.ndarray) -> np.ndarray:
+        body = self.ctx.body
+        factor = np.ones(len(points))
+        for look in self.looks:
+            inside = in_frustums(look.camera, np.array([look.heading]), np.array([look.tilt]),
+                                 points, (body.hfov, body.vfov), body.detect_range)[0]
+            factor[inside] *= self.opt["seen_weight"]
+        return factor
+
+    # -- learning --
+
+    def learn(self, found: KnownObject) -> None:
+        if not self.opt["learn"] or not self.landmarks:
+            return
+        update = learn_from_observation(self.knowledge, found.label, found.position,
+                                        self.landmarks)
+        self.ctx.trace.emit("belief", qsr_learnt=[d.text() for d in update.credited])
+        if not update.credited:
+            return
+        if self.knowledge_from != "task":
+            _LEARNT[_PROCESS] = update.knowledge
+        path = str(self.opt.get("learn_file") or "")
+        if path:
+            import yaml
+
+            Path(path).write_text(yaml.safe_dump(dump_qsr(update.knowledge), sort_keys=False),
+                                  encoding="utf-8")

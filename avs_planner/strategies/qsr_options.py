@@ -1,0 +1,25 @@
+"""Options of the QSR strategies and their defaults (apart from `qsr.py`, so the registry can
+name them without importing the strategies)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+OPTIONS: dict[str, Any] = {
+    "abort_s": 120.0,  # the seed's search monitor: simulated seconds of search before abort
+    "n_poses": 20,  # poses sampled per selection (Algorithm 1's n)
+    "frustums": 2,  # best frustums perceived at each pose (of the nine ranked)
+    "pan_sweep_deg": 0.0,  # widen the 2D cone by a head pan each way (the seed's Table IV: 60)
+    "seen_weight": 0.25,  # density factor of a voxel per look that covered it: about the
+    # chance that a look misses a cup in view (camera miss 0.2, + 0.8 x 0.2^2 unconfirmed)
+    "confirm_frames": 2,  # frames to confirm a first detection (any one agreeing suffices)
+    "uniform_floor": 0.02,  # qsr: share of uniform density mixed in (wrong QSRs stay findable)
+    "max_poses": 40,  # view poses before giving up regardless of time
+    "survey_stops": 3,  # frontier stops of the survey (after looking round at the start)
+    "survey_headings": 8,  # directions looked at per survey stop
+    "depth_columns": 64,  # depth frame size (columns x rows)
+    "depth_rows": 48,
+    "watch": False,  # the detector watches for the target while driving to a view pose
+    "learn": True,  # after a found object, update the knowledge kept for the next search
+    "learn_file": "",  # QSR YAML read at start (when it exists) and written after learning
+}

@@ -1,0 +1,125 @@
+"""Seed 002's simulated experiments (Kunze et al., Tables II and III) on our desk scene.
+
+Variant A (`sim/worlds/qsr_desks_a.yaml`): three cups where the default QSR knowledge says cups
+are; B: two of them removed; C: the remaining one moved to a non-QSR location. Table II runs the
+three methods (`random`, `supporting-planes`, `qsr`) on A; Table III runs `qsr` on A, B and C.
+Every cell is `--trials` searches for a cup (seeds 0..N-1) through
+`avs_planner.episode.run_episode`, learning switched off so that trials are independent.
+
+As in the seed, time and poses are means over the successful trials only; "found" counts
+searches that ended with a confirmed cup that is a cup in the world. Time is the search
+monitor's time (simulated seconds after the survey, which stands in for the seed's given maps
+and landmark poses); the survey's own time is printed beside it.
+"±" is the half-width of a normal 95% confidence interval of the mean (over successful trials).
+Run: `python -m bench.qsr_experiment [--trials 10] [--tables II,III] [--option KEY=VALUE]`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import statistics
+import time
+from typing import Any
+
+from avs_planner.episode import run_episode
+
+TABLE_II = {"random": (6, 68.5, 4.8), "supporting-planes": (10, 33.6, 2.3),
+            "qsr": (10, 15.6, 1.1)}  # fmt: skip
+TABLE_III = {"A": (10, 15.6, 1.1), "B": (8, 55.0, 3.1), "C": (6, 65.0, 3.2)}
+SEED_TRIALS = 10
+
+
+def run_cell(method: str, variant: str, trials: int, options: dict[str, Any]
+             ) -> list[dict[str, Any]]:  # fmt: skip
+    out = []
+    for seed in range(trials):
+        summary = run_episode({
+            "target": "cup", "world": f"qsr_desks_{variant.lower()}", "strategy": method,
+            "seed": seed, "strategy_options": {"learn": False, **options},
+        })  # fmt: skip
+        d = summary["details"]
+        out.append({"seed": seed, "outcome": summary["outcome"], "correct": summary["correct"],
+                    "search_time_s": d["search_time_s"], "survey_time_s": d["survey_time_s"],
+                    "poses": d["poses"], "views": summary["views_processed"],
+                    "landmarks": len(d["landmarks"]), "wall_s": summary["wall_time_s"]})
+    return out
+
+
+def stats(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    ok = [r for r in runs if r["outcome"] == "found" and r["correct"]]
+
+    def mean(key: str, rows: list[dict[str, Any]]) -> float | None:
+        return statistics.fmean(r[key] for r in rows) if rows else None
+
+    def ci(key: str, rows: list[dict[str, Any]]) -> float | None:
+        """Half-width of a normal 95% confidence interval of the mean."""
+        if len(rows) < 2:
+            return None
+        return 1.96 * statistics.stdev(r[key] for r in rows) / math.sqrt(len(rows))
+
+    return {"found": len(ok), "trials": len(runs), "time": mean("search_time_s", ok),
+            "poses": mean("poses", ok), "survey": mean("survey_time_s", runs),
+            "time_ci": ci("search_time_s", ok), "poses_ci": ci("poses", ok),
+            "wrong": sum(r["outcome"] == "found" and not r["correct"] for r in runs),
+            "wall": mean("wall_s", runs)}
+
+
+def _fmt(value: float | None, digits: int = 1) -> str:
+    return "-" if value is None else f"{value:.{digits}f}"
+
+
+def print_table(title: str, rows: list[tuple[str, dict[str, Any], tuple[int, float, float]]]
+                ) -> None:  # fmt: skip
+    print(title)
+    print(f"{'':<22} {'found':>7} {'time s':>13} {'poses':>12} | {'seed found':>10} "
+          f"{'time s':>7} {'poses':>6} | {'survey s':>8} {'wrong':>5}")
+    for name, s, (f, t, p) in rows:
+        time_s = f"{_fmt(s['time'])} ±{_fmt(s['time_ci'])}"
+        poses = f"{_fmt(s['poses'], 2)} ±{_fmt(s['poses_ci'], 2)}"
+        print(f"{name:<22} {s['found']:>3}/{s['trials']:<3} {time_s:>13} {poses:>12} | "
+              f"{f:>6}/{SEED_TRIALS:<3} {t:>7.1f} {p:>6.1f} | {_fmt(s['survey']):>8} "
+              f"{s['wrong']:>5}")
+    print()
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--trials", type=int, default=10, help="searches per cell (seeds 0..N-1)")
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+                        help="a strategy option for every run, e.g. frustums=4 (repeatable)")
+    parser.add_argument("--json", help="also write every run and the tables to this file")
+    parser.add_argument("--tables", default="II,III", help="which tables: II, III or II,III")
+    args = parser.parse_args(argv)
+    options = {}
+    for text in args.option:
+        key, _, value = text.partition("=")
+        options[key] = value
+    start = time.perf_counter()
+    tables = {t.strip().upper() for t in args.tables.split(",")}
+    cells: dict[str, list[dict[str, Any]]] = {}
+    for method in ("random", "supporting-planes", "qsr") if "II" in tables else ("qsr",):
+        cells[f"{method}/A"] = run_cell(method, "A", args.trials, options)
+    for variant in ("B", "C") if "III" in tables else ():
+        cells[f"qsr/{variant}"] = run_cell("qsr", variant, args.trials, options)
+    table = {key: stats(runs) for key, runs in cells.items()}
+    print(f"seed 002 experiments, {args.trials} trials per cell (seeds 0..{args.trials - 1}), "
+          f"options {options or 'default'}; ours beside the seed's (10 trials); time and poses "
+          f"over successful trials; wall {time.perf_counter() - start:.0f} s\n")
+    if "II" in tables:
+        print_table("Table II: search methods, variant A",
+                    [(m, table[f"{m}/A"], TABLE_II[m]) for m in ("random", "supporting-planes",
+                                                                 "qsr")])
+    if "III" in tables:
+        print_table("Table III: qsr under false beliefs",
+                    [(f"{v} ({w})", table[f"qsr/{v}"], TABLE_III[v]) for v, w in
+                     (("A", "correct QSRs"), ("B", "partially correct"), ("C", "wrong QSRs"))])
+    if args.json:
+        with open(args.json, "w", encoding="utf-8") as fh:
+            json.dump({"options": options, "tables": table, "runs": cells}, fh, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,128 @@
+"""The QSR strategies (seed 002) search the desk world: survey, view selection, monitor,
+learning, and the task's QSR descriptions."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from avs_planner.episode import EpisodeError, run_episode
+from avs_planner.episode.runner import EpisodeSpec
+from avs_planner.strategies import get_strategy
+from avs_planner.strategies.qsr import LandmarkTracker, forget_learnt, open_side
+from conceptual_map.metric import OccupancyGrid
+from conceptual_map.qsr import load_qsr
+
+
+def _spec(strategy, **extra):
+    options = {"learn": False, **extra.pop("options", {})}
+    return {"target": "cup", "world": "qsr_desks", "strategy": strategy, "seed": 1,
+            "strategy_options": options, **extra}
+
+
+@pytest.mark.parametrize("strategy", ["qsr", "supporting-planes", "random"])
+def test_each_method_finds_a_cup_on_the_desks_and_counts_its_views(strategy, tmp_path):
+    summary = run_episode(_spec(strategy, output_dir=str(tmp_path)))
+    assert summary["outcome"] == "found" and summary["correct"], summary["reason"]
+    assert summary["strategy"] == strategy and summary["plans"] == 0
+    details = summary["details"]
+    assert details["method"] == strategy and details["poses"] >= 1
+    assert 0 < details["search_time_s"] <= 120.0 < summary["sim_time_s"] + 120.0
+    assert {lm["label"] for lm in details["landmarks"]} >= {"monitor", "keyboard", "desk"}
+    events = [json.loads(line) for line in (tmp_path / "trace.jsonl").read_text().splitlines()]
+    looks = [e for e in events if e["type"] == "observation" and e["label"] == "cup"]
+    assert summary["views_processed"] == len(looks) > 0
+    poses = [e for e in events if e["type"] == "action"
+             and e["action"] == f"(view-pose {strategy})" and e["status"] == "done"]
+    assert len(poses) == details["poses"]
+    assert events[-1]["type"] == "done" and events[-1]["outcome"] == "found"
+
+
+def test_the_search_monitor_gives_up_on_an_absent_object():
+    """Staplers have QSR descriptions but none is in the room: the monitor aborts the search
+    after `abort_s` simulated seconds of search (the seed's 120 s, shortened here)."""
+    assert get_strategy("qsr").options["abort_s"] == 120.0
+    summary = run_episode({**_spec("qsr", options={"abort_s": 30.0}), "target": "stapler"})
+    assert summary["outcome"] == "gave_up" and summary["object"] is None
+    assert summary["reason"].startswith("search monitor")
+    assert summary["details"]["search_time_s"] >= 30.0
+    assert summary["views_processed"] >= summary["details"]["poses"] >= 1
+
+
+def test_a_found_cup_teaches_the_knowledge_kept_for_the_next_search(tmp_path):
+    forget_learnt()
+    path = tmp_path / "learnt.yaml"
+    before = {d.key: d.count for d in load_qsr().descriptions_for("cup")}
+    try:
+        summary = run_episode(_spec("qsr", options={"learn": True, "learn_file": str(path)}))
+        assert summary["outcome"] == "found" and summary["details"]["knowledge"] == "default"
+        learnt = load_qsr(path)  # written after the find, in the format load_qsr reads
+        after = {d.key: d.count for d in learnt.descriptions_for("cup")}
+        gained = {k: after[k] - before.get(k, 0.0) for k in after if after[k] != before.get(k)}
+        assert gained and all(v == 1.0 for v in gained.values())
+        # the next search in this process without a file uses what was learnt
+        short = {"survey_stops": 0, "abort_s": 1.0}
+        again = run_episode(_spec("qsr", options={"learn": True, **short}))
+        assert again["details"]["knowledge"] == "learnt in this process"
+        # ... unless learning is off (independent trials, as in bench/qsr_experiment.py)
+        off = run_episode(_spec("qsr", options={"learn": False, **short}))
+        assert off["details"]["knowledge"] == "default"
+    finally:
+        forget_learnt()
+
+
+def test_task_descriptions_are_validated_with_clear_errors():
+    good = [{"target": "cup", "relations": ["left", "close"], "of": "keyboard", "count": 2}]
+    spec = EpisodeSpec.from_dict(_spec("qsr", qsr=good))
+    assert [d.text() for d in spec.qsr.descriptions] == [
+        "left(cup, keyboard) & close(cup, keyboard)"]
+    assert EpisodeSpec.from_dict(_spec("qsr", qsr={"descriptions": good})).qsr is not None
+    assert EpisodeSpec.from_dict(_spec("qsr")).qsr is None
+    bad = [
+        ([{"target": "cup", "relations": ["left"], "of": "sofa", "count": 1}],
+         "descriptions[0].of: unknown landmark label 'sofa'"),
+        ([{"target": "cup", "relations": ["above"], "of": "desk", "count": 1}],
+         "unknown relation 'above'"),
+        ([{"target": "cup", "relations": ["left"], "of": "desk"}], "descriptions[0]"),
+        ("cup left of keyboard", "'qsr' must be a non-empty list"),
+        ([], "'qsr' must be a non-empty list"),
+    ]
+    for data, message in bad:
+        with pytest.raises(EpisodeError, match="qsr") as info:
+            EpisodeSpec.from_dict(_spec("qsr", qsr=data))
+        assert message in str(info.value)
+
+
+def test_landmarks_need_two_sightings_and_face_the_open_side():
+    tracker = LandmarkTracker(("monitor", "desk"), 0.25, 0.6)
+    tracker.add("monitor", (2.0, 5.7, 0.9), (2.0, 3.0))
+    tracker.add("monitor", (2.05, 5.68, 0.92), (2.5, 3.0))
+    tracker.add("monitor", (4.0, 3.0, 0.9), (2.0, 3.0))  # a phantom, seen once
+    tracker.add("desk", (2.0, 5.5, 0.4), (2.0, 3.0))
+    tracker.add("desk", (2.4, 5.4, 0.4), (2.0, 3.0))  # the same desk, its centre seen apart
+    confirmed = tracker.confirmed()
+    assert sorted(c.label for c in confirmed) == ["desk", "monitor"]
+    monitor = next(c for c in confirmed if c.label == "monitor")
+    np.testing.assert_allclose(monitor.position, (2.025, 5.69, 0.91))
+    # a room free below y = 5 and walled above: a landmark at the wall faces -y
+    grid = OccupancyGrid((0.0, 0.0), (6.0, 6.0), 0.05)
+    grid.logodds[...] = grid.model.clamp_min
+    grid.logodds[:, 100:] = grid.model.clamp_max
+    grid._touch()
+    facing = open_side(grid, np.array([3.0, 5.5]), 0.3)
+    assert facing == pytest.approx(-math.pi / 2, abs=math.radians(3))
+
+
+def test_simulate_qsr_file_errors_exit_1_before_the_run(tmp_path, capsys):
+    from avs_planner.cli import main
+
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("- {target: cup, relations: [left, close], of: sofa, count: 1}\n")
+    base = ["simulate", "--world", "qsr_desks", "--target", "cup", "--strategy", "qsr",
+            "--out", str(tmp_path / "out")]
+    assert main([*base, "--qsr", str(bad)]) == 1
+    assert "qsr: descriptions[0].of: unknown landmark label 'sofa'" in capsys.readouterr().err
+    assert main([*base, "--qsr", str(tmp_path / "missing.yaml")]) == 1
+    assert "cannot read" in capsys.readouterr().err
+    assert not (tmp_path / "out" / "summary.json").exists()
