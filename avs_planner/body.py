@@ -11,6 +11,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+# m the mind keeps between its footprint circle and mapped obstacles: the grid's cells are
+# 5 cm, its walls ~1-2 cm noisy, and the simulator refuses any contact deeper than 0.1 mm.
+# The Pioneer's footprint (0.26 m) plus this is the 0.30 m the mind always planned with.
+PLANNING_CLEARANCE = 0.04
+
 
 @dataclass(frozen=True)
 class JointRange:
@@ -49,6 +54,16 @@ class RobotBody:
     tilt_speed: float  # rad/s
     scan_time: float  # s per laser scan or depth frame
     sensing_time: float  # s per detection or place classification
+
+    @property
+    def planning_radius(self) -> float:
+        """The disc the mind's path planning, reachability and standpoints keep clear."""
+        return self.footprint_radius + PLANNING_CLEARANCE
+
+    @property
+    def passing_width(self) -> float:
+        """The narrowest opening (door) the mind plans through."""
+        return 2.0 * self.planning_radius
 
     def drive_time(self, distance: float) -> float:
         return abs(distance) / self.linear_speed

@@ -237,7 +237,8 @@ class Robot:
                         raise PathBlockedError(
                             f"move_along: segment {i} from ({x:.2f}, {y:.2f}) to ({px:.2f}, "
                             f"{py:.2f}) is blocked at ({cx:.2f}, {cy:.2f}) by {blocker} "
-                            f"(footprint radius {self.model.footprint_radius:g} m); not moved")
+                            f"(footprint radius {self.model.footprint_radius:g} m); not moved",
+                            at=(float(cx), float(cy)), heading=math.atan2(py - y, px - x))
                 x, y = px, py
         finally:
             self._set_pose(start)

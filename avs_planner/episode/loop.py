@@ -62,6 +62,9 @@ class SwitchingLoop:
         self.planner: ContinualPlanner | None = None
         self.start_clock = executor.robot.clock
         self.visited_rooms: set[str] = set()
+        # (action, belief state) pairs that failed: never executed again (a guard; the state
+        # builder already withholds a failed move until something new is learned)
+        self.failed: set[tuple[str, int]] = set()
 
     def run(self) -> SearchResult:
         self.executor.watching = self.config.watch
@@ -84,7 +87,13 @@ class SwitchingLoop:
             if index is None:
                 return self._end(Outcome.GAVE_UP, "plan has no executable step")
             step = self.planner.plan[index]
+            tried = (step.label, _signature(state))
+            if tried in self.failed:
+                return self._end(Outcome.GAVE_UP, f"{step.label} failed from this very state "
+                                 f"before and nothing new was learned since")
             outcome = self._execute(step, state)
+            if outcome.status is StepStatus.FAILED:
+                self.failed.add(tried)
             if outcome.status is StepStatus.FOUND:
                 self.result.found = outcome.reported
                 return self._end(Outcome.FOUND, outcome.detail)
@@ -256,10 +265,27 @@ class SwitchingLoop:
         return None
 
     def _end(self, outcome: Outcome, reason: str) -> SearchResult:
+        if outcome is Outcome.GAVE_UP:
+            reason += self._cut_off()
         self.result.outcome, self.result.reason = outcome, reason
         self.trace.emit("done", outcome=outcome.value, reason=reason)
         return self.result
 
+
+    def _cut_off(self) -> str:
+        """What the robot's body keeps it from: blocked doors and openings too narrow."""
+        mind = self.executor.mind
+        notes = [b.describe() for b in mind.blockages.items.values()]
+        notes += [o.describe(mind.passing_width)
+                  for o in mind.narrow_openings(self.executor.robot.pose[:2])]
+        if notes:
+            self.trace.emit("belief", cut_off=notes)
+        return f"; unreachable: {'; '.join(notes)}" if notes else ""
+
+
+def _signature(state: AvsState) -> int:
+    """The belief state as the CP sees it (atoms and numbers)."""
+    return hash((state.atoms, frozenset(state.values.items())))
 
 
 def _timed_out(result: PlanResult) -> bool:

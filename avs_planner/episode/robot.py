@@ -19,7 +19,7 @@ from matplotlib.path import Path as MplPath
 from avs_planner.body import JointRange, RobotBody
 from avs_planner.episode.errors import EpisodeError
 from sim import World, load_world_spec
-from sim.errors import MotionError, SimError
+from sim.errors import MotionError, PathBlockedError, SimError
 from sim.robot_models import ROBOT_MODELS
 from sim.world_spec import RoomSpec, WorldSpec
 
@@ -42,6 +42,7 @@ class SimRobot:
         self.robot = world.robot
         self.truth_of: dict[int, str | None] = {}
         self.model = self.robot.model.name
+        self.last_contact: tuple[float, float, float] | None = None
 
     # ---- proprioception ---------------------------------------------------------------------
 
@@ -78,9 +79,16 @@ class SimRobot:
     # ---- acting -----------------------------------------------------------------------------
 
     def move_along(self, path: Sequence[tuple[float, float]]) -> bool:
-        """Drive through waypoints; False (without moving) if the path is blocked."""
+        """Drive through waypoints; False (without moving) if the path is blocked. Then
+        `last_contact` is where the base would have touched something and the heading it
+        drove (its own contact sense, like a bumper; never what it touched)."""
+        self.last_contact = None
         try:
             self.robot.move_along(list(path))
+        except PathBlockedError as exc:
+            if exc.at is not None and exc.heading is not None:
+                self.last_contact = (*exc.at, exc.heading)
+            return False
         except MotionError:
             return False
         return True

@@ -1,0 +1,146 @@
+"""Blocked moves as evidence, and openings too narrow for the robot's body.
+
+A move the base refuses (`SimRobot.last_contact`: where its centre was at first contact, and
+its heading) becomes a `Blockage`: a keep-out disc just beyond the contact point that the
+grid's traversability (so every path, reachability and standpoint query) respects until
+`retry_after` simulated seconds have passed, and that cuts the place-graph edges through it.
+A blockage at a mapped door names the door. `narrow_openings` finds free space the robot can
+see but not reach because an opening on the way is narrower than its `passing_width`: the
+reason an episode gives when that is all that is left.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import ndimage
+
+from conceptual_map.metric import OccupancyGrid, plan_path
+from conceptual_map.metric.errors import PathQueryError
+from conceptual_map.places.frontiers import reachable_mask
+from conceptual_map.places.model import Door
+
+Point = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Blockage:
+    """Where a motion was refused: a keep-out disc, since when, until when, at which door."""
+
+    id: str
+    centre: Point
+    radius: float
+    time: float
+    until: float
+    door: str | None = None
+    door_width: float | None = None
+
+    def describe(self) -> str:
+        where = f"({self.centre[0]:.2f}, {self.centre[1]:.2f})"
+        if self.door is not None:
+            return (f"door {self.door} ({self.door_width:.2f} m wide) at {where} blocked the "
+                    f"robot at t={self.time:.0f} s")
+        return f"something unmapped at {where} blocked the robot at t={self.time:.0f} s"
+
+    def cuts(self, a: Point, b: Point, margin: float = 0.1) -> bool:
+        """The straight segment a-b passes within `radius + margin` of the centre."""
+        p, q, c = np.asarray(a), np.asarray(b), np.asarray(self.centre)
+        d = q - p
+        t = 0.0 if not d.any() else float(np.clip((c - p) @ d / (d @ d), 0.0, 1.0))
+        return float(np.linalg.norm(p + t * d - c)) <= self.radius + margin
+
+
+@dataclass
+class Blockages:
+    """The blockages the robot has run into; expired ones are forgotten."""
+
+    retry_after: float = 300.0  # s of simulated time before a blocked spot is tried again
+    radius: float = 0.2  # m: keep-out disc just beyond the contact point
+    door_reach: float = 0.7  # m: a contact this near a mapped door's centre is at the door
+    items: dict[str, Blockage] = field(default_factory=dict)
+    _count: int = 0
+
+    def add(self, contact: tuple[float, float, float], time: float,
+            doors: dict[str, Door]) -> Blockage:
+        x, y, heading = contact
+        centre = (x + self.radius * math.cos(heading), y + self.radius * math.sin(heading))
+        door = min(doors.values(), key=lambda d: math.dist(d.centre, centre), default=None)
+        if door is not None and math.dist(door.centre, centre) > self.door_reach:
+            door = None
+        self._count += 1
+        blockage = Blockage(f"blocked{self._count}", centre, self.radius, time,
+                            time + self.retry_after, door.id if door else None,
+                            door.width if door else None)
+        self.items[blockage.id] = blockage
+        return blockage
+
+    def expire(self, time: float) -> list[Blockage]:
+        gone = [b for b in self.items.values() if b.until <= time]
+        for b in gone:
+            del self.items[b.id]
+        return gone
+
+    def discs(self) -> list[tuple[float, float, float]]:
+        return [(*b.centre, b.radius) for b in self.items.values()]
+
+    def cutting(self, a: Point, b: Point) -> Blockage | None:
+        return next((k for k in self.items.values() if k.cuts(a, b)), None)
+
+    def signature(self) -> frozenset[str]:
+        """What the robot knows about blocked spots now (new evidence changes it)."""
+        return frozenset(self.items)
+
+
+@dataclass(frozen=True)
+class NarrowOpening:
+    """Free space seen beyond an opening narrower than the robot passes."""
+
+    centre: Point
+    width: float  # m, estimated from the grid (cells are 5 cm)
+    area_beyond: float  # m^2 of free space seen behind it
+    door: str | None = None
+
+    def describe(self, needed: float) -> str:
+        name = f"door {self.door}" if self.door else "an opening"
+        return (f"{name} about {self.width:.2f} m wide at ({self.centre[0]:.2f}, "
+                f"{self.centre[1]:.2f}) leads to {self.area_beyond:.1f} m^2 seen but not "
+                f"reachable: the robot needs {needed:.2f} m")
+
+
+def narrow_openings(grid: OccupancyGrid, robot: Point, radius: float, doors: dict[str, Door],
+                    slim: float = 0.12, min_area: float = 0.5) -> list[NarrowOpening]:
+    """Free space a slim robot reaches but this one (`radius`) does not come near, with the
+    bottleneck on the way to it (the narrowest point of a slim path there)."""
+    mine = reachable_mask(grid, robot, radius)
+    thin = reachable_mask(grid, robot, slim)
+    if not thin.any():
+        return []
+    near = ndimage.binary_dilation(mine, iterations=int(math.ceil(1.5 * radius
+                                                                   / grid.resolution)))
+    labels, n = ndimage.label(thin & ~near)
+    out = []
+    clearance = grid.clearance()
+    for k in range(1, n + 1):
+        cells = np.argwhere(labels == k)
+        area = len(cells) * grid.resolution ** 2
+        if area < min_area:
+            continue
+        goal = grid.to_world(cells[len(cells) // 2][None, :])[0]
+        try:
+            path = plan_path(grid, robot, (float(goal[0]), float(goal[1])), slim, smooth=False)
+        except PathQueryError:
+            continue
+        if not path.found:
+            continue
+        points = np.asarray(path.waypoints)
+        at = grid.to_cell(points)
+        values = clearance[at[:, 0], at[:, 1]]
+        i = int(np.argmin(values))
+        centre = (float(points[i, 0]), float(points[i, 1]))
+        width = 2.0 * (float(values[i]) + grid.resolution / math.sqrt(2.0))
+        door = min(doors.values(), key=lambda d: math.dist(d.centre, centre), default=None)
+        name = door.id if door is not None and math.dist(door.centre, centre) < 0.5 else None
+        out.append(NarrowOpening(centre, round(width, 2), round(area, 1), name))
+    return out
