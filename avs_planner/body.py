@@ -11,10 +11,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-# m the mind keeps between its footprint circle and mapped obstacles: the grid's cells are
-# 5 cm, its walls ~1-2 cm noisy, and the simulator refuses any contact deeper than 0.1 mm.
-# The Pioneer's footprint (0.26 m) plus this is the 0.30 m the mind always planned with.
-PLANNING_CLEARANCE = 0.04
+# m the mind keeps between its footprint circle and mapped obstacles, beyond the grid's own
+# conservatism (`OccupancyGrid.clearance` is a lower bound: half a 5 cm cell's diagonal less
+# than the distance to the nearest occupied cell); the walls are ~1-2 cm noisy and the
+# simulator refuses any contact deeper than 0.1 mm. The PR2 (0.34 m) plans with 0.36 m, so a
+# 0.9 m door leaves it 0.18 m of centre-line play; with 0.04 m (0.38 m) it leaves 0.14 m, which
+# the grid's noisy jambs closed in the office (scenario a gave up at its 0.9 m door).
+PLANNING_CLEARANCE = 0.02
 
 
 @dataclass(frozen=True)
@@ -54,11 +57,12 @@ class RobotBody:
     tilt_speed: float  # rad/s
     scan_time: float  # s per laser scan or depth frame
     sensing_time: float  # s per detection or place classification
+    clearance: float = PLANNING_CLEARANCE  # m kept beyond the footprint when planning paths
 
     @property
     def planning_radius(self) -> float:
         """The disc the mind's path planning, reachability and standpoints keep clear."""
-        return self.footprint_radius + PLANNING_CLEARANCE
+        return round(self.footprint_radius + self.clearance, 3)
 
     @property
     def passing_width(self) -> float:

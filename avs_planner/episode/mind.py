@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from avs_planner.body import PLANNING_CLEARANCE, RobotBody
+from avs_planner.body import RobotBody
 from avs_planner.episode.blockages import Blockage, Blockages, NarrowOpening, narrow_openings
 from conceptual_map.conceptual import ConceptualMap, RelatedSpace
 from conceptual_map.conceptual.place_events import PlaceMapFeed
@@ -43,7 +43,7 @@ class Mind:
     robot's own footprint (`RobotBody.planning_radius`)."""
 
     config: PlaceMapConfig = field(default_factory=lambda: PlaceMapConfig(
-        robot_radius=round(0.26 + PLANNING_CLEARANCE, 3)))
+        robot_radius=0.3))
     body: RobotBody | None = None
     knowledge: Knowledge | None = None
     resolution: float = 0.05
@@ -71,7 +71,7 @@ class Mind:
     @classmethod
     def for_body(cls, body: RobotBody, knowledge: Knowledge | None = None) -> Mind:
         """A mind that plans for `body`'s footprint (from the robot model, never the world)."""
-        return cls(config=PlaceMapConfig(robot_radius=round(body.planning_radius, 3)),
+        return cls(config=PlaceMapConfig(robot_radius=body.planning_radius),
                    body=body, knowledge=knowledge)
 
     @property
