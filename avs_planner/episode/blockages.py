@@ -19,6 +19,8 @@ from scipy import ndimage
 
 from conceptual_map.metric import OccupancyGrid, plan_path
 from conceptual_map.metric.errors import PathQueryError
+from conceptual_map.places.config import PlaceMapConfig
+from conceptual_map.places.doors import openings_along
 from conceptual_map.places.frontiers import reachable_mask
 from conceptual_map.places.model import Door
 
@@ -110,7 +112,8 @@ class NarrowOpening:
 
 
 def narrow_openings(grid: OccupancyGrid, robot: Point, radius: float, doors: dict[str, Door],
-                    slim: float = 0.12, min_area: float = 0.5) -> list[NarrowOpening]:
+                    config: PlaceMapConfig | None = None, slim: float = 0.12,
+                    min_area: float = 0.5) -> list[NarrowOpening]:
     """Free space a slim robot reaches but this one (`radius`) does not come near, with the
     bottleneck on the way to it (the narrowest point of a slim path there)."""
     mine = reachable_mask(grid, robot, radius)
@@ -140,7 +143,24 @@ def narrow_openings(grid: OccupancyGrid, robot: Point, radius: float, doors: dic
         i = int(np.argmin(values))
         centre = (float(points[i, 0]), float(points[i, 1]))
         width = 2.0 * (float(values[i]) + grid.resolution / math.sqrt(2.0))
+        near = points[np.linalg.norm(points - points[i], axis=1) <= 0.6]
+        chords = openings_along(grid, _densify(near), config) if config else []
+        if chords:  # the door detector's chord is a better width than the path's clearance
+            best = min(chords, key=lambda o: float(np.linalg.norm(o.centre - points[i])))
+            centre = (float(best.centre[0]), float(best.centre[1]))
+            width = best.width
         door = min(doors.values(), key=lambda d: math.dist(d.centre, centre), default=None)
         name = door.id if door is not None and math.dist(door.centre, centre) < 0.5 else None
         out.append(NarrowOpening(centre, round(width, 2), round(area, 1), name))
     return out
+
+
+def _densify(points: np.ndarray, step: float = 0.05) -> np.ndarray:
+    """Points every `step` m along a polyline."""
+    if len(points) < 2:
+        return points
+    out = [points[0]]
+    for a, b in zip(points, points[1:], strict=False):
+        n = max(1, int(np.ceil(np.linalg.norm(b - a) / step)))
+        out.extend(a + (b - a) * k / n for k in range(1, n + 1))
+    return np.asarray(out)

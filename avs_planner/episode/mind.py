@@ -107,7 +107,8 @@ class Mind:
 
     def narrow_openings(self, robot: tuple[float, float]) -> list[NarrowOpening]:
         """Openings on the way to seen free space that are narrower than the robot passes."""
-        return narrow_openings(self.grid, robot, self.config.robot_radius, self.place_map.doors)
+        return narrow_openings(self.grid, robot, self.config.robot_radius, self.place_map.doors,
+                               self.config)
 
     def sense(self, scan: LaserScanLike, poses: list[Pose], time: float) -> list[MapEvent]:
         """Integrate a scan taken at the end of `poses` and grow the place map along them."""
