@@ -1,0 +1,128 @@
+"""The robot's body in the loop: doors vs footprint, blocked moves as evidence, no repeats."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from avs_planner.episode import Episode, EpisodeSpec
+from avs_planner.episode.executor import Executor
+from avs_planner.episode.loop import SwitchingLoop, _signature
+from avs_planner.episode.mind import Mind
+from avs_planner.episode.outcome import StepStatus
+from avs_planner.episode.robot import load_spec, open_world
+from avs_planner.episode.state_builder import SearchTask, StateBuilder
+from avs_planner.episode.trace import Trace
+from avs_planner.episode.viewcones import CameraModel
+
+_WORLD = """name: door_{w}
+size: [10.0, 5.0]
+wall_height: 2.0
+rooms:
+  - {{name: hall, category: office, rect: [0.0, 0.0, 5.0, 5.0]}}
+  - {{name: kitchen, category: kitchen, rect: [5.0, 0.0, 10.0, 5.0]}}
+doors:
+  - {{rooms: [hall, kitchen], at: [5.0, 2.5], width: {w}}}
+furniture:
+  - {{name: table1, label: table, room: kitchen, pose: [7.5, 2.5, 0.0], size: [1.2, 0.8, 0.75]}}
+objects:
+  - {{name: cereal1, label: cerealbox, on: table1, offset: [0.0, 0.0], size: [0.2, 0.07, 0.3]}}
+robot: {{model: pioneer, start: [2.5, 2.5, 0.0]}}
+"""
+
+
+def _episode(width: float, robot: str) -> tuple[dict, Episode]:
+    spec = EpisodeSpec.from_dict({"target": "cerealbox", "world_file": _WORLD.format(w=width),
+                                  "robot": robot, "seed": 1, "time_budget_s": 900.0})
+    episode = Episode(spec)
+    return episode.run(), episode
+
+
+def test_the_mind_plans_with_the_robots_own_footprint() -> None:
+    for model, radius in (("pioneer", 0.30), ("pr2", 0.36)):
+        robot = open_world(load_spec("office", model), 0)
+        try:
+            assert Mind.for_body(robot.body()).config.robot_radius == pytest.approx(radius)
+        finally:
+            robot.world.close()
+
+
+def test_a_door_narrower_than_the_pr2_is_never_planned_through_and_named() -> None:
+    summary, episode = _episode(0.6, "pr2")
+    assert summary["outcome"] == "gave_up"
+    assert "0.72 m" in summary["reason"] and "wide at (4.9" in summary["reason"]
+    assert all(x < 5.0 for x, *_ in episode.executor.stats.path)  # never went through
+    assert not episode.mind.blockages.items  # never even tried (so never blocked)
+
+
+@pytest.mark.parametrize("robot", ["pioneer", "pr2"])
+def test_a_door_wider_than_the_robot_is_passed(robot: str) -> None:
+    summary, episode = _episode(0.9, robot)
+    assert summary["outcome"] == "found" and summary["correct"]
+    assert any(x > 5.5 for x, *_ in episode.executor.stats.path)
+
+
+class _HiddenObstacle:
+    """A robot adapter whose base also refuses legs through a disc no scan shows (a low box
+    under the laser), reporting the contact point like the simulator does."""
+
+    def __init__(self, robot, centre: tuple[float, float], radius: float):  # noqa: ANN001
+        self._robot, self.centre, self.radius = robot, centre, radius
+        self.refused = 0
+
+    def __getattr__(self, name: str):  # noqa: ANN204 - delegate everything else
+        return getattr(self._robot, name)
+
+    def move_along(self, path: list[tuple[float, float]]) -> bool:
+        reach = self.radius + self._robot.robot.model.footprint_radius
+        x, y = self._robot.pose[:2]
+        for px, py in path:
+            n = max(2, int(math.dist((x, y), (px, py)) / 0.02) + 1)
+            for k in range(n):
+                cx, cy = x + (px - x) * k / (n - 1), y + (py - y) * k / (n - 1)
+                if math.dist((cx, cy), self.centre) < reach:
+                    self.refused += 1
+                    self._robot.last_contact = (cx, cy, math.atan2(py - y, px - x))
+                    return False
+            x, y = px, py
+        return self._robot.move_along(path)
+
+
+def test_a_move_blocked_by_an_unmapped_obstacle_goes_around_it() -> None:
+    sim = open_world(load_spec("office", start=(6.0, 3.2, 0.0)), seed=1)
+    try:
+        robot = _HiddenObstacle(sim, (8.0, 2.9), 0.1)
+        mind = Mind.for_body(sim.body())
+        builder = StateBuilder(mind, SearchTask("cerealbox"))
+        events: list[tuple] = []
+        executor = Executor(robot, mind, builder, CameraModel(sim.camera_height, 1.0, 3.5),
+                            lambda *a, **k: events.append((a, k)))
+        executor.look_around()
+        outcome = executor.drive_to((10.0, 3.2))
+        assert outcome.status is StepStatus.DONE, outcome.detail
+        assert 1 <= robot.refused <= 2 and len(mind.blockages.items) == robot.refused
+        assert any(k.get("blocked") for _, k in events)  # the trace reports it
+        assert math.dist(sim.pose[:2], (10.0, 3.2)) <= executor.config.arrive
+    finally:
+        sim.world.close()
+
+
+def test_no_failed_action_is_repeated_from_an_unchanged_state(corridor) -> None:  # noqa: ANN001
+    """Every move is refused (with no contact point to learn from): the episode must end
+    with a reason, never re-running a failed action from the same belief state."""
+    mind, builder, executor = corridor
+    executor.robot.move_along = lambda path: False
+    executed: list[tuple[str, int]] = []
+    loop = SwitchingLoop(builder, executor, Trace(lambda: executor.robot.clock, None, None))
+    run = loop._execute
+
+    def record(step, state):  # noqa: ANN001, ANN202
+        executed.append((step.label, _signature(state)))
+        return run(step, state)
+
+    loop._execute = record
+    result = loop.run()
+    assert result.outcome.value == "gave_up", result.reason
+    assert executed and len(executed) == len(set(executed))
+    assert mind.failed_moves
