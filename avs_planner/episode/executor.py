@@ -380,11 +380,15 @@ class Executor:
         return True
 
     def _squeeze(self, start: tuple[float, float], goal: tuple[float, float]):  # noqa: ANN202
-        """A path with a slimmer margin (the robot may start close to furniture), then one
+        """A path with a slimmer margin (the robot may start close to furniture; never below
+        its footprint less a cell: `clearance` underestimates by half a cell), then one
         through unknown cells (a laser mounted ahead of the base never sees the cells under
         and behind it); the simulator still refuses any motion that would collide."""
         radius = self.mind.config.robot_radius
-        tries = ((radius - self.config.squeeze, False), (radius, True))
+        slim = radius - self.config.squeeze
+        if self.mind.body is not None:  # never slimmer than the footprint less a grid cell
+            slim = max(slim, self.mind.body.footprint_radius - self.mind.grid.resolution)
+        tries = ((slim, False), (radius, True))
         for margin, unknown in tries:
             try:
                 path = plan_path(self.mind.grid, start, goal, margin, allow_unknown=unknown)
