@@ -329,8 +329,9 @@ class Executor:
             if not self.robot.move_along(leg):
                 detours += 1
                 why = self._blocked()
-                if why is not None or detours > cfg.detours:
-                    return StepOutcome(StepStatus.FAILED, f"blocked: {why or 'again'}")
+                if getattr(self.robot, "last_contact", None) is None or detours > cfg.detours:
+                    return StepOutcome(StepStatus.FAILED, f"blocked {detours} times on the way "
+                                       f"to ({goal[0]:.2f}, {goal[1]:.2f}): {why}")
                 route = []  # plan around the keep-out disc
                 continue
             self.stats.distance += sum(math.dist(a, b) for a, b in
@@ -338,9 +339,9 @@ class Executor:
             self._sense([(x, y, self.robot.pose[2]) for x, y in leg])
         return StepOutcome(StepStatus.FAILED, "too many legs")
 
-    def _blocked(self) -> str | None:
-        """The base refused a leg: its contact point becomes a blockage the paths avoid.
-        None to plan around it; else why not (no contact point to learn from)."""
+    def _blocked(self) -> str:
+        """The base refused a leg: its contact point becomes a blockage the paths avoid
+        (reported to the trace). Returns what was learned."""
         contact = getattr(self.robot, "last_contact", None)
         if contact is None:
             return "the base refused the leg and gave no contact point"
@@ -348,7 +349,7 @@ class Executor:
         self.emit("belief", blocked=blockage.id, at=[round(v, 2) for v in blockage.centre],
                   door=blockage.door, retry_at=round(blockage.until, 1),
                   detail=blockage.describe())
-        return None
+        return blockage.describe()
 
     def _no_path(self, goal: tuple[float, float]) -> str:
         """Why no path leads to `goal`, naming the blockages the robot has run into."""

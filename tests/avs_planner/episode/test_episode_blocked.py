@@ -126,3 +126,35 @@ def test_no_failed_action_is_repeated_from_an_unchanged_state(corridor) -> None:
     assert result.outcome.value == "gave_up", result.reason
     assert executed and len(executed) == len(set(executed))
     assert mind.failed_moves
+
+
+def test_a_blockage_at_a_door_names_it_cuts_edges_and_expires() -> None:
+    from avs_planner.episode.blockages import Blockages
+    from conceptual_map.places.model import Door
+
+    door = Door("door3", (5.0, 2.5), 0.8, ((5.0, 2.1), (5.0, 2.9)), True)
+    ledger = Blockages(retry_after=100.0)
+    b = ledger.add((4.6, 2.5, 0.0), time=10.0, doors={"door3": door})
+    assert b.door == "door3" and "door door3 (0.80 m wide)" in b.describe()
+    assert ledger.cutting((3.0, 2.5), (7.0, 2.5)) is b
+    assert ledger.cutting((3.0, 0.5), (7.0, 0.5)) is None
+    before = ledger.signature()
+    assert ledger.expire(50.0) == [] and ledger.signature() == before
+    assert ledger.expire(110.0) == [b] and not ledger.items
+
+
+def test_a_failed_move_is_withheld_until_something_new_is_learned(corridor) -> None:  # noqa: ANN001
+    mind, builder, _ = corridor
+    state = builder.build()
+    hub = state.robot_place
+    target = next(b for a in state.atoms if a[0] == "connected" and a[1] == hub
+                  for b in [a[2]])
+    mind.move_failed(target)
+    assert ("connected", hub, target) not in builder.build().atoms
+    far = tuple(v + 50.0 for v in mind.place_map.places[hub].position)
+    mind.block((*far, 0.0), time=1.0)  # new evidence (elsewhere): the move may be tried again
+    assert ("connected", hub, target) in builder.build().atoms
+    a, b = mind.place_map.places[hub].position, builder.build().positions[target]
+    mind.block(((a[0] + b[0]) / 2 - 0.2, (a[1] + b[1]) / 2, 0.0), time=2.0)  # on the way
+    lengths = builder._edge_length(hub, target, mind.place_map.graph.edges[hub, target])
+    assert lengths is None
