@@ -1,8 +1,9 @@
 """Blocked moves as evidence, and openings too narrow for the robot's body.
 
-A move the base refuses (`SimRobot.last_contact`: where its centre was at first contact, and
-its heading) becomes a `Blockage`: a keep-out disc just beyond the contact point that the
-grid's traversability (so every path, reachability and standpoint query) respects until
+A move the base refuses (`SimRobot.last_contact`: the point of its rim that touched something)
+becomes a `Blockage`: a keep-out disc for the robot's centre around the touched point (the
+planning radius plus a margin that grows with each touch nearby) that the grid's
+traversability (so every path, reachability and standpoint query) respects until
 `retry_after` simulated seconds have passed, and that cuts the place-graph edges through it.
 A blockage at a mapped door names the door. `narrow_openings` finds free space the robot can
 see but not reach because an opening on the way is narrower than its `passing_width`: the
@@ -42,11 +43,11 @@ class Blockage:
     def describe(self) -> str:
         where = f"({self.centre[0]:.2f}, {self.centre[1]:.2f})"
         if self.door is not None:
-            return (f"door {self.door} ({self.door_width:.2f} m wide) at {where} blocked the "
-                    f"robot at t={self.time:.0f} s")
-        return f"something unmapped at {where} blocked the robot at t={self.time:.0f} s"
+            return (f"the base touched door {self.door} ({self.door_width:.2f} m wide) at "
+                    f"{where} at t={self.time:.0f} s")
+        return f"the base touched something unmapped at {where} at t={self.time:.0f} s"
 
-    def cuts(self, a: Point, b: Point, margin: float = 0.1) -> bool:
+    def cuts(self, a: Point, b: Point, margin: float = 0.0) -> bool:
         """The straight segment a-b passes within `radius + margin` of the centre."""
         p, q, c = np.asarray(a), np.asarray(b), np.asarray(self.centre)
         d = q - p
@@ -59,21 +60,25 @@ class Blockages:
     """The blockages the robot has run into; expired ones are forgotten."""
 
     retry_after: float = 300.0  # s of simulated time before a blocked spot is tried again
-    radius: float = 0.2  # m: keep-out disc just beyond the contact point
-    door_reach: float = 0.7  # m: a contact this near a mapped door's centre is at the door
+    margin: float = 0.05  # m beyond the planning radius kept from a touched point
+    merge: float = 0.3  # m: touches this close are the same spot (each widens the berth)
+    door_reach: float = 0.7  # m: a touch this near a mapped door's centre is at the door
     items: dict[str, Blockage] = field(default_factory=dict)
     _count: int = 0
 
-    def add(self, contact: tuple[float, float, float], time: float,
-            doors: dict[str, Door]) -> Blockage:
-        x, y, heading = contact
-        centre = (x + self.radius * math.cos(heading), y + self.radius * math.sin(heading))
-        door = min(doors.values(), key=lambda d: math.dist(d.centre, centre), default=None)
-        if door is not None and math.dist(door.centre, centre) > self.door_reach:
+    def add(self, touch: Point, time: float, doors: dict[str, Door],
+            planning_radius: float) -> Blockage:
+        """The base's rim touched something at `touch`: the robot's centre keeps
+        `planning_radius` plus `margin` from there (a grid obstacle the scans missed, or a
+        mapped one a few cm off), `margin` more for each blockage already near it."""
+        near = sum(1 for b in self.items.values() if math.dist(b.centre, touch) < self.merge)
+        radius = planning_radius + self.margin * (1 + near)
+        door = min(doors.values(), key=lambda d: math.dist(d.centre, touch), default=None)
+        if door is not None and math.dist(door.centre, touch) > self.door_reach:
             door = None
         self._count += 1
-        blockage = Blockage(f"blocked{self._count}", centre, self.radius, time,
-                            time + self.retry_after, door.id if door else None,
+        blockage = Blockage(f"blocked{self._count}", (float(touch[0]), float(touch[1])), radius,
+                            time, time + self.retry_after, door.id if door else None,
                             door.width if door else None)
         self.items[blockage.id] = blockage
         return blockage

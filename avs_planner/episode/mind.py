@@ -81,9 +81,10 @@ class Mind:
 
     # ---- blocked moves ----------------------------------------------------------------------
 
-    def block(self, contact: tuple[float, float, float], time: float) -> Blockage:
-        """The base was refused at `contact` (x, y, heading): keep out of there for a while."""
-        blockage = self.blockages.add(contact, time, self.place_map.doors)
+    def block(self, touch: tuple[float, float], time: float) -> Blockage:
+        """The base's rim touched something at `touch`: keep clear of it for a while."""
+        blockage = self.blockages.add(touch, time, self.place_map.doors,
+                                      self.config.robot_radius)
         self.grid.set_keep_out(self.blockages.discs())
         return blockage
 

@@ -46,7 +46,7 @@ class SimRobot:
         self.robot = world.robot
         self.truth_of: dict[int, str | None] = {}
         self.model = self.robot.model.name
-        self.last_contact: tuple[float, float, float] | None = None
+        self.last_contact: tuple[float, float] | None = None
 
     # ---- proprioception ---------------------------------------------------------------------
 
@@ -85,14 +85,14 @@ class SimRobot:
 
     def move_along(self, path: Sequence[tuple[float, float]]) -> bool:
         """Drive through waypoints; False (without moving) if the path is blocked. Then
-        `last_contact` is where the base would have touched something and the heading it
-        drove (its own contact sense, like a bumper; never what it touched)."""
+        `last_contact` is the point (x, y) where the base's rim would have touched something
+        (its own contact sense, like a bumper; never what it touched)."""
         self.last_contact = None
         try:
             self.robot.move_along(list(path))
         except PathBlockedError as exc:
-            if exc.at is not None and exc.heading is not None:
-                self.last_contact = (*exc.at, exc.heading)
+            if exc.touch is not None:
+                self.last_contact = exc.touch
             return False
         except MotionError:
             return False
