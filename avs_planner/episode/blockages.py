@@ -63,7 +63,8 @@ class Blockages:
     margin: float = 0.05  # m beyond the planning radius kept from a touched point
     merge: float = 0.3  # m: touches this close are the same spot (each widens the berth)
     door_reach: float = 0.7  # m: a touch this near a mapped door's centre is at the door
-    items: dict[str, Blockage] = field(default_factory=dict)
+    items: dict[str, Blockage] = field(default_factory=dict)  # active
+    seen: dict[str, Blockage] = field(default_factory=dict)  # every touch, never forgotten
     _count: int = 0
 
     def add(self, touch: Point, time: float, doors: dict[str, Door],
@@ -71,7 +72,7 @@ class Blockages:
         """The base's rim touched something at `touch`: the robot's centre keeps
         `planning_radius` plus `margin` from there (a grid obstacle the scans missed, or a
         mapped one a few cm off), `margin` more for each blockage already near it."""
-        near = sum(1 for b in self.items.values() if math.dist(b.centre, touch) < self.merge)
+        near = sum(1 for b in self.seen.values() if math.dist(b.centre, touch) < self.merge)
         radius = planning_radius + self.margin * (1 + near)
         door = min(doors.values(), key=lambda d: math.dist(d.centre, touch), default=None)
         if door is not None and math.dist(door.centre, touch) > self.door_reach:
@@ -81,7 +82,15 @@ class Blockages:
                             time, time + self.retry_after, door.id if door else None,
                             door.width if door else None)
         self.items[blockage.id] = blockage
+        self.seen[blockage.id] = blockage
         return blockage
+
+    def clear(self) -> list[Blockage]:
+        """Nothing else is left to try: every blocked spot is tried again (a spot touched
+        again gets a wider berth, so retrying ends)."""
+        gone = list(self.items.values())
+        self.items.clear()
+        return gone
 
     def expire(self, time: float) -> list[Blockage]:
         gone = [b for b in self.items.values() if b.until <= time]

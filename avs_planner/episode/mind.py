@@ -95,6 +95,13 @@ class Mind:
             self.grid.set_keep_out(self.blockages.discs())
         return gone
 
+    def retry_blocked(self) -> list[Blockage]:
+        """Forget the active blockages now (nothing else is left to try)."""
+        gone = self.blockages.clear()
+        if gone:
+            self.grid.set_keep_out([])
+        return gone
+
     def move_failed(self, target: str) -> None:
         """A move to `target` failed from the current place, with today's evidence."""
         here = self.place_map.current_place
