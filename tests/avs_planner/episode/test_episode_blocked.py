@@ -164,3 +164,16 @@ def test_a_failed_move_is_withheld_until_something_new_is_learned(corridor) -> N
     mind.block(((a[0] + b[0]) / 2, (a[1] + b[1]) / 2), time=2.0)  # on the way
     lengths = builder._edge_length(hub, target, mind.place_map.graph.edges[hub, target])
     assert lengths is None
+
+
+def test_blocked_spots_are_retried_when_nothing_else_is_left_at_most_twice(corridor) -> None:  # noqa: ANN001
+    mind, builder, executor = corridor
+    loop = SwitchingLoop(builder, executor, Trace(lambda: executor.robot.clock, None, None))
+    here = executor.robot.pose[:2]
+    for k in range(3):
+        mind.block((here[0] + 2.0, here[1]), time=float(k))
+        assert mind.grid.keep_out
+        assert loop._retry_blocked() is (k < 2)
+    assert len(mind.blockages.seen) == 3
+    assert [round(b.radius, 2) for b in mind.blockages.seen.values()] == [0.35, 0.4, 0.45]
+    assert "touched something unmapped" in loop._cut_off()
