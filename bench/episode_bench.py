@@ -64,8 +64,8 @@ def _median(values: list[float]) -> float:
     return statistics.median(values) if values else float("nan")
 
 
-def run(scenarios: list[str], seeds: list[int], with_reference: bool, jsonl: Path | None
-        ) -> None:
+def run(scenarios: list[str], seeds: list[int], with_reference: bool, jsonl: Path | None,
+        robot: str | None = None) -> None:
     print(f"{'scen':4s} {'ok':>6s} {'sim s':>7s} {'ref s':>7s} {'ratio':>6s} {'dist m':>7s} "
           f"{'plans':>5s} {'CP s/plan':>9s} {'DT ms/dec':>9s} {'wall s':>7s}")
     every: list[dict] = []
@@ -74,7 +74,7 @@ def run(scenarios: list[str], seeds: list[int], with_reference: bool, jsonl: Pat
         rows, refs = [], []
         for seed in seeds:
             start = time.perf_counter()
-            summary = run_episode(scenario.episode_spec(seed=seed), None, None)
+            summary = run_episode(scenario.episode_spec(seed=seed, robot=robot), None, None)
             summary["wall_time_s"] = time.perf_counter() - start
             summary["scenario"] = name
             rows.append(summary)
@@ -82,7 +82,7 @@ def run(scenarios: list[str], seeds: list[int], with_reference: bool, jsonl: Pat
                 with jsonl.open("a", encoding="utf-8") as f:
                     f.write(json.dumps(summary) + "\n")
             if with_reference and scenario.expected == "found":
-                refs.append(reference_search(scenario.episode_spec(seed=seed)))
+                refs.append(reference_search(scenario.episode_spec(seed=seed, robot=robot)))
         _print_row(name, scenario.expected, rows, refs)
         every.extend(rows)
     _print_cp_calls(every)
@@ -124,6 +124,8 @@ def main() -> None:
     parser.add_argument("--scenarios", default="a,c,d", help="comma-separated (default a,c,d)")
     parser.add_argument("--no-reference", action="store_true")
     parser.add_argument("--jsonl", type=Path, help="append every episode's summary here")
+    parser.add_argument("--robot", choices=("pioneer", "pr2"),
+                        help="robot model (default: the scenario's world's)")
     args = parser.parse_args()
     scenarios = ["a", "c"] if args.quick else args.scenarios.split(",")
     unknown = set(scenarios) - set(builtin_scenarios())
@@ -133,7 +135,7 @@ def main() -> None:
     print(f"episode bench: scenarios {','.join(scenarios)}, seeds {seeds[0]}..{seeds[-1]}; "
           "sim/ref/dist: medians over successful runs; ref = frontier exploration looking "
           "around at every stop")
-    run(scenarios, seeds, not args.no_reference, args.jsonl)
+    run(scenarios, seeds, not args.no_reference, args.jsonl, args.robot)
 
 
 if __name__ == "__main__":

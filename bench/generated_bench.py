@@ -27,15 +27,16 @@ from avs_planner.episode.worlds import generated_targets
 STRATEGIES = ("switching", "exhaustive", "most-likely-room")
 
 
-def episodes(worlds: int, style: str, strategies: list[str], first: int = 0
-             ) -> list[dict]:
+def episodes(worlds: int, style: str, strategies: list[str], first: int = 0,
+             robot: str | None = None) -> list[dict]:
     """One spec per (world, target, strategy); the targets come from the generator's record."""
     specs = []
     for seed in range(first, first + worlds):
         for label, present in generated_targets(seed, style):
             for strategy in strategies:
                 specs.append({"generate": {"seed": seed, "style": style}, "target": label,
-                              "seed": seed, "strategy": strategy, "present": present})
+                              "seed": seed, "strategy": strategy, "present": present,
+                              **({"robot": robot} if robot else {})})
     return specs
 
 
@@ -108,9 +109,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=int, default=None)
     parser.add_argument("--quick", action="store_true", help="3 worlds")
     parser.add_argument("--jsonl", type=Path, help="write every episode's summary here")
+    parser.add_argument("--robot", choices=("pioneer", "pr2"),
+                        help="robot model (default: the world's, the pioneer)")
     args = parser.parse_args(argv)
     strategies = args.strategies.split(",")
-    specs = episodes(3 if args.quick else args.worlds, args.style, strategies, args.first)
+    specs = episodes(3 if args.quick else args.worlds, args.style, strategies, args.first,
+                     args.robot)
     print(f"generated bench: {len(specs)} episodes ({args.style} worlds "
           f"{args.first}..{args.first + (3 if args.quick else args.worlds) - 1}, "
           f"strategies {', '.join(strategies)})", flush=True)

@@ -17,7 +17,19 @@ class MotionError(SimError):
 
 
 class PathBlockedError(MotionError):
-    """`move_along` refused a path because the robot's footprint would hit the world."""
+    """`move_along` refused a path because the robot's footprint would hit the world.
+
+    `at` is where the base's centre would have been at first contact, `heading` the direction
+    it was driving and `touch` the point of the base's rim that touched (what a bumper or a
+    stalled base controller tells a real robot: where, never what).
+    """
+
+    def __init__(self, message: str, at: tuple[float, float] | None = None,
+                 heading: float | None = None, touch: tuple[float, float] | None = None):
+        super().__init__(message)
+        self.at = at
+        self.heading = heading
+        self.touch = touch
 
 
 class JointLimitError(MotionError):

@@ -55,6 +55,7 @@ class Robot:
         self._rng = world.rng(f"robot-{model}-sensors")
         self._pose = (float(start[0]), float(start[1]), float(start[2]))
         self._torso = self._pan = self._tilt = 0.0
+        self._touch: tuple[float, float] | None = None  # where the base last touched something
         self._load_body()
         blocker = self._collision_at(self._pose)
         if blocker is not None:
@@ -221,6 +222,7 @@ class Robot:
         client.performCollisionDetection()
         for contact in client.getContactPoints(bodyA=self.body):
             if contact[8] < -_PENETRATION:
+                self._touch = (float(contact[5][0]), float(contact[5][1]))  # on the base
                 return self.world.body_name(contact[2])
         return None
 
@@ -237,7 +239,9 @@ class Robot:
                         raise PathBlockedError(
                             f"move_along: segment {i} from ({x:.2f}, {y:.2f}) to ({px:.2f}, "
                             f"{py:.2f}) is blocked at ({cx:.2f}, {cy:.2f}) by {blocker} "
-                            f"(footprint radius {self.model.footprint_radius:g} m); not moved")
+                            f"(footprint radius {self.model.footprint_radius:g} m); not moved",
+                            at=(float(cx), float(cy)), heading=math.atan2(py - y, px - x),
+                            touch=self._touch)
                 x, y = px, py
         finally:
             self._set_pose(start)

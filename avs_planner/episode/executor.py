@@ -47,6 +47,9 @@ class ExecutorConfig:
     agree: tuple[float, float] = (0.25, 0.6)  # m, for the target / for supports (whose
     # detected centre moves with the part in view)
     squeeze: float = 0.08  # m less clearance when no path keeps the full margin
+    # a leg the base refuses becomes a keep-out disc and the path is planned again around
+    # it, up to this many times per move; then the move fails and the CP plans around it
+    detours: int = 2
     miss_penalty: float = 500.0  # s of robot time: the CP's goal reward R
     support_radius: float = 0.9  # m: a detection this near a support is "on" it
     same_object: float = 1.0  # m: a detection this near a known object of its label is it
@@ -289,6 +292,8 @@ class Executor:
                                target not in self.mind.place_map.placeholders)
         if status.status is StepStatus.DONE and is_placeholder:
             self.look_around()
+        if status.status is StepStatus.FAILED:
+            self.mind.move_failed(target)
         return status
 
     def drive_to(self, goal: tuple[float, float], stop: Callable[[], bool] = lambda: False
@@ -296,7 +301,7 @@ class Executor:
         """Drive leg by leg to `goal`, re-planning the path on the growing grid."""
         cfg = self.config
         route: list[tuple[float, float]] = []  # the rest of the last A* path
-        age = 0
+        age = detours = 0
         for _ in range(cfg.max_legs):
             if stop():
                 return StepOutcome(StepStatus.DONE, "explored on the way")
@@ -316,17 +321,41 @@ class Executor:
                 if not path.found:
                     path = self._squeeze(here[:2], goal)
                 if not path.found:
-                    return StepOutcome(StepStatus.FAILED, f"no path to {goal}")
+                    return StepOutcome(StepStatus.FAILED, self._no_path(goal))
                 route, age = list(path.waypoints), 0
             route[0] = here[:2]
             leg, route = _split_leg(route, cfg.leg)
             age += 1
             if not self.robot.move_along(leg):
-                return StepOutcome(StepStatus.FAILED, "blocked")
+                detours += 1
+                why = self._blocked()
+                if getattr(self.robot, "last_contact", None) is None or detours > cfg.detours:
+                    return StepOutcome(StepStatus.FAILED, f"blocked {detours} times on the way "
+                                       f"to ({goal[0]:.2f}, {goal[1]:.2f}): {why}")
+                route = []  # plan around the keep-out disc
+                continue
             self.stats.distance += sum(math.dist(a, b) for a, b in
                                        zip([here[:2], *leg], leg, strict=False))
             self._sense([(x, y, self.robot.pose[2]) for x, y in leg])
         return StepOutcome(StepStatus.FAILED, "too many legs")
+
+    def _blocked(self) -> str:
+        """The base refused a leg: its contact point becomes a blockage the paths avoid
+        (reported to the trace). Returns what was learned."""
+        contact = getattr(self.robot, "last_contact", None)
+        if contact is None:
+            return "the base refused the leg and gave no contact point"
+        blockage = self.mind.block(contact, self.robot.clock)
+        self.emit("belief", blocked=blockage.id, at=[round(v, 2) for v in blockage.centre],
+                  door=blockage.door, retry_at=round(blockage.until, 1),
+                  detail=blockage.describe())
+        return blockage.describe()
+
+    def _no_path(self, goal: tuple[float, float]) -> str:
+        """Why no path leads to `goal`, naming the blockages the robot has run into."""
+        known = [b.describe() for b in self.mind.blockages.items.values()]
+        return f"no path to ({goal[0]:.2f}, {goal[1]:.2f})" + (
+            f" ({'; '.join(known)})" if known else "")
 
     def _clear(self, route: list[tuple[float, float]]) -> bool:
         """The rest of the last path still keeps the full margin on the grown grid (so the
@@ -352,11 +381,15 @@ class Executor:
         return True
 
     def _squeeze(self, start: tuple[float, float], goal: tuple[float, float]):  # noqa: ANN202
-        """A path with a slimmer margin (the robot may start close to furniture), then one
+        """A path with a slimmer margin (the robot may start close to furniture; never below
+        its footprint less a cell: `clearance` underestimates by half a cell), then one
         through unknown cells (a laser mounted ahead of the base never sees the cells under
         and behind it); the simulator still refuses any motion that would collide."""
         radius = self.mind.config.robot_radius
-        tries = ((radius - self.config.squeeze, False), (radius, True))
+        slim = radius - self.config.squeeze
+        if self.mind.body is not None:  # never slimmer than the footprint less a grid cell
+            slim = max(slim, self.mind.body.footprint_radius - self.mind.grid.resolution)
+        tries = ((slim, False), (radius, True))
         for margin, unknown in tries:
             try:
                 path = plan_path(self.mind.grid, start, goal, margin, allow_unknown=unknown)

@@ -48,6 +48,8 @@ class LoopConfig:
     # the detector looks for the target as the robot drives (Executor.watch); False searches
     # only through the DT's view cones, as the seed's system did
     watch: bool = True
+    # blocked spots are tried again this many times when nothing else is left
+    retry_blocked: int = 2
 
 
 class SwitchingLoop:
@@ -62,6 +64,10 @@ class SwitchingLoop:
         self.planner: ContinualPlanner | None = None
         self.start_clock = executor.robot.clock
         self.visited_rooms: set[str] = set()
+        # (action, belief state) pairs that failed: never executed again (a guard; the state
+        # builder already withholds a failed move until something new is learned)
+        self.failed: set[tuple[str, int]] = set()
+        self.retries = 0
 
     def run(self) -> SearchResult:
         self.executor.watching = self.config.watch
@@ -84,7 +90,13 @@ class SwitchingLoop:
             if index is None:
                 return self._end(Outcome.GAVE_UP, "plan has no executable step")
             step = self.planner.plan[index]
+            tried = (step.label, _signature(state))
+            if tried in self.failed:
+                return self._end(Outcome.GAVE_UP, f"{step.label} failed from this very state "
+                                 f"before and nothing new was learned since")
             outcome = self._execute(step, state)
+            if outcome.status is StepStatus.FAILED:
+                self.failed.add(tried)
             if outcome.status is StepStatus.FOUND:
                 self.result.found = outcome.reported
                 return self._end(Outcome.FOUND, outcome.detail)
@@ -156,6 +168,8 @@ class SwitchingLoop:
                 result = self._plan_again("after visiting an uncertain room")
             elif self._doubt_categories():
                 result = self._plan_again("doubting room categories believed certain")
+            elif self._retry_blocked():
+                result = self._plan_again("retrying spots the base was blocked at")
             else:
                 return result
 
@@ -195,6 +209,19 @@ class SwitchingLoop:
             return False
         self.builder.config = replace(cfg, certain_category=doubt)
         self.trace.emit("belief", doubt_categories=doubt, reason="no plan above the threshold")
+        return True
+
+    def _retry_blocked(self) -> bool:
+        """No plan is good enough while blocked spots are kept out of: try them again before
+        giving up, at most `retry_blocked` times (each touch there widens the berth)."""
+        if self.retries >= self.config.retry_blocked:
+            return False
+        gone = self.executor.mind.retry_blocked()
+        if not gone:
+            return False
+        self.retries += 1
+        self.trace.emit("belief", retry_blocked=[b.id for b in gone],
+                        reason="no plan above the threshold")
         return True
 
     def _shrink(self) -> bool:
@@ -256,10 +283,27 @@ class SwitchingLoop:
         return None
 
     def _end(self, outcome: Outcome, reason: str) -> SearchResult:
+        if outcome is Outcome.GAVE_UP:
+            reason += self._cut_off()
         self.result.outcome, self.result.reason = outcome, reason
         self.trace.emit("done", outcome=outcome.value, reason=reason)
         return self.result
 
+
+    def _cut_off(self) -> str:
+        """What the robot's body keeps it from: blocked doors and openings too narrow."""
+        mind = self.executor.mind
+        notes = [b.describe() for b in mind.blockages.seen.values()]
+        notes += [o.describe(mind.passing_width)
+                  for o in mind.narrow_openings(self.executor.robot.pose[:2])]
+        if notes:
+            self.trace.emit("belief", cut_off=notes)
+        return f"; unreachable: {'; '.join(notes)}" if notes else ""
+
+
+def _signature(state: AvsState) -> int:
+    """The belief state as the CP sees it (atoms and numbers)."""
+    return hash((state.atoms, frozenset(state.values.items())))
 
 
 def _timed_out(result: PlanResult) -> bool:

@@ -12,8 +12,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from avs_planner.body import RobotBody
+from avs_planner.episode.blockages import Blockage, Blockages, NarrowOpening, narrow_openings
 from conceptual_map.conceptual import ConceptualMap, RelatedSpace
 from conceptual_map.conceptual.place_events import PlaceMapFeed
+from conceptual_map.knowledge import Knowledge
 from conceptual_map.metric import OccupancyGrid, VoxelMap
 from conceptual_map.metric.sensors import DepthFrameLike, LaserScanLike
 from conceptual_map.places import MapEvent, PlaceMap, PlaceMapConfig
@@ -34,9 +37,15 @@ class KnownObject:
 
 @dataclass
 class Mind:
-    """Occupancy grid, place map, conceptual map (fed by place-map events), known objects."""
+    """Occupancy grid, place map, conceptual map (fed by place-map events), known objects.
 
-    config: PlaceMapConfig = field(default_factory=lambda: PlaceMapConfig(robot_radius=0.3))
+    Without a body it plans for a Pioneer-sized disc (0.30 m); `Mind.for_body` plans for the
+    robot's own footprint (`RobotBody.planning_radius`)."""
+
+    config: PlaceMapConfig = field(default_factory=lambda: PlaceMapConfig(
+        robot_radius=0.3))
+    body: RobotBody | None = None
+    knowledge: Knowledge | None = None
     resolution: float = 0.05
     grid: OccupancyGrid = field(init=False)
     place_map: PlaceMap = field(init=False)
@@ -48,15 +57,70 @@ class Mind:
     voxel_resolution: float = 0.05
     voxel_heights: tuple[float, float] = (-0.1, 2.5)  # m: the band the 3D map covers
     voxels: VoxelMap | None = field(default=None, init=False)
+    blockages: Blockages = field(default_factory=Blockages)
+    # (place, move target) -> the blockage evidence when that move failed from that place:
+    # while the robot stands there with the same evidence, the move is not offered again
+    failed_moves: dict[tuple[str, str], frozenset[str]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.grid = OccupancyGrid(resolution=self.resolution)
         self.place_map = PlaceMap(self.config)
-        self.cmap = ConceptualMap()
+        self.cmap = ConceptualMap(self.knowledge)
         self._feed = PlaceMapFeed(self.cmap)
+
+    @classmethod
+    def for_body(cls, body: RobotBody, knowledge: Knowledge | None = None) -> Mind:
+        """A mind that plans for `body`'s footprint (from the robot model, never the world)."""
+        return cls(config=PlaceMapConfig(robot_radius=body.planning_radius),
+                   body=body, knowledge=knowledge)
+
+    @property
+    def passing_width(self) -> float:
+        """The narrowest opening the mind plans through."""
+        return 2.0 * self.config.robot_radius
+
+    # ---- blocked moves ----------------------------------------------------------------------
+
+    def block(self, touch: tuple[float, float], time: float) -> Blockage:
+        """The base's rim touched something at `touch`: keep clear of it for a while."""
+        blockage = self.blockages.add(touch, time, self.place_map.doors,
+                                      self.config.robot_radius)
+        self.grid.set_keep_out(self.blockages.discs())
+        return blockage
+
+    def forget_blockages(self, time: float) -> list[Blockage]:
+        """Blockages past their retry time are tried again."""
+        gone = self.blockages.expire(time)
+        if gone:
+            self.grid.set_keep_out(self.blockages.discs())
+        return gone
+
+    def retry_blocked(self) -> list[Blockage]:
+        """Forget the active blockages now (nothing else is left to try)."""
+        gone = self.blockages.clear()
+        if gone:
+            self.grid.set_keep_out([])
+        return gone
+
+    def move_failed(self, target: str) -> None:
+        """A move to `target` failed from the current place, with today's evidence."""
+        here = self.place_map.current_place
+        if here is not None:
+            self.failed_moves[(here, target)] = self.blockages.signature()
+
+    def move_withheld(self, place: str, target: str) -> bool:
+        """The move failed from `place` and nothing was learned since (by construction it is
+        not offered again: no identical failed move from an unchanged state)."""
+        return self.failed_moves.get((place, target)) == self.blockages.signature()
+
+    def narrow_openings(self, robot: tuple[float, float]) -> list[NarrowOpening]:
+        """Openings on the way to seen free space that are narrower than the robot passes."""
+        return narrow_openings(self.grid, robot, self.config.robot_radius, self.place_map.doors,
+                               self.config)
 
     def sense(self, scan: LaserScanLike, poses: list[Pose], time: float) -> list[MapEvent]:
         """Integrate a scan taken at the end of `poses` and grow the place map along them."""
+        self.forget_blockages(time)
         self.grid.integrate_scan(scan)
         events = self.place_map.follow(self.grid, poses, time)
         self._feed.apply(events)

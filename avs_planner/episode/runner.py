@@ -28,6 +28,7 @@ from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.trace import Trace, write_summary
 from avs_planner.episode.viewcones import CameraModel
 from avs_planner.strategies import SearchContext, get_strategy
+from conceptual_map.knowledge import load_knowledge
 
 Emit = Callable[[dict[str, Any]], None]
 
@@ -139,10 +140,10 @@ class Episode:
         self.spec = spec
         self.out = Path(spec.output_dir) if spec.output_dir else None
         self.world_spec = self._world_spec()
-        self.mind = Mind()
-        categories = self.mind.cmap.knowledge.categories
-        check_categories(self.world_spec, categories)
-        self.robot: SimRobot = open_world(self.world_spec, spec.seed, categories)
+        knowledge = load_knowledge()
+        check_categories(self.world_spec, knowledge.categories)
+        self.robot: SimRobot = open_world(self.world_spec, spec.seed, knowledge.categories)
+        self.mind = Mind.for_body(self.robot.body(), knowledge)  # its own body, not the world
         if self.out is not None:
             self.out.mkdir(parents=True, exist_ok=True)
         self.trace = Trace(lambda: self.robot.clock, self.out / "trace.jsonl" if self.out

@@ -240,18 +240,36 @@ class StateBuilder:
         hub = pm.current_place
         nodes = sorted(places | placeholders)
         atoms |= {("at", hub)} | {("visited", p) for p in places}
-        lengths = nx.single_source_dijkstra_path_length(pm.graph, hub, weight="length")
+        lengths = nx.single_source_dijkstra_path_length(pm.graph, hub, weight=self._edge_length)
         for a in nodes:
             for b in nodes:
                 values[("move-cost", a, b)] = 0.0
         for node in nodes:
             d = lengths.get(node, math.inf)
-            if node == hub or not math.isfinite(d):
+            if node == hub or not math.isfinite(d) or self.mind.move_withheld(hub, node):
                 continue
             values[("move-cost", hub, node)] = values[("move-cost", node, hub)] = round(d, 3)
             atoms |= {("connected", hub, node), ("connected", node, hub)}
         for p in nodes:
             atoms.add(("in-room", p, pm.room_of(p)))
+
+    def _edge_length(self, u: str, v: str, data: dict) -> float | None:
+        """Place-graph edge length; None (impassable) through a blockage the robot ran into."""
+        blockages = self.mind.blockages
+        if not blockages.items:
+            return data["length"]
+        a, b = self._node_position(u), self._node_position(v)
+        if a is not None and b is not None and blockages.cutting(a, b) is not None:
+            return None
+        return data["length"]
+
+    def _node_position(self, node: str) -> tuple[float, float] | None:
+        pm = self.mind.place_map
+        if node in pm.places:
+            return pm.places[node].position
+        if node in pm.placeholders:
+            return pm.placeholders[node].position
+        return None
 
     def _rooms(self, rooms: list[str], placeholders: set[str], atoms: set[Atom],
                values: dict[Atom, float]) -> None:

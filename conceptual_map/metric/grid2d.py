@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from scipy import ndimage
 
@@ -25,6 +27,34 @@ class OccupancyGrid(LogOddsGrid):
         super().__init__(origin, shape, resolution, model)
         self.version = 0
         self._cache: dict[tuple, np.ndarray] = {}
+        # discs (x, y, r) the robot's centre must keep out of, whatever the cells say: places
+        # where its own motion was blocked by something the scans do not show
+        self.keep_out: tuple[tuple[float, float, float], ...] = ()
+
+    def set_keep_out(self, discs: Sequence[tuple[float, float, float]]) -> None:
+        """Replace the keep-out discs (derived grids are recomputed if they changed)."""
+        discs = tuple((float(x), float(y), float(r)) for x, y, r in discs)
+        if discs != self.keep_out:
+            self.keep_out = discs
+            self._touch()
+
+    def keep_out_mask(self) -> np.ndarray:
+        """Cells whose centre lies in a keep-out disc (cached until the next update)."""
+
+        def build() -> np.ndarray:
+            mask = np.zeros(self.shape, dtype=bool)
+            for x, y, r in self.keep_out:
+                lo = np.maximum(self.to_cell(np.array([[x - r, y - r]]))[0], 0)
+                hi = np.minimum(self.to_cell(np.array([[x + r, y + r]]))[0] + 1, self.shape)
+                if (hi <= lo).any():
+                    continue
+                ii, jj = np.mgrid[lo[0]:hi[0], lo[1]:hi[1]]
+                centres = self.to_world(np.stack([ii.ravel(), jj.ravel()], axis=1))
+                inside = np.hypot(centres[:, 0] - x, centres[:, 1] - y) <= r
+                mask[ii.ravel()[inside], jj.ravel()[inside]] = True
+            return mask
+
+        return self._cached(("keep_out",), build)
 
     def integrate_scan(self, scan: LaserScanLike) -> UpdateSummary:
         """Add one laser scan (rays that hit nothing clear space up to max range)."""
@@ -79,14 +109,16 @@ class OccupancyGrid(LogOddsGrid):
         return self._cached(("clearance",), build)
 
     def traversable(self, robot_radius: float, allow_unknown: bool = False) -> np.ndarray:
-        """Cells where a disc of `robot_radius` fits without touching an occupied cell."""
+        """Cells where a disc of `robot_radius` fits without touching an occupied cell (and
+        outside every keep-out disc)."""
 
         def build() -> np.ndarray:
             states = self.state_grid()
             known_ok = states == CellState.FREE
             if allow_unknown:
                 known_ok |= states == CellState.UNKNOWN
-            return known_ok & (self.clearance() >= robot_radius)
+            ok = known_ok & (self.clearance() >= robot_radius)
+            return ok & ~self.keep_out_mask() if self.keep_out else ok
 
         return self._cached(("traversable", robot_radius, allow_unknown), build)
 

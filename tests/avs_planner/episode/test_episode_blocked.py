@@ -1,0 +1,179 @@
+"""The robot's body in the loop: doors vs footprint, blocked moves as evidence, no repeats."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from avs_planner.episode import Episode, EpisodeSpec
+from avs_planner.episode.executor import Executor
+from avs_planner.episode.loop import SwitchingLoop, _signature
+from avs_planner.episode.mind import Mind
+from avs_planner.episode.outcome import StepStatus
+from avs_planner.episode.robot import load_spec, open_world
+from avs_planner.episode.state_builder import SearchTask, StateBuilder
+from avs_planner.episode.trace import Trace
+from avs_planner.episode.viewcones import CameraModel
+
+_WORLD = """name: door_{w}
+size: [10.0, 5.0]
+wall_height: 2.0
+rooms:
+  - {{name: hall, category: office, rect: [0.0, 0.0, 5.0, 5.0]}}
+  - {{name: kitchen, category: kitchen, rect: [5.0, 0.0, 10.0, 5.0]}}
+doors:
+  - {{rooms: [hall, kitchen], at: [5.0, 2.5], width: {w}}}
+furniture:
+  - {{name: table1, label: table, room: kitchen, pose: [7.5, 2.5, 0.0], size: [1.2, 0.8, 0.75]}}
+objects:
+  - {{name: cereal1, label: cerealbox, on: table1, offset: [0.0, 0.0], size: [0.2, 0.07, 0.3]}}
+robot: {{model: pioneer, start: [2.5, 2.5, 0.0]}}
+"""
+
+
+def _episode(width: float, robot: str) -> tuple[dict, Episode]:
+    spec = EpisodeSpec.from_dict({"target": "cerealbox", "world_file": _WORLD.format(w=width),
+                                  "robot": robot, "seed": 1, "time_budget_s": 900.0})
+    episode = Episode(spec)
+    return episode.run(), episode
+
+
+def test_the_mind_plans_with_the_robots_own_footprint() -> None:
+    for model, radius in (("pioneer", 0.30), ("pr2", 0.36)):
+        robot = open_world(load_spec("office", model), 0)
+        try:
+            assert Mind.for_body(robot.body()).config.robot_radius == pytest.approx(radius)
+        finally:
+            robot.world.close()
+
+
+def test_a_door_narrower_than_the_pr2_is_never_planned_through_and_named() -> None:
+    summary, episode = _episode(0.6, "pr2")
+    assert summary["outcome"] == "gave_up"
+    assert "needs 0.72 m" in summary["reason"] and "wide at (4.9" in summary["reason"]
+    assert all(x < 5.0 for x, *_ in episode.executor.stats.path)  # never went through
+    assert not episode.mind.blockages.items  # never even tried (so never blocked)
+
+
+@pytest.mark.parametrize("robot", ["pioneer", "pr2"])
+def test_a_door_wider_than_the_robot_is_passed(robot: str) -> None:
+    summary, episode = _episode(0.9, robot)
+    assert summary["outcome"] == "found" and summary["correct"]
+    assert any(x > 5.5 for x, *_ in episode.executor.stats.path)
+
+
+class _HiddenObstacle:
+    """A robot adapter whose base also refuses legs through a disc no scan shows (a low box
+    under the laser), reporting the contact point like the simulator does."""
+
+    def __init__(self, robot, centre: tuple[float, float], radius: float):  # noqa: ANN001
+        self._robot, self.centre, self.radius = robot, centre, radius
+        self.refused = 0
+
+    def __getattr__(self, name: str):  # noqa: ANN204 - delegate everything else
+        return getattr(self._robot, name)
+
+    def move_along(self, path: list[tuple[float, float]]) -> bool:
+        reach = self.radius + self._robot.robot.model.footprint_radius
+        x, y = self._robot.pose[:2]
+        for px, py in path:
+            n = max(2, int(math.dist((x, y), (px, py)) / 0.02) + 1)
+            for k in range(n):
+                cx, cy = x + (px - x) * k / (n - 1), y + (py - y) * k / (n - 1)
+                d = math.dist((cx, cy), self.centre)
+                if d < reach:  # the rim point toward the obstacle touched it
+                    self.refused += 1
+                    rim = self._robot.robot.model.footprint_radius / d
+                    self._robot.last_contact = (cx + (self.centre[0] - cx) * rim,
+                                                cy + (self.centre[1] - cy) * rim)
+                    return False
+            x, y = px, py
+        return self._robot.move_along(path)
+
+
+def test_a_move_blocked_by_an_unmapped_obstacle_goes_around_it() -> None:
+    sim = open_world(load_spec("office", start=(6.0, 3.2, 0.0)), seed=1)
+    try:
+        robot = _HiddenObstacle(sim, (8.0, 2.9), 0.1)
+        mind = Mind.for_body(sim.body())
+        builder = StateBuilder(mind, SearchTask("cerealbox"))
+        events: list[tuple] = []
+        executor = Executor(robot, mind, builder, CameraModel(sim.camera_height, 1.0, 3.5),
+                            lambda *a, **k: events.append((a, k)))
+        executor.look_around()
+        outcome = executor.drive_to((10.0, 3.2))
+        assert outcome.status is StepStatus.DONE, outcome.detail
+        assert 1 <= robot.refused <= 2 and len(mind.blockages.items) == robot.refused
+        assert any(k.get("blocked") for _, k in events)  # the trace reports it
+        assert math.dist(sim.pose[:2], (10.0, 3.2)) <= executor.config.arrive
+    finally:
+        sim.world.close()
+
+
+def test_no_failed_action_is_repeated_from_an_unchanged_state(corridor) -> None:  # noqa: ANN001
+    """Every move is refused (with no contact point to learn from): the episode must end
+    with a reason, never re-running a failed action from the same belief state."""
+    mind, builder, executor = corridor
+    executor.robot.move_along = lambda path: False
+    executed: list[tuple[str, int]] = []
+    loop = SwitchingLoop(builder, executor, Trace(lambda: executor.robot.clock, None, None))
+    run = loop._execute
+
+    def record(step, state):  # noqa: ANN001, ANN202
+        executed.append((step.label, _signature(state)))
+        return run(step, state)
+
+    loop._execute = record
+    result = loop.run()
+    assert result.outcome.value == "gave_up", result.reason
+    assert executed and len(executed) == len(set(executed))
+    assert mind.failed_moves
+
+
+def test_a_blockage_at_a_door_names_it_cuts_edges_and_expires() -> None:
+    from avs_planner.episode.blockages import Blockages
+    from conceptual_map.places.model import Door
+
+    door = Door("door3", (5.0, 2.5), 0.8, ((5.0, 2.1), (5.0, 2.9)), True)
+    ledger = Blockages(retry_after=100.0)
+    b = ledger.add((5.0, 2.1), time=10.0, doors={"door3": door}, planning_radius=0.34)
+    assert b.door == "door3" and "door door3 (0.80 m wide)" in b.describe()
+    assert b.radius == pytest.approx(0.39)
+    assert ledger.cutting((3.0, 2.3), (7.0, 2.3)) is b
+    assert ledger.cutting((3.0, 0.5), (7.0, 0.5)) is None
+    again = ledger.add((5.0, 2.15), time=11.0, doors={"door3": door}, planning_radius=0.34)
+    assert again.radius == pytest.approx(0.44)  # a second touch there: a wider berth
+    before = ledger.signature()
+    assert ledger.expire(50.0) == [] and ledger.signature() == before
+    assert ledger.expire(110.0) == [b] and ledger.expire(111.0) == [again] and not ledger.items
+
+
+def test_a_failed_move_is_withheld_until_something_new_is_learned(corridor) -> None:  # noqa: ANN001
+    mind, builder, _ = corridor
+    state = builder.build()
+    hub = state.robot_place
+    target = next(b for a in state.atoms if a[0] == "connected" and a[1] == hub
+                  for b in [a[2]])
+    mind.move_failed(target)
+    assert ("connected", hub, target) not in builder.build().atoms
+    far = tuple(v + 50.0 for v in mind.place_map.places[hub].position)
+    mind.block(far, time=1.0)  # new evidence (elsewhere): the move may be tried again
+    assert ("connected", hub, target) in builder.build().atoms
+    a, b = mind.place_map.places[hub].position, builder.build().positions[target]
+    mind.block(((a[0] + b[0]) / 2, (a[1] + b[1]) / 2), time=2.0)  # on the way
+    lengths = builder._edge_length(hub, target, mind.place_map.graph.edges[hub, target])
+    assert lengths is None
+
+
+def test_blocked_spots_are_retried_when_nothing_else_is_left_at_most_twice(corridor) -> None:  # noqa: ANN001
+    mind, builder, executor = corridor
+    loop = SwitchingLoop(builder, executor, Trace(lambda: executor.robot.clock, None, None))
+    here = executor.robot.pose[:2]
+    for k in range(3):
+        mind.block((here[0] + 2.0, here[1]), time=float(k))
+        assert mind.grid.keep_out
+        assert loop._retry_blocked() is (k < 2)
+    assert len(mind.blockages.seen) == 3
+    assert [round(b.radius, 2) for b in mind.blockages.seen.values()] == [0.35, 0.4, 0.45]
+    assert "touched something unmapped" in loop._cut_off()
