@@ -12,8 +12,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 
+import numpy as np
+
 from avs_planner.body import RobotBody
-from avs_planner.flap.planner import PlannerOptions, PlanResult, plan_greedy, plan_views
+from avs_planner.flap.planner import (
+    PlannerOptions,
+    PlanResult,
+    StopReason,
+    plan_greedy,
+    plan_views,
+)
 from avs_planner.flap.problem import SequencingProblem
 from avs_planner.flap.sampling import SamplerOptions, View, ViewPose, ViewSampler
 from avs_planner.flap.target import TargetBelief, TargetVolume
@@ -63,11 +71,28 @@ class FlapSearch:
         self.options = options or FlapOptions()
         self.planned: list[View] = []
         self.cycle = 0
+        self.exhausted = np.zeros(0, dtype=bool)  # region cells given up on (see `sensed`)
+
+    def sensed(self, voxels: VoxelMap, view: View) -> int:
+        """After the robot sensed at `view` (or as near it as it got): the cells the view was
+        expected to reveal but that the map still has unknown are taken as unobservable from
+        the views (optimistic ray casting assumed unknown space free; a solid interior, a gap
+        between depth rays, or a pose not quite reached leave them unknown). Without this a
+        continual search could choose the same view forever. Returns how many were dropped."""
+        belief = TargetBelief(voxels, self.volumes)
+        if self.exhausted.size != belief.size:
+            self.exhausted = np.zeros(belief.size, dtype=bool)
+        cells = np.asarray(view.cells, dtype=np.int64)
+        missed = cells[belief.unknown[cells] & ~self.exhausted[cells]]
+        self.exhausted[missed] = True
+        return int(missed.size)
 
     def decide(self, voxels: VoxelMap, grid: OccupancyGrid, pose: ViewPose) -> Decision:
         """Plan from the robot's pose on the current maps; returns where to look next."""
         clock = _Clock()
         belief = TargetBelief(voxels, self.volumes)
+        if self.exhausted.size == belief.size:
+            belief.mark_seen(np.flatnonzero(self.exhausted))
         sampler = ViewSampler(voxels, grid, self.body, belief, self.options.sampler)
         views = sampler.evaluate(self.planned)
         views += sampler.sample(max(0, self.options.views - len(views)),
@@ -94,7 +119,10 @@ class FlapSearch:
     def _plan(self, problem: SequencingProblem) -> PlanResult:
         if self.options.greedy:
             return plan_greedy(problem, self.options.planner.omega)
-        return plan_views(problem, self.options.planner)
+        plan = plan_views(problem, self.options.planner)
+        if not plan.sequence and plan.stop in (StopReason.TIME_LIMIT, StopReason.NODE_LIMIT):
+            return plan_greedy(problem, self.options.planner.omega)  # a limit struck first
+        return plan
 
 
 class _Clock:
