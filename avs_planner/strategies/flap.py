@@ -251,7 +251,7 @@ def run(ctx: SearchContext) -> SearchResult:
             *robot.pose, head.torso, head.pan, head.tilt)],
             p_seen=round(-math.expm1(before - after), 5),
             survival=round(math.exp(log0 - after), 5), expected_cells=int(decision.view.cells.size),
-            unrevealed=dropped, found=found is not None)
+            unrevealed=dropped, known_voxels=_known_voxels(ctx), found=found is not None)
         if found is not None:
             return _found(ctx, result, found)
     return ctx.end(result, Outcome.TIMEOUT, f"{o['max_views']} views")
