@@ -41,7 +41,8 @@ from avs_planner.strategies.context import SearchContext
 from avs_planner.strategies.looking import _look
 
 SURVEY_TILTS = (0.0, -0.6)  # rad: depth frames per survey heading (ahead, down at tables)
-SURVEY_DEPTH_COLUMNS = 48
+SURVEY_DEPTH_COLUMNS = 48  # before the clock (the prior map)
+SEARCH_SURVEY_DEPTH_COLUMNS = 32  # while the clock runs: cheaper; FLAP's views map densely
 MAX_SURVEY_STOPS = 60
 
 
@@ -59,20 +60,25 @@ class _Head:
 def prepare(ctx: SearchContext) -> None:
     """Before the clock starts (episode `pre_explore`): survey the building, detecting the
     target's supports, with depth frames into the 3D map when `prior_map` is set."""
-    survey(ctx, depth=bool(ctx.options["prior_map"]), find=False)
-    ctx.mind.tried_placeholders.clear()
+    survey(ctx, depth=bool(ctx.options["prior_map"]), find=False)  # ends with no placeholder
+    # left untried twice, so the search gives up once the region is searched (no re-survey)
     ctx.trace.emit("flap", event="prepared", supports=_support_names(ctx),
                    voxels=_known_voxels(ctx))
 
 
-def survey(ctx: SearchContext, depth: bool, find: bool) -> KnownObject | None:
+def survey(ctx: SearchContext, depth: bool, find: bool, until_support: bool = False,
+           columns: int = SURVEY_DEPTH_COLUMNS) -> KnownObject | None:
     """Visit placeholders nearest-first (frontier exploration), looking all round at every
-    stop for supports (and the target when `find`); returns the target once confirmed."""
+    stop for supports (and the target when `find`); returns the target once confirmed. With
+    `until_support` it stops after the first stop that registered a new support."""
     mind, ex = ctx.mind, ctx.executor
+    known = len(_support_names(ctx))
     ex.look_around()
-    found = _survey_stop(ctx, depth, find)
+    found = _survey_stop(ctx, depth, find, columns)
     for _ in range(MAX_SURVEY_STOPS):
         if found is not None or (find and ctx.budget_spent()):
+            break
+        if until_support and len(_support_names(ctx)) > known:
             break
         target = ex.nearest_placeholder()
         if target is None:
@@ -82,11 +88,12 @@ def survey(ctx: SearchContext, depth: bool, find: bool) -> KnownObject | None:
         outcome = ex.drive_to(goal, stop=lambda t=target: t not in mind.place_map.placeholders)
         if outcome.status is StepStatus.DONE:
             ex.look_around()
-            found = _survey_stop(ctx, depth, find)
+            found = _survey_stop(ctx, depth, find, columns)
     return found
 
 
-def _survey_stop(ctx: SearchContext, depth: bool, find: bool) -> KnownObject | None:
+def _survey_stop(ctx: SearchContext, depth: bool, find: bool, columns: int
+                 ) -> KnownObject | None:
     robot, headings = ctx.robot, ctx.options["survey_headings"]
     supports = _support_labels(ctx)
     labels = [*supports, ctx.target] if find else supports
@@ -96,7 +103,7 @@ def _survey_stop(ctx: SearchContext, depth: bool, find: bool) -> KnownObject | N
         if depth:
             for tilt in SURVEY_TILTS:
                 robot.look(0.0, tilt)
-                ctx.mind.integrate_depth(robot.depth(_size(SURVEY_DEPTH_COLUMNS)))
+                ctx.mind.integrate_depth(robot.depth(_size(columns)))
         robot.look(0.0, SURVEY_TILTS[-1] / 2)
         if not labels:
             continue
@@ -151,14 +158,15 @@ def _size(columns: int) -> tuple[int, int]:
 
 # ---- the search region -----------------------------------------------------------------------
 
-def support_volumes(ctx: SearchContext) -> list[TargetVolume]:
-    """One box above each known support of the target; overlapping boxes of a label merge."""
+def support_volumes(ctx: SearchContext, skip: set[str] = frozenset()) -> list[TargetVolume]:
+    """One box above each known support of the target (but those in `skip`); overlapping
+    boxes of a label merge. A volume's name lists its supports' ids joined by '+'."""
     o, mind = ctx.options, ctx.mind
     labels = set(_support_labels(ctx))
     boxes: list[list] = []  # [lo, hi, label, P, ids]
     reach, height = o["support_reach"], o["volume_height"]
     for obj in mind.objects.values():
-        if obj.label not in labels:
+        if obj.label not in labels or obj.id in skip:
             continue
         x, y, z = obj.position
         top = max(0.3, 2.0 * z)  # a detection's centre is half the support's height
@@ -195,21 +203,41 @@ def _p_on(ctx: SearchContext, obj: KnownObject) -> float:
 # ---- the search ------------------------------------------------------------------------------
 
 def run(ctx: SearchContext) -> SearchResult:
+    """Search the known supports' region with FLAP; when it is exhausted (omega), survey on to
+    the next support (or, with none known yet, survey until one is seen)."""
     result = SearchResult(Outcome.GAVE_UP, "")
-    o, mind, robot = ctx.options, ctx.mind, ctx.robot
-    if not support_volumes(ctx):
-        found = survey(ctx, depth=True, find=True)
-        if found is not None:
-            return _found(ctx, result, found)
+    mind, ex = ctx.mind, ctx.executor
+    head = _Head(torso=max(0.0, ctx.robot.camera_height - ctx.body.camera_height))
+    searched: set[str] = set()
+    reset, why = bool(ctx.options["reset_region"]), "no support of the target is known"
+    while True:
         stop = ctx.budget_spent()
         if stop:
             return ctx.end(result, Outcome.TIMEOUT, stop)
-    volumes = support_volumes(ctx)
-    if not volumes:
-        return ctx.end(result, Outcome.GAVE_UP, "no support of the target is known")
-    head = _Head(torso=max(0.0, robot.camera_height - ctx.body.camera_height))
+        volumes = support_volumes(ctx, skip=searched)
+        if volumes:
+            ended = _search_region(ctx, result, volumes, head, reset)
+            if ended is not None:
+                return ended
+            searched |= {oid for v in volumes for oid in v.name.split("+")}
+            why = "the known supports are searched (p(V̂(S)) < omega)"
+        elif mind.place_map.places and ex.nearest_placeholder() is None:
+            return ctx.end(result, Outcome.GAVE_UP, f"{why}; nothing left to explore")
+        else:
+            found = survey(ctx, depth=True, find=True, until_support=True,
+                           columns=SEARCH_SURVEY_DEPTH_COLUMNS)
+            if found is not None:
+                return _found(ctx, result, found)
+        reset = False  # only the map known before the search is taken as out of date
+
+
+def _search_region(ctx: SearchContext, result: SearchResult, volumes: list[TargetVolume],
+                   head: _Head, reset: bool) -> SearchResult | None:
+    """The FLAP cycle over one region until the target is found (the ended result), the
+    budget is spent (ditto), or p(V̂(S)) < omega (None)."""
+    o, mind, robot = ctx.options, ctx.mind, ctx.robot
     mind.integrate_depth(robot.depth(_size(o["depth_columns"])))  # makes the map if none
-    if o["reset_region"]:
+    if reset:
         for volume in volumes:
             mind.voxels.reset_box(volume.lo, volume.hi)
     tracker = TargetBelief(mind.voxels, volumes)
@@ -237,11 +265,8 @@ def run(ctx: SearchContext) -> SearchResult:
                        stop=plan.stop.value if plan else None,
                        seconds={**{n: round(s, 3) for n, s in decision.seconds.items()},
                                 "total": round(time.perf_counter() - began, 3)})
-        if decision.status is SearchStatus.DONE:
-            return ctx.end(result, Outcome.GAVE_UP, f"p(V̂(S)) = {decision.p_remaining:.3f} "
-                           f"< omega = {o['omega']:g}: the region is searched")
-        if decision.status is SearchStatus.NO_VIEWS:
-            return ctx.end(result, Outcome.GAVE_UP, "no reachable view sees the search region")
+        if decision.status is not SearchStatus.GO:
+            return None  # DONE: p(V̂(S)) < omega; NO_VIEWS: nothing reachable sees the region
         found = _visit(ctx, decision.view, head)
         dropped = search.sensed(mind.voxels, decision.view)
         before = float(tracker.log_miss().sum())
@@ -254,7 +279,7 @@ def run(ctx: SearchContext) -> SearchResult:
             unrevealed=dropped, known_voxels=_known_voxels(ctx), found=found is not None)
         if found is not None:
             return _found(ctx, result, found)
-    return ctx.end(result, Outcome.TIMEOUT, f"{o['max_views']} views")
+    return None
 
 
 def _visit(ctx: SearchContext, view: View, head: _Head) -> KnownObject | None:
