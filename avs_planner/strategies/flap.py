@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 import time
+import weakref
 from dataclasses import dataclass
 
 from avs_planner.episode.mind import KnownObject
@@ -117,15 +118,20 @@ def _survey_stop(ctx: SearchContext, depth: bool, find: bool, columns: int
 
 
 def _register_supports(ctx: SearchContext, seen: list) -> None:
-    """Supports seen in one frame become known objects when a second frame repeats them and
-    no known object of their label is within `same_object` m."""
+    """Supports seen in a frame become known objects when another detection repeats them (a
+    second frame now, or any later frame of the survey: a pose may see a support only at the
+    edge of the image) and no known object of their label is within `same_object` m."""
     if not seen:
         return
     ex, mind = ctx.executor, ctx.mind
+    pending = _PENDING.setdefault(ex, [])
     again = ctx.robot.detect(sorted({s.label for s in seen}))
+    near = ex.config.agree[1]
     for s in seen:
-        if not any(a.label == s.label and math.dist(a.position, s.position) <= ex.config.agree[1]
-                   for a in again):
+        repeated = [a for a in (*again, *pending) if a.label == s.label
+                    and math.dist(a.position, s.position) <= near]
+        if not repeated:
+            pending.append(s)
             continue
         if any(o.label == s.label and math.dist(o.position[:2], s.position[:2])
                <= ex.config.same_object for o in mind.objects.values()):
@@ -136,6 +142,10 @@ def _register_supports(ctx: SearchContext, seen: list) -> None:
             continue  # no room known there yet
         ctx.trace.emit("observation", label=s.label, detected=True, registered=obj.id,
                        position=[round(v, 2) for v in s.position])
+
+
+# per episode (its executor): support detections that no other one has repeated yet
+_PENDING: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def _support_labels(ctx: SearchContext) -> list[str]:
@@ -171,7 +181,8 @@ def support_volumes(ctx: SearchContext, skip: set[str] = frozenset()) -> list[Ta
         x, y, z = obj.position
         top = max(0.3, 2.0 * z)  # a detection's centre is half the support's height
         p = o["p_volume"] if o["p_volume"] > 0 else _p_on(ctx, obj)
-        boxes.append([[x - reach, y - reach, top], [x + reach, y + reach, top + height],
+        low = top + ctx.executor.config.above_support[0]  # the top is a noisy estimate
+        boxes.append([[x - reach, y - reach, low], [x + reach, y + reach, top + height],
                       obj.label, p, [obj.id]])
     merged = True
     while merged:
