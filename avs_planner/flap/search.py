@@ -7,6 +7,7 @@ The search is over when p(V̂(S)) < omega: the views can no longer find the targ
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -72,6 +73,13 @@ class FlapSearch:
         self.planned: list[View] = []
         self.cycle = 0
         self.exhausted = np.zeros(0, dtype=bool)  # region cells given up on (see `sensed`)
+        self.blocked: list[tuple[float, float]] = []  # view positions the robot failed to reach
+
+    def unreachable(self, view: View, radius: float = 0.3) -> None:
+        """The robot could not get to `view`: no view within `radius` m of it is planned again
+        (its cells stay in play for views elsewhere)."""
+        self.blocked.append((view.pose.x, view.pose.y))
+        self.block_radius = radius
 
     def sensed(self, voxels: VoxelMap, view: View) -> int:
         """After the robot sensed at `view` (or as near it as it got): the cells the view was
@@ -98,6 +106,8 @@ class FlapSearch:
         views += sampler.sample(max(0, self.options.views - len(views)),
                                 self.options.sample_timeout, seed=self.cycle)  # fmt: skip
         self.cycle += 1
+        if self.blocked:
+            views = [v for v in views if not _near(v, self.blocked, self.block_radius)]
         clock.lap("sampling")
         p_all = belief.p_views(v.cells for v in views)
         if not views or p_all < self.options.planner.omega:
@@ -136,3 +146,7 @@ class _Clock:
         now = time.perf_counter()
         self.laps[name] = now - self._last
         self._last = now
+
+
+def _near(view: View, points: list[tuple[float, float]], radius: float) -> bool:
+    return any(math.hypot(view.pose.x - x, view.pose.y - y) < radius for x, y in points)

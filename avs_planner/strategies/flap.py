@@ -54,6 +54,7 @@ class _Head:
     torso: float
     pan: float = 0.0
     tilt: float = 0.0
+    drive: str = ""  # how the last drive to a view ended
 
 
 # ---- preparation and survey ------------------------------------------------------------------
@@ -279,7 +280,13 @@ def _search_region(ctx: SearchContext, result: SearchResult, volumes: list[Targe
         if decision.status is not SearchStatus.GO:
             return None  # DONE: p(V̂(S)) < omega; NO_VIEWS: nothing reachable sees the region
         found = _visit(ctx, decision.view, head)
-        dropped = search.sensed(mind.voxels, decision.view)
+        view = decision.view
+        off = math.dist(robot.pose[:2], (view.pose.x, view.pose.y))
+        dropped = 0
+        if off > ctx.executor.config.arrive:
+            search.unreachable(view)  # what it saw from where it stopped is in the map anyway
+        else:
+            dropped = search.sensed(mind.voxels, view)
         before = float(tracker.log_miss().sum())
         tracker.refresh(mind.voxels)
         after = float(tracker.log_miss().sum())
@@ -287,7 +294,9 @@ def _search_region(ctx: SearchContext, result: SearchResult, volumes: list[Targe
             *robot.pose, head.torso, head.pan, head.tilt)],
             p_seen=round(-math.expm1(before - after), 5),
             survival=round(math.exp(log0 - after), 5), expected_cells=int(decision.view.cells.size),
-            unrevealed=dropped, known_voxels=_known_voxels(ctx), found=found is not None)
+            unrevealed=dropped, known_voxels=_known_voxels(ctx), drive=head.drive,
+            off=round(off, 3),
+            found=found is not None)
         if found is not None:
             return _found(ctx, result, found)
     return None
@@ -298,6 +307,8 @@ def _visit(ctx: SearchContext, view: View, head: _Head) -> KnownObject | None:
     into the 3D map and look for the target."""
     robot, body, pose = ctx.robot, ctx.body, view.pose
     outcome = ctx.executor.drive_to((pose.x, pose.y))
+    head.drive = outcome.status.value if not outcome.detail else f"{outcome.status.value}: " \
+        f"{outcome.detail}"
     if outcome.status is StepStatus.DONE and math.dist(robot.pose[:2], (pose.x, pose.y)) > 0.02:
         robot.move_along([(pose.x, pose.y)])  # the last few cm (refused if it would collide)
     x, y, _ = robot.pose
