@@ -43,7 +43,7 @@ TARGET = "stapler"  # the knowledge puts it on shelves and tables; the world has
 CELLS = [("map", True, False), ("map", True, True), ("no map", False, False),
          ("no map", False, True)]  # (label, prior_map, greedy)
 SEED_DIFF = {"map": -10.0, "no map": -7.0}  # %: the seed's planner vs greedy (§5)
-OPTIONS = {"time_limit_s": 0.5, "max_views": 60}
+OPTIONS = {"time_limit_s": 0.5, "max_views": 60, "survey_on": False}  # one region per trial
 
 
 def start_pose(seed: int) -> list[float]:
@@ -77,7 +77,9 @@ def run_trial(seed: int, prior_map: bool, greedy: bool) -> dict:
 
 def measure(events: list[dict], summary: dict) -> dict:
     """E[T] (execution and planning) of the executed view sequence, steps, completion time."""
-    region = next(e for e in events if e.get("event") == "region")
+    regions = [k for k, e in enumerate(events) if e.get("event") == "region"]
+    region = events[regions[0]]
+    events = events[regions[0]:regions[1] if len(regions) > 1 else None]  # the first region
     t_prev, survival, e_exec, e_plan, steps = region["t"], 1.0, 0.0, 0.0, 0
     for e in events:
         if e.get("event") == "decision":
@@ -87,7 +89,9 @@ def measure(events: list[dict], summary: dict) -> dict:
             t_prev, survival, steps = e["t"], e["survival"], steps + 1
     return {"expected_exec_s": round(e_exec, 2), "expected_plan_s": round(e_plan, 2),
             "expected_total_s": round(e_exec + e_plan, 2), "steps": steps,
-            "complete_s": summary["sim_time_s"], "p_total": region["p_total"],
+            "complete_s": (summary["sim_time_s"] if len(regions) == 1 else
+                           round(events[-1]["t"] - region["t"], 2)),  # (from the search start)
+            "p_total": region["p_total"],
             "p_revealed": round(1.0 - survival, 4), "outcome": summary["outcome"],
             "reason": summary["reason"]}
 

@@ -233,6 +233,8 @@ def run(ctx: SearchContext) -> SearchResult:
                 return ended
             searched |= {oid for v in volumes for oid in v.name.split("+")}
             why = "the known supports are searched (p(V̂(S)) < omega)"
+            if not ctx.options["survey_on"]:
+                return ctx.end(result, Outcome.GAVE_UP, why)
         elif mind.place_map.places and ex.nearest_placeholder() is None:
             return ctx.end(result, Outcome.GAVE_UP, f"{why}; nothing left to explore")
         else:

@@ -93,6 +93,7 @@ _FLAP_OPTIONS = {  # avs_planner/strategies/flap.py
     "volume_height": 0.3,  # m: height of a support's box above its top
     "depth_columns": 64,  # depth frame columns at a view (rows: 3/4 of them)
     "survey_headings": 6,  # headings looked at per survey stop
+    "survey_on": True,  # after a region is searched, survey on for more supports
     "max_views": 80,
 }
 
