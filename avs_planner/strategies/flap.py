@@ -301,7 +301,7 @@ def _search_region(ctx: SearchContext, result: SearchResult, volumes: list[Targe
             found=found is not None)
         if found is not None:
             return _found(ctx, result, found)
-    return None
+    return ctx.end(result, Outcome.TIMEOUT, f"{o['max_views']} views in one region")
 
 
 def _visit(ctx: SearchContext, view: View, head: _Head) -> KnownObject | None:
