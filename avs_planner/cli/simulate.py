@@ -48,6 +48,9 @@ def register(subparsers: Any) -> None:
     where.add_argument("--start", help="start pose x,y,yaw (metres, radians)")
     parser.add_argument("--seed", type=int, help="sensor noise seed (default 0)")
     parser.add_argument("--time-budget", type=float, help="simulated seconds (default 1200)")
+    parser.add_argument("--pre-explore", action="store_true", help="map the building before "
+                        "the clock starts (the strategy's own survey where it has one, e.g. "
+                        "flap's with depth frames)")
     parser.add_argument("--out", default="avs-episode", help="output directory")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     parser.set_defaults(func=run)
@@ -94,6 +97,8 @@ def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
         spec["generate"] = {"seed": args.generated, "style": args.style, "rooms": args.rooms}
     if args.strategy:
         spec["strategy"] = args.strategy
+    if args.pre_explore:
+        spec["pre_explore"] = True
     if args.option:
         spec["strategy_options"] = dict(_option(text) for text in args.option)
     if args.qsr:

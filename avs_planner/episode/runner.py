@@ -200,7 +200,11 @@ class Episode:
         if self.spec.pre_explore:
             from avs_planner.episode.prebuilt import explore
 
-            explore(self.executor)
+            prepare = get_strategy(self.spec.strategy).load_prepare()
+            if prepare is not None:
+                prepare(self.context)  # the strategy's own survey (e.g. with depth frames)
+            else:
+                explore(self.executor)
             self.trace.emit("belief", pre_explored=True, places=len(self.mind.place_map.places),
                             rooms=len(self.mind.place_map.rooms))
         self.context.start_clock = self.robot.clock

@@ -7,13 +7,22 @@ The search is over when p(V̂(S)) < omega: the views can no longer find the targ
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 
+import numpy as np
+
 from avs_planner.body import RobotBody
-from avs_planner.flap.planner import PlannerOptions, PlanResult, plan_greedy, plan_views
+from avs_planner.flap.planner import (
+    PlannerOptions,
+    PlanResult,
+    StopReason,
+    plan_greedy,
+    plan_views,
+)
 from avs_planner.flap.problem import SequencingProblem
 from avs_planner.flap.sampling import SamplerOptions, View, ViewPose, ViewSampler
 from avs_planner.flap.target import TargetBelief, TargetVolume
@@ -63,16 +72,42 @@ class FlapSearch:
         self.options = options or FlapOptions()
         self.planned: list[View] = []
         self.cycle = 0
+        self.exhausted = np.zeros(0, dtype=bool)  # region cells given up on (see `sensed`)
+        self.blocked: list[tuple[float, float]] = []  # view positions the robot failed to reach
+
+    def unreachable(self, view: View, radius: float = 0.3) -> None:
+        """The robot could not get to `view`: no view within `radius` m of it is planned again
+        (its cells stay in play for views elsewhere)."""
+        self.blocked.append((view.pose.x, view.pose.y))
+        self.block_radius = radius
+
+    def sensed(self, voxels: VoxelMap, view: View) -> int:
+        """After the robot sensed at `view` (or as near it as it got): the cells the view was
+        expected to reveal but that the map still has unknown are taken as unobservable from
+        the views (optimistic ray casting assumed unknown space free; a solid interior, a gap
+        between depth rays, or a pose not quite reached leave them unknown). Without this a
+        continual search could choose the same view forever. Returns how many were dropped."""
+        belief = TargetBelief(voxels, self.volumes)
+        if self.exhausted.size != belief.size:
+            self.exhausted = np.zeros(belief.size, dtype=bool)
+        cells = np.asarray(view.cells, dtype=np.int64)
+        missed = cells[belief.unknown[cells] & ~self.exhausted[cells]]
+        self.exhausted[missed] = True
+        return int(missed.size)
 
     def decide(self, voxels: VoxelMap, grid: OccupancyGrid, pose: ViewPose) -> Decision:
         """Plan from the robot's pose on the current maps; returns where to look next."""
         clock = _Clock()
         belief = TargetBelief(voxels, self.volumes)
+        if self.exhausted.size == belief.size:
+            belief.mark_seen(np.flatnonzero(self.exhausted))
         sampler = ViewSampler(voxels, grid, self.body, belief, self.options.sampler)
         views = sampler.evaluate(self.planned)
         views += sampler.sample(max(0, self.options.views - len(views)),
                                 self.options.sample_timeout, seed=self.cycle)  # fmt: skip
         self.cycle += 1
+        if self.blocked:
+            views = [v for v in views if not _near(v, self.blocked, self.block_radius)]
         clock.lap("sampling")
         p_all = belief.p_views(v.cells for v in views)
         if not views or p_all < self.options.planner.omega:
@@ -94,7 +129,10 @@ class FlapSearch:
     def _plan(self, problem: SequencingProblem) -> PlanResult:
         if self.options.greedy:
             return plan_greedy(problem, self.options.planner.omega)
-        return plan_views(problem, self.options.planner)
+        plan = plan_views(problem, self.options.planner)
+        if not plan.sequence and plan.stop in (StopReason.TIME_LIMIT, StopReason.NODE_LIMIT):
+            return plan_greedy(problem, self.options.planner.omega)  # a limit struck first
+        return plan
 
 
 class _Clock:
@@ -108,3 +146,7 @@ class _Clock:
         now = time.perf_counter()
         self.laps[name] = now - self._last
         self._last = now
+
+
+def _near(view: View, points: list[tuple[float, float]], radius: float) -> bool:
+    return any(math.hypot(view.pose.x - x, view.pose.y - y) < radius for x, y in points)

@@ -29,10 +29,14 @@ class Strategy:
     summary: str
     entry: str
     options: Mapping[str, Any]
+    prepare: str | None = None  # "module:function" run by `pre_explore` instead of the plain
+    # frontier exploration, before the clock starts (e.g. FLAP's survey with depth frames)
 
     def load(self) -> Run:
-        module, function = self.entry.split(":")
-        return getattr(importlib.import_module(module), function)
+        return _load(self.entry)
+
+    def load_prepare(self) -> Callable[[SearchContext], None] | None:
+        return _load(self.prepare) if self.prepare else None
 
     def check_options(self, given: Mapping[str, Any] | None) -> dict[str, Any]:
         """The defaults overridden by `given`, each converted to its default's type."""
@@ -44,6 +48,11 @@ class Strategy:
                                 f"{', '.join(unknown)} (known: {known})")
         return {key: _convert(self.name, key, given.get(key, default), default)
                 for key, default in self.options.items()}
+
+
+def _load(entry: str) -> Callable[..., Any]:
+    module, function = entry.split(":")
+    return getattr(importlib.import_module(module), function)
 
 
 def _convert(strategy: str, key: str, value: Any, default: Any) -> Any:
@@ -72,6 +81,23 @@ def _convert(strategy: str, key: str, value: Any, default: Any) -> Any:
 _SWITCHING_OPTIONS = {f.name: f.default for f in fields(LoopConfig)
                       if f.name not in ("time_budget_s", "wall_budget_s", "dump_dir")}
 
+_FLAP_OPTIONS = {  # avs_planner/strategies/flap.py
+    "greedy": False,  # next best view by p/t (the seed's baseline) instead of branch and bound
+    "views": 200,  # view samples per cycle (the views still planned count towards them)
+    "clusters": 50,  # transition table clusters
+    "time_limit_s": 2.0,  # planner wall limit per cycle (0: none); no plan by then: greedy
+    "omega": 0.05,  # give up once p(V̂(S)) < omega
+    "p_volume": 0.2,  # P_i per support volume (seed: 0.2); <= 0: the conceptual map's belief
+    "prior_map": True,  # the preparation (pre_explore) builds the 3D map with depth frames
+    "reset_region": True,  # forget the 3D map inside the search region at the start
+    "support_reach": 0.7,  # m: half width of a support's box around its detected centre
+    "volume_height": 0.3,  # m: height of a support's box above its top
+    "depth_columns": 64,  # depth frame columns at a view (rows: 3/4 of them)
+    "survey_headings": 6,  # headings looked at per survey stop
+    "survey_on": True,  # after a region is searched, survey on for more supports
+    "max_views": 80,
+}
+
 STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
     Strategy("switching", "the switching planner: continual PDDL planner with assumptions + "
              "POMDP view-cone search (Goebelbecker et al.)",
@@ -93,6 +119,10 @@ STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
              "avs_planner.strategies.qsr:run_supporting_planes", _QSR_OPTIONS),
     Strategy("random", "QSR baseline: as qsr, but a random one of the 20 sampled view poses",
              "avs_planner.strategies.qsr:run_random", _QSR_OPTIONS),
+    Strategy("flap", "FLAP (seed 000): frontier view sampling in the 3D map and expected-time "
+             "view sequencing over the target's known supports (greedy: true is its baseline)",
+             "avs_planner.strategies.flap:run", _FLAP_OPTIONS,
+             prepare="avs_planner.strategies.flap:prepare"),
 )}
 
 

@@ -42,3 +42,23 @@ def test_a_region_the_map_already_knows_has_no_views(fresh_scene: Scene) -> None
     search = FlapSearch(PR2_BODY, [seen], FlapOptions(views=10))
     decision = search.decide(scene.voxels, scene.grid, ViewPose(*scene.start, 0, 0, 0))
     assert decision.status is SearchStatus.NO_VIEWS and decision.view is None
+
+
+def test_sensed_drops_unrevealed_cells_and_unreachable_views_are_not_planned_again(
+        fresh_scene: Scene) -> None:
+    scene = fresh_scene
+    search = FlapSearch(PR2_BODY, scene.volumes, FlapOptions(views=40, clusters=10))
+    decision = search.decide(scene.voxels, scene.grid, ViewPose(*scene.start, 0.0, 0.0, 0.0))
+    view = decision.view
+    # nothing sensed: every cell the view expected is still unknown, so all are dropped
+    assert search.sensed(scene.voxels, view) == view.cells.size > 0
+    assert search.exhausted[view.cells].all()
+    again = search.decide(scene.voxels, scene.grid, ViewPose(*scene.start, 0.0, 0.0, 0.0))
+    assert again.p_remaining < decision.p_remaining
+    search.unreachable(again.view)
+    third = search.decide(scene.voxels, scene.grid, ViewPose(*scene.start, 0.0, 0.0, 0.0))
+    if third.view is not None:
+        assert (abs(third.view.pose.x - again.view.pose.x) > 1e-9
+                or abs(third.view.pose.y - again.view.pose.y) > 1e-9)
+        assert all(((p.pose.x - again.view.pose.x) ** 2 + (p.pose.y - again.view.pose.y) ** 2)
+                   >= 0.3 ** 2 for p in search.planned)

@@ -1,0 +1,66 @@
+"""The flap strategy searches `flap_two_rooms` with depth frames in the 3D map (seed 000)."""
+
+import json
+
+from avs_planner.cli import main as avs_main
+from avs_planner.episode import run_episode
+from avs_planner.strategies import get_strategy
+
+# small cycles keep the tests quick; the experiment uses the defaults (200 views, 50 clusters)
+QUICK = {"views": 60, "clusters": 20, "time_limit_s": 0.2, "prior_map": False}
+
+
+def _flap_events(events):
+    return [e for e in events if e["type"] == "flap"]
+
+
+def test_flap_is_registered_with_its_options():
+    strategy = get_strategy("flap")
+    options = strategy.check_options({"greedy": "true", "views": "50"})
+    assert options["greedy"] is True and options["views"] == 50
+    assert strategy.load_prepare() is not None
+
+
+def test_avs_simulate_flap_finds_a_cup_in_flap_two_rooms(tmp_path, capsys):
+    """`avs simulate --strategy flap --pre-explore`: the survey (before the clock) registers
+    the tables; the FLAP views over their tops find a cup, confirmed by a second frame."""
+    out = tmp_path / "episode"
+    code = avs_main(["simulate", "--world", "flap_two_rooms", "--target", "cup",
+                     "--strategy", "flap", "--pre-explore", "--start", "2.5,3.6,1.57",
+                     "--seed", "0", "--out", str(out), "--json",
+                     *[f"--option={k}={v}" for k, v in QUICK.items()]])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0, summary["reason"]
+    assert summary["outcome"] == "found" and summary["correct"]
+    assert summary["strategy"] == "flap" and summary["views_processed"] > 0
+    events = [json.loads(line) for line in (out / "trace.jsonl").read_text().splitlines()]
+    flap = _flap_events(events)
+    kinds = [e["event"] for e in flap]
+    assert kinds[:2] == ["prepared", "region"]
+    assert "decision" in kinds and kinds[-1] == "view" and flap[-1]["found"]
+    decision = next(e for e in flap if e["event"] == "decision")
+    assert decision["status"] == "go" and decision["candidates"] > 0
+    assert {"sampling", "transitions", "planning", "total"} <= set(decision["seconds"])
+
+
+def test_flap_gives_up_on_an_absent_label_through_the_omega_test():
+    """No stapler in the world: the views reveal the support tops until p(V̂(S)) < omega
+    (a high omega keeps the test short). The depth frames build and grow the 3D map."""
+    events = []
+    summary = run_episode({"target": "stapler", "world": "flap_two_rooms", "seed": 1,
+                           "start": [2.5, 3.6, 1.57], "strategy": "flap", "pre_explore": True,
+                           "strategy_options": {**QUICK, "omega": 0.35}}, events.append)
+    assert summary["outcome"] == "gave_up", summary["reason"]
+    assert "omega" in summary["reason"] and summary["object"] is None
+    flap = _flap_events(events)
+    assert flap[0]["event"] == "prepared" and flap[0]["voxels"] == 0  # no prior 3D map
+    decisions = [e for e in flap if e["event"] == "decision"]
+    assert decisions[-1]["status"] == "done" and decisions[-1]["p_remaining"] < 0.35
+    assert all(d["p_remaining"] >= 0.35 for d in decisions[:-1])
+    views = [e for e in flap if e["event"] == "view"]
+    assert views and sum(v["p_seen"] for v in views) > 0
+    known = [v["known_voxels"] for v in views]
+    assert known[0] > 0 and all(b >= a for a, b in zip(known, known[1:], strict=False))
+    assert known[-1] > known[0]
+    survival = [v["survival"] for v in views]
+    assert all(b <= a + 1e-9 for a, b in zip(survival, survival[1:], strict=False))
