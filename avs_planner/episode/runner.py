@@ -27,7 +27,6 @@ from avs_planner.episode.robot import (
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.trace import Trace, write_summary
 from avs_planner.episode.viewcones import CameraModel
-from avs_planner.strategies import SearchContext, get_strategy
 from conceptual_map.knowledge import load_knowledge
 
 Emit = Callable[[dict[str, Any]], None]
@@ -71,6 +70,8 @@ class EpisodeSpec:
         if not isinstance(options, Mapping):
             raise EpisodeError(f"episode spec: 'strategy_options' must be a mapping, got "
                                f"{options!r}")
+        from avs_planner.strategies import get_strategy  # the registry imports this package
+
         strategy = get_strategy(str(spec.get("strategy") or "switching"))
         options = strategy.check_options(options)
         generate = spec.get("generate")
@@ -154,6 +155,8 @@ class Episode:
         self.executor = Executor(self.robot, self.mind, self.builder, self.camera,
                                  self._emit, ExecutorConfig(dt_policy=spec.dt_policy),
                                  seed=spec.seed)
+        from avs_planner.strategies import SearchContext
+
         self.context = SearchContext(
             robot=self.robot, body=self.robot.body(), mind=self.mind, builder=self.builder,
             executor=self.executor, trace=self.trace, target=spec.target,
@@ -176,6 +179,11 @@ class Episode:
             except EpisodeError as exc:  # name the spec key, not the temporary file
                 raise EpisodeError(str(exc).replace(str(path), "world_file")) from None
 
+    def _strategy(self):  # noqa: ANN202 - a Strategy (imported late: it imports this package)
+        from avs_planner.strategies import get_strategy
+
+        return get_strategy(self.spec.strategy)
+
     def _emit(self, type_: str, **fields: Any) -> None:
         self.trace.emit(type_, **fields)
 
@@ -185,7 +193,7 @@ class Episode:
                             robot=self.robot.model, pose=list(self.robot.pose),
                             seed=self.spec.seed, strategy=self.spec.strategy)
             start_clock, start_distance = self._pre_explore()
-            result = get_strategy(self.spec.strategy).load()(self.context)
+            result = self._strategy().load()(self.context)
             summary = self.summary(result, start_clock, start_distance)
             if self.out is not None:
                 write_summary(self.out / "summary.json", summary)
@@ -200,7 +208,7 @@ class Episode:
         if self.spec.pre_explore:
             from avs_planner.episode.prebuilt import explore
 
-            prepare = get_strategy(self.spec.strategy).load_prepare()
+            prepare = self._strategy().load_prepare()
             if prepare is not None:
                 prepare(self.context)  # the strategy's own survey (e.g. with depth frames)
             else:

@@ -41,3 +41,14 @@ def test_episode_spec_takes_strategy_and_options() -> None:
     assert EpisodeSpec.from_dict({"target": "cup"}).strategy == "switching"
     with pytest.raises(StrategyError):
         EpisodeSpec.from_dict({"target": "cup", "strategy": "random-walk"})
+
+
+def test_the_registry_imports_on_its_own() -> None:
+    """`avs_planner.strategies` imported first (before the episode package) is no cycle."""
+    import subprocess
+    import sys
+
+    code = "import avs_planner.strategies as s; print(len(s.strategy_names()))"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          check=False)
+    assert done.returncode == 0, done.stderr
