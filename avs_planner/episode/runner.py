@@ -210,7 +210,13 @@ class Episode:
 
             prepare = self._strategy().load_prepare()
             if prepare is not None:
-                prepare(self.context)  # the strategy's own survey (e.g. with depth frames)
+                # the strategy's own survey (e.g. with depth frames); the robot is not searching
+                # yet, so its detector does not watch for the target (as in `explore`)
+                self.executor.watching = False
+                try:
+                    prepare(self.context)
+                finally:
+                    self.executor.watching = True
             else:
                 explore(self.executor)
             self.trace.emit("belief", pre_explored=True, places=len(self.mind.place_map.places),
