@@ -89,16 +89,20 @@ class _Reader:
 def load_knowledge(path: str | Path | None = None) -> Knowledge:
     """Read knowledge from `path` (the built-in default file when None) and validate it."""
     file = Path(path) if path is not None else DEFAULT_KNOWLEDGE_PATH
-    reader = _Reader(str(file))
+    return parse_knowledge(read_yaml(file), _Reader(str(file)).source)
+
+
+def read_yaml(file: Path) -> Any:
+    """A knowledge YAML file's document; KnowledgeError naming the file if it cannot be
+    read or parsed (shared by the knowledge and QSR loaders)."""
     try:
         text = file.read_text(encoding="utf-8")
     except OSError as exc:
         raise KnowledgeError(f"{file}: cannot read: {exc.strerror or exc}") from None
     try:
-        data = yaml.load(text, Loader=KnowledgeYamlLoader)  # a SafeLoader subclass
+        return yaml.load(text, Loader=KnowledgeYamlLoader)  # a SafeLoader subclass
     except yaml.YAMLError as exc:
         raise KnowledgeError(f"{file}: not valid YAML: {exc}") from None
-    return parse_knowledge(data, reader.source)
 
 
 def parse_knowledge(data: Any, source: str = "<knowledge>") -> Knowledge:

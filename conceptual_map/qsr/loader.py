@@ -12,10 +12,8 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-import yaml
-
 from conceptual_map.errors import KnowledgeError
-from conceptual_map.knowledge.loader import KnowledgeYamlLoader
+from conceptual_map.knowledge.loader import read_yaml
 from conceptual_map.qsr.model import (
     DIRECTIONS,
     DISTANCES,
@@ -72,15 +70,7 @@ class _Reader:
 def load_qsr(path: str | Path | None = None) -> QsrKnowledge:
     """Read QSR knowledge from `path` (the built-in file when None) and validate it."""
     file = Path(path) if path is not None else DEFAULT_QSR_PATH
-    try:
-        text = file.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise KnowledgeError(f"{file}: cannot read: {exc.strerror or exc}") from None
-    try:
-        data = yaml.load(text, Loader=KnowledgeYamlLoader)  # a SafeLoader subclass
-    except yaml.YAMLError as exc:
-        raise KnowledgeError(f"{file}: not valid YAML: {exc}") from None
-    return parse_qsr(data, str(file))
+    return parse_qsr(read_yaml(file), str(file))
 
 
 def parse_qsr(data: Any, source: str = "<qsr>") -> QsrKnowledge:
