@@ -102,3 +102,21 @@ def test_categories_believed_certain_are_doubted_once_before_giving_up(corridor)
     assert any(k[:2] == ("p-room-category", room) for k in state.values)
     assert events and events[0][1]["doubt_categories"] == 1.0
     assert not loop._doubt_categories()  # once per episode
+
+
+def test_a_search_that_hits_its_node_limit_is_retried_in_the_anytime_mode(corridor) -> None:
+    """The first CP call stops at its (tiny) expansion limit; the fallback runs the anytime
+    schedule (greedy FF first, then weighted A* restarts) and returns a plan."""
+    from avs_planner.cp.continual import ContinualPlanner
+
+    _, builder, executor = corridor
+    trace = Trace(lambda: executor.robot.clock)
+    loop = SwitchingLoop(builder, executor, trace, LoopConfig(cp_node_limit=1))
+    state = builder.build()
+    loop.planner = ContinualPlanner(state.skeleton(), loop._options(),
+                                    min_success=loop.config.min_success)
+    first = loop.planner.replan(state.world_state())
+    assert first.status.value == "node_limit"
+    retried = loop._fallback(first)
+    assert retried.solved and "anytime" in retried.extra
+    assert loop.planner.options.node_limit == 1  # the loop's own options are restored
