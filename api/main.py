@@ -19,6 +19,7 @@ from api.config import Settings
 from api.docs import add_docs
 from api.manager import TaskManager
 from api.middleware import BodyLimitMiddleware
+from api.pages import add_pages
 from api.plan_jobs import PlanJobs
 from api.routes import domains, misc, plans, tasks
 from api.security import RateLimiter
@@ -69,6 +70,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     for module in (tasks, plans, domains, misc):
         app.include_router(module.router, prefix=API_PREFIX)
     add_docs(app)
+    add_pages(app)
     _add_error_handlers(app)
     return app
 
