@@ -3,8 +3,8 @@
 The episode's wiring (`runner.Episode`) subscribes one `MapSnapshots` to its trace; planners,
 strategies and maps never call it. From the events it sees it decides when to read the mind:
 
-- after every completed step (an `action` event with a final status), after `dt` and `done`:
-  a `map` event;
+- at the start and after every completed step (an `action` event with a final status): a
+  `map` event (`done`, always right after a step or a plan, stays the trace's last event);
 - while the robot drives or looks (a `belief` event with map changes, an `observation`), a
   `map` event at most every `interval_s` simulated seconds;
 - after CREATEVIEWCONES: a `cones` event with the cones' poses and probabilities.
@@ -34,7 +34,6 @@ Emit = Callable[..., Any]
 
 MAP = "map"
 CONES = "cones"
-_FINAL = frozenset({"done", "dt"})
 _LIVE = frozenset({"belief", "observation"})
 _GREY = {CellState.UNKNOWN: 128, CellState.FREE: 255, CellState.OCCUPIED: 0}
 
@@ -77,7 +76,7 @@ class MapSnapshots:
 
     def _due(self, event: dict[str, Any]) -> bool:
         kind = event.get("type")
-        if kind == "start" or kind in _FINAL:
+        if kind == "start":
             return True
         if kind == "action":
             return event.get("status") not in (None, "start")
