@@ -110,6 +110,11 @@ def _method_not_allowed(request: Request) -> Response:
         pattern = re.sub(r"\\{[^/]+?\\}", "[^/]+", re.escape(template))
         if re.fullmatch(pattern, request.url.path):
             methods |= {m.upper() for m in operations}
+    for route in request.app.routes:  # the pages, which are not in the schema
+        regex, route_methods = getattr(route, "path_regex", None), getattr(route, "methods", None)
+        if regex is not None and route_methods and not getattr(route, "include_in_schema", True) \
+                and regex.fullmatch(request.url.path):
+            methods |= set(route_methods)
     if "GET" in methods:
         methods.add("HEAD")
     headers = {"Allow": ", ".join(sorted(methods))}

@@ -55,3 +55,9 @@ def test_recording_is_served_when_the_episode_wrote_one(client: TestClient, wait
     assert got.status_code == 200 and got.content == b"RRF2fake"
     assert got.headers["content-type"] == "application/octet-stream"
     assert client.get("/v1/tasks/nope/recording.rrd").status_code == 404
+
+
+def test_a_method_a_page_does_not_have_names_the_ones_it_has(client: TestClient) -> None:
+    refused = client.post("/")
+    assert refused.status_code == 405 and refused.headers["allow"] == "GET, HEAD, OPTIONS"
+    assert client.options("/tasks/abc").headers["allow"] == "GET, HEAD, OPTIONS"
