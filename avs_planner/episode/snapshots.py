@@ -52,6 +52,7 @@ class MapSnapshots:
         self.maps = 0
         self._last_t: float | None = None
         self._grid_key: tuple[Any, ...] | None = None
+        self._grid_version: tuple[Any, ...] | None = None
         self._path_sent = 0
         self._detections_sent = 0
         self._busy = False
@@ -141,10 +142,13 @@ class MapSnapshots:
     def _grid(self) -> dict[str, Any] | None:
         """The coarse grid as a PNG, or None when it looks as in the last `map` event."""
         grid = self.executor.mind.grid
-        states = grid.state_grid()
+        version = (grid.version, tuple(np.round(grid.origin, 6)), grid.shape)
+        if version == self._grid_version:
+            return None
+        self._grid_version = version
         k = max(1, round(self.resolution / grid.resolution))
-        coarse = coarsen(states, k)
-        key = (tuple(np.round(grid.origin, 6)), coarse.shape, zlib.crc32(coarse.tobytes()))
+        coarse = coarsen(grid.state_grid(), k)
+        key = (version[1], coarse.shape, zlib.crc32(coarse.tobytes()))
         if key == self._grid_key:
             return None
         self._grid_key = key
@@ -175,18 +179,18 @@ class MapSnapshots:
 
 def coarsen(states: np.ndarray, k: int) -> np.ndarray:
     """Blocks of k x k cells: occupied if any cell is, else free if any is, else unknown (a
-    wall one fine cell thick stays a wall)."""
+    wall one fine cell thick stays a wall): the largest CellState of the block."""
+    assert CellState.UNKNOWN < CellState.FREE < CellState.OCCUPIED
     if k == 1:
         return states.astype(np.uint8)
     w, h = states.shape
-    pw, ph = -w % k, -h % k
-    padded = np.pad(states, ((0, pw), (0, ph)), constant_values=CellState.UNKNOWN)
-    blocks = padded.reshape(padded.shape[0] // k, k, padded.shape[1] // k, k)
-    occupied = (blocks == CellState.OCCUPIED).any(axis=(1, 3))
-    free = (blocks == CellState.FREE).any(axis=(1, 3))
-    out = np.full(occupied.shape, CellState.UNKNOWN, dtype=np.uint8)
-    out[free] = CellState.FREE
-    out[occupied] = CellState.OCCUPIED
+    padded = np.pad(states.astype(np.uint8), ((0, -w % k), (0, -h % k)),
+                    constant_values=CellState.UNKNOWN)
+    out = padded[0::k, 0::k].copy()
+    for i in range(k):
+        for j in range(k):
+            if i or j:
+                np.maximum(out, padded[i::k, j::k], out=out)
     return out
 
 
