@@ -228,7 +228,22 @@
     const box = $("explanation");
     box.dataset.status = "loading";
     box.textContent = "loading...";
-    const answer = await json(`${base}/explanation`);
+    let answer;
+    try {
+      const response = await AVS.api(`${base}/explanation`);
+      const text = await response.text();
+      let body = text;
+      try {
+        body = JSON.parse(text);
+      } catch (_) {
+        body = text; // a plain-text explanation is shown as it is
+      }
+      answer = { status: response.status, ok: response.ok, body };
+    } catch (error) {
+      box.dataset.status = "error";
+      box.textContent = `cannot load the explanation: ${error}`;
+      return;
+    }
     if (answer.status === 404) {
       box.dataset.status = "none";
       box.className = "explanation muted";
@@ -244,8 +259,9 @@
     box.dataset.status = "loaded";
     box.className = "explanation";
     const body = answer.body;
-    box.replaceChildren(typeof body === "object" && body && typeof body.text === "string"
-      ? el("pre", { text: body.text }) : renderValue(body));
+    if (typeof body === "string") box.replaceChildren(el("pre", { text: body }));
+    else if (body && typeof body.text === "string") box.replaceChildren(el("pre", { text: body.text }));
+    else box.replaceChildren(renderValue(body));
   }
 
   async function onTerminal() {
