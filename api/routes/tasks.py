@@ -1,4 +1,5 @@
-"""/tasks: submit a search, list and read tasks, stream their events, cancel, trajectory picture."""
+"""/tasks: submit a search, list and read tasks, stream their events, cancel; the episode's
+trajectory picture and Rerun recording."""
 
 from __future__ import annotations
 
@@ -190,3 +191,21 @@ async def read_trajectory(task: TaskDep, settings: SettingsDep) -> FileResponse:
             detail=f"task {task.id} has no trajectory picture yet (state: {task.state.value})",
         )
     return FileResponse(path, media_type="image/png")
+
+
+@router.head("/{task_id}/recording.rrd", include_in_schema=False)
+@router.get(
+    "/{task_id}/recording.rrd",
+    response_class=FileResponse,
+    responses={200: {"content": {"application/octet-stream": {}}}, 404: {"model": Message}},
+)
+async def read_recording(task: TaskDep, settings: SettingsDep) -> FileResponse:
+    """The episode's Rerun recording (`recording.rrd`), when the episode wrote one (open it
+    with the Rerun viewer); HEAD tells whether there is one."""
+    path = settings.tasks_dir / task.id / "recording.rrd"
+    if not path.is_file():
+        raise HTTPException(
+            status.HTTP_404_NOT_FOUND, detail=f"task {task.id} has no recording"
+        )
+    return FileResponse(path, media_type="application/octet-stream",
+                        filename=f"{task.id}.rrd")

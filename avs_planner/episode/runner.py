@@ -24,6 +24,7 @@ from avs_planner.episode.robot import (
     load_spec,
     open_world,
 )
+from avs_planner.episode.snapshots import MapSnapshots
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.trace import Trace, write_summary
 from avs_planner.episode.viewcones import CameraModel
@@ -155,6 +156,7 @@ class Episode:
         self.executor = Executor(self.robot, self.mind, self.builder, self.camera,
                                  self._emit, ExecutorConfig(dt_policy=spec.dt_policy),
                                  seed=spec.seed)
+        self.trace.subscribe(MapSnapshots(self.executor, self._emit).observe)
         from avs_planner.strategies import SearchContext
 
         self.context = SearchContext(

@@ -21,6 +21,11 @@ class Trace:
         self._sink = sink
         self._start = time.perf_counter()
         self._file: TextIO | None = path.open("w", encoding="utf-8") if path else None
+        self._subscribers: list[Sink] = []
+
+    def subscribe(self, subscriber: Sink) -> None:
+        """Call `subscriber(event)` after each event is recorded (it may emit more events)."""
+        self._subscribers.append(subscriber)
 
     @property
     def wall(self) -> float:
@@ -35,6 +40,8 @@ class Trace:
             self._file.flush()
         if self._sink is not None:
             self._sink(event)
+        for subscriber in self._subscribers:
+            subscriber(event)
         return event
 
     def close(self) -> None:
