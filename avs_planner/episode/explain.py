@@ -22,6 +22,7 @@ explanation has: what was searched, what was seen, and why the search ended.
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -69,21 +70,26 @@ def _virtual(name: str) -> bool:
     return name.startswith("new-")
 
 
+def _a(noun: str) -> str:
+    return f"{'an' if noun[:1].lower() in 'aeiou' else 'a'} {noun}"
+
+
 def describe(action: str) -> tuple[str, dict[str, str | None]]:
     """What an assumptive step assumes, in words, and its subject, category and label."""
     name, *args = _strip(action) or [""]
     if name == "assume-leads-to-room" and len(args) == 3:
-        return (f"a {args[1]} lies behind {args[0]} ({args[2]})",
+        return (f"{_a(args[1])} lies behind {args[0]} ({args[2]})",
                 {"subject": args[0], "category": args[1], "label": None})
     if name == "assume-category" and len(args) == 2:
-        return f"{args[0]} is a {args[1]}", {"subject": args[0], "category": args[1],
-                                              "label": None}
+        return f"{args[0]} is {_a(args[1])}", {"subject": args[0], "category": args[1],
+                                                "label": None}
     if name == "assume-obj-exists-in" and len(args) == 4:
-        return (f"a {args[0]} is in {args[1]} (as a {args[2]}) ({args[3]})",
+        return (f"{_a(args[0])} is in {args[1]} (as {_a(args[2])}) ({args[3]})",
                 {"subject": args[1], "category": args[2], "label": args[0]})
     if name == "assume-obj-exists-on" and len(args) == 6:
-        return (f"a {args[0]} is on {args[1]} (a {args[2]} in {args[4]}, as a {args[3]}) "
-                f"({args[5]})", {"subject": args[1], "category": args[3], "label": args[0]})
+        return (f"{_a(args[0])} is on {args[1]} ({_a(args[2])} in {args[4]}, as "
+                f"{_a(args[3])}) ({args[5]})",
+                {"subject": args[1], "category": args[3], "label": args[0]})
     return f"{action} holds", {"subject": args[0] if args else None, "category": None,
                                "label": None}
 
@@ -127,17 +133,20 @@ def _evidence(event: Mapping[str, Any]) -> str | None:
     return None
 
 
-def _why_refuted(entry: Assumption, detail: str, after: Mapping[str, Any] | None) -> str:
-    """The monitor's verdict on a contradicted assumption, read with the step just done."""
-    moved_to = None
-    if after is not None:
-        words = _strip(str(after.get("action") or ""))
-        if len(words) == 3 and words[0] in ("move", "explore"):
-            moved_to = words[2]
-        elif len(words) == 2 and words[0] == "explore":
-            moved_to = words[1]
+def _destination(action: str) -> str | None:
+    """Where a move or explore step went."""
+    words = _strip(action)
+    if len(words) == 3 and words[0] == "move":
+        return words[2]
+    if len(words) == 2 and words[0] == "explore":
+        return words[1]
+    return None
+
+
+def _why_refuted(entry: Assumption, detail: str, went_to: Mapping[str, float]) -> str:
+    """The monitor's verdict on a contradicted assumption, read with where the robot went."""
     if entry.kind == "assume-leads-to-room" and "no longer possible" in detail:
-        if moved_to == entry.subject:
+        if went_to.get(entry.subject or "", -math.inf) >= float(entry.assumed_at or 0.0):
             return (f"{entry.subject} was explored (the robot went there) and is no longer a "
                     f"placeholder, so no unseen {entry.category} can be assumed behind it; "
                     f"what lay behind it is in the map now (monitor: {detail})")
@@ -147,6 +156,11 @@ def _why_refuted(entry: Assumption, detail: str, after: Mapping[str, Any] | None
         return (f"the planner no longer offers {entry.category} for {entry.subject}: its "
                 f"category belief is taken as settled, or the room changed as the map grew "
                 f"(monitor: {detail})")
+    if entry.kind.startswith("assume-obj-exists") and "defined-exists" in detail:
+        where = "in" if entry.kind == "assume-obj-exists-in" else "on"
+        return (f"{_a(entry.label or 'object')} may no longer be assumed {where} "
+                f"{entry.subject}: the searches there came back empty (or one was found "
+                f"there already) (monitor: {detail})")
     return f"monitor: {detail}"
 
 
@@ -176,6 +190,7 @@ class Ledger:
         self.notes: list[str] = []
         self.since: list[str] = []  # evidence since the last monitor check
         self.last_done: dict[str, Any] | None = None
+        self.went_to: dict[str, float] = {}  # move/explore destination -> when it was done
         self._pending_replan: dict[str, Any] | None = None
         self._monitor_evidence: str | None = None
         self.tail: list[str] = []  # what happened since the last plan that was found
@@ -204,6 +219,9 @@ class Ledger:
                   "status": event.get("status"), "detail": event.get("detail") or ""}
         self.actions.append(record)
         self.last_done = record
+        where = _destination(str(record["action"]))
+        if where is not None:
+            self.went_to[where] = float(record["t"] or 0.0)
 
     def _on_observation(self, event: Mapping[str, Any]) -> None:
         self.observations["confirmed" if event.get("detected") else "not_confirmed"] += 1
@@ -214,6 +232,8 @@ class Ledger:
                                "steps", "cones")})
 
     def _on_belief(self, event: Mapping[str, Any]) -> None:
+        if isinstance(event.get("matched"), Mapping):
+            self._matched(event["matched"], event.get("t"))
         for key in ("cut_off", "doubt_categories", "retry_blocked", "dropped_support",
                     "most_likely"):
             if key in event:
@@ -293,6 +313,25 @@ class Ledger:
                     introduced[n] = sig
         return out
 
+    def _matched(self, matched: Mapping[str, str], t: Any) -> None:
+        """A real object matched a virtual one: the assumption that introduced the virtual
+        object came true; the plan's other steps now name the real object."""
+        evidence = "; ".join(self.since) if self.since else "a detection"
+        for virtual, real in matched.items():
+            for entry in list(self.open.values()):
+                names = _strip(entry.action)[1:]
+                if entry.kind.startswith("assume-obj-exists") and names[-1:] == [virtual]:
+                    self._close(entry, "confirmed", t, f"{virtual} matched {real}: a "
+                                f"{entry.label} was found there", evidence)
+        renamed: dict[str, tuple] = {}
+        for label, sig in self.current.items():
+            words = _strip(label)
+            new = "(" + " ".join(matched.get(w, w) for w in words) + ")"
+            renamed[label] = sig
+            if new != label:
+                renamed[new] = sig
+        self.current = renamed
+
     def _entry(self, label: str | None) -> Assumption | None:
         sig = self.current.get(label) if label else None
         return self.open.get(sig) if sig is not None else None
@@ -336,8 +375,8 @@ class Ledger:
             if verdict == "assumption_contradicted":
                 if entry.p_last != 0.0:
                     entry.history.append({"t": t, "p": 0.0, "source": "monitor"})
-                self._close(entry, "refuted", t, _why_refuted(entry, detail or verdict, after),
-                            evidence)
+                why = _why_refuted(entry, detail or verdict, self.went_to)
+                self._close(entry, "refuted", t, why, evidence)
         self.replans.append(record)
         self._pending_replan = record
 
