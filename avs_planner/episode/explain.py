@@ -188,6 +188,8 @@ class Ledger:
         self.searches: list[dict[str, Any]] = []
         self.observations = {"confirmed": 0, "not_confirmed": 0}
         self.notes: list[str] = []
+        self.flap: dict[str, Any] = {"regions": [], "decisions": 0, "views": 0,
+                                     "last_decision": None}
         self.since: list[str] = []  # evidence since the last monitor check
         self.last_done: dict[str, Any] | None = None
         self.went_to: dict[str, float] = {}  # move/explore destination -> when it was done
@@ -242,6 +244,19 @@ class Ledger:
                     text = (f"most likely {event.get('kind')}: {event['most_likely']} "
                             f"(p {event.get('probability')})")
                 self.notes.append(f"t={float(event.get('t', 0.0)):.1f} s: {text}")
+
+    def _on_flap(self, event: Mapping[str, Any]) -> None:
+        """FLAP's view planning: the regions searched, its decisions and views."""
+        kind = event.get("event")
+        if kind == "region":
+            self.flap["regions"] = [{"name": v.get("name"), "p": v.get("p")}
+                                    for v in event.get("volumes") or []]
+        elif kind == "decision":
+            self.flap["decisions"] += 1
+            self.flap["last_decision"] = {k: event.get(k) for k in
+                                          ("t", "cycle", "status", "p_remaining", "planned")}
+        elif kind == "view":
+            self.flap["views"] += 1
 
     def _on_plan(self, event: Mapping[str, Any]) -> None:
         steps = list(event.get("plan") or [])
@@ -436,8 +451,11 @@ class Ledger:
                 seen = visited.setdefault(words[0], [])
                 if target not in seen:
                     seen.append(target)
-        return {"actions": self.actions, "action_counts": kinds, "visited": visited,
-                "dt_searches": self.searches, "observations": dict(self.observations)}
+        out = {"actions": self.actions, "action_counts": kinds, "visited": visited,
+               "dt_searches": self.searches, "observations": dict(self.observations)}
+        if self.flap["decisions"] or self.flap["regions"]:
+            out["flap"] = dict(self.flap)
+        return out
 
     def _give_up(self, final: Mapping[str, Any] | None) -> dict[str, Any]:
         """The room hypotheses tried (where a plan assumed the target could be) with their
@@ -663,7 +681,8 @@ def render(explanation: Mapping[str, Any]) -> str:
         out.append(f"Search ({e.get('strategy')} does not plan with assumptions, so there is "
                    f"no assumption ledger):")
     if counts or not plans:
-        out.append("  steps: " + (", ".join(f"{n}x {k}" for k, n in counts.items()) or "none"))
+        if counts:
+            out.append("  steps: " + ", ".join(f"{n}x {k}" for k, n in counts.items()))
         for kind, targets in (search.get("visited") or {}).items():
             if kind == "move":
                 continue
@@ -671,6 +690,15 @@ def render(explanation: Mapping[str, Any]) -> str:
         for s in search.get("dt_searches") or []:
             out.append(f"  DT search t={_t(s.get('t'))}: {s.get('label')} {s.get('relation')} "
                        f"{s.get('location')}: {s.get('result')} (p {_p(s.get('probability'))})")
+        flap = search.get("flap")
+        if flap:
+            regions = ", ".join(f"{r['name']} (p {_p(r['p'])})" for r in flap["regions"])
+            out.append(f"  FLAP: regions {regions or 'none'}; {flap['decisions']} decisions, "
+                       f"{flap['views']} views")
+            last = flap.get("last_decision")
+            if last:
+                out.append(f"    last decision (cycle {last['cycle']}): {last['status']}, "
+                           f"P(target still unseen in the regions) {_p(last['p_remaining'])}")
         obs = search.get("observations") or {}
         out.append(f"  detections: {obs.get('confirmed', 0)} confirmed, "
                    f"{obs.get('not_confirmed', 0)} not confirmed")

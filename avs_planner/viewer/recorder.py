@@ -52,7 +52,7 @@ class Recorder:
 
     def __init__(self, mind: Any, executor: Any, robot: Any, camera: Any, target: str,
                  path: Path | None = None, spawn: bool = False, grid_every_s: float = 2.0,
-                 voxels_every_s: float = 5.0, name: str = "episode"):
+                 voxels_every_s: float = 10.0, name: str = "episode"):
         if path is None and not spawn:
             raise ViewerError("a recorder needs a file to write or a viewer to stream to")
         started = time.perf_counter()
@@ -180,11 +180,12 @@ class Recorder:
         voxels = getattr(self.mind, "voxels", None)
         if voxels is None or (not force and self._t - self._voxels_t < self.voxels_every_s):
             return
-        occupied = np.argwhere(voxels.states() == 2)
-        if len(occupied) == self._voxel_count:
+        flat = np.flatnonzero(voxels.logodds.ravel() >= voxels.model.occupied_at)
+        if len(flat) == self._voxel_count:
             return
-        self._voxels_t, self._voxel_count = self._t, len(occupied)
-        points = voxels.to_world(occupied)
+        self._voxels_t, self._voxel_count = self._t, len(flat)
+        points = voxels.to_world(np.stack(np.unravel_index(flat, voxels.shape), axis=1))
+        points = points.astype(np.float32)
         colours = _height_colours(points[:, 2])
         self.rec.log("world/voxels", self.rr.Points3D(points, colors=colours,
                                                       radii=voxels.resolution / 2))
