@@ -147,9 +147,9 @@ def _why_refuted(entry: Assumption, detail: str, went_to: Mapping[str, float]) -
     """The monitor's verdict on a contradicted assumption, read with where the robot went."""
     if entry.kind == "assume-leads-to-room" and "no longer possible" in detail:
         if went_to.get(entry.subject or "", -math.inf) >= float(entry.assumed_at or 0.0):
-            return (f"{entry.subject} was explored (the robot went there) and is no longer a "
-                    f"placeholder, so no unseen {entry.category} can be assumed behind it; "
-                    f"what lay behind it is in the map now (monitor: {detail})")
+            return (f"{entry.subject} was explored (the robot went there): it is no longer "
+                    f"a placeholder, so no unseen {entry.category} can be assumed behind it "
+                    f"(monitor: {detail})")
         return (f"{entry.subject} is no longer a placeholder (the map grew over it), so no "
                 f"unseen {entry.category} can be assumed behind it (monitor: {detail})")
     if entry.kind == "assume-category" and "no longer possible" in detail:
@@ -314,18 +314,31 @@ class Ledger:
 
     @staticmethod
     def _signatures(steps: list[str]) -> dict[str, tuple]:
-        """An assumption's identity: its label and the identities of the assumptions that
-        introduced the virtual objects it mentions (in plan order)."""
-        introduced: dict[str, tuple] = {}
+        """An assumption's identity: its label and the identities of the earlier assumptions
+        it rests on: those that introduced the virtual objects it mentions, and the one that
+        gave its room the category it assumes an object for."""
+        introduced: dict[Any, tuple] = {}
         out: dict[str, tuple] = {}
         for step in steps:
-            names = _strip(step)[1:]
-            deps = tuple(introduced[n] for n in names if _virtual(n) and n in introduced)
-            sig = (step, deps)
+            name, *args = _strip(step) or [""]
+            uses: list[Any] = [n for n in args if _virtual(n)]
+            if name == "assume-obj-exists-in" and len(args) == 4:
+                uses.append(("category", args[1], args[2]))
+            elif name == "assume-obj-exists-on" and len(args) == 6:
+                uses.append(("category", args[4], args[3]))
+            deps: list[tuple] = []
+            for key in uses:
+                if key in introduced and introduced[key] not in deps:
+                    deps.append(introduced[key])
+            sig = (step, tuple(deps))
             out[step] = sig
-            for n in names:
-                if _virtual(n) and n not in introduced:
-                    introduced[n] = sig
+            provides: list[Any] = [n for n in args if _virtual(n)]
+            if name == "assume-category" and len(args) == 2:
+                provides.append(("category", args[0], args[1]))
+            elif name == "assume-leads-to-room" and len(args) == 3:
+                provides.append(("category", args[2], args[1]))
+            for key in provides:
+                introduced.setdefault(key, sig)
         return out
 
     def _matched(self, matched: Mapping[str, str], t: Any) -> None:
@@ -410,6 +423,8 @@ class Ledger:
         if sig is None:
             return
         del self.open[sig]
+        if status == "confirmed":  # what rests on it now rests on a fact
+            self._rekey(sig)
         if status in ("refuted", "dropped"):  # what rests on it falls with it
             for other_sig, other in list(self.open.items()):
                 if sig in other_sig[1]:
@@ -417,6 +432,16 @@ class Ledger:
                         other.history.append({"t": t, "p": 0.0, "source": "monitor"})
                     self._close(other, status, t, f"rests on {entry.id} ({entry.meaning}), "
                                 f"which was {status}", by)
+
+    def _rekey(self, fact: tuple) -> None:
+        """An assumption came true: the entries resting on it no longer do (a next plan
+        without it continues them)."""
+        for sig, entry in list(self.open.items()):
+            if fact in sig[1]:
+                new = (sig[0], tuple(d for d in sig[1] if d != fact))
+                del self.open[sig]
+                self.open[new] = entry
+                self.current = {k: new if v == sig else v for k, v in self.current.items()}
 
     # ---- the explanation ---------------------------------------------------------------------
 

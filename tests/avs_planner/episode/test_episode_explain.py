@@ -131,6 +131,8 @@ def test_a_give_up_names_the_hypotheses_tried_and_why_each_fell() -> None:
     assert hypotheses[0]["p_first"] == 0.3 and hypotheses[0]["p_final"] == 0.0
     assert hypotheses[1]["p_first"] == 0.4 and hypotheses[1]["p_final"] == 0.05  # the mind's
     assert "room2 believed office 0.90" in hypotheses[1]["final_note"]
+    (exists,) = entries(explanation)[EXISTS_ROOM2]  # assumed for the kitchen room2 was not
+    assert exists["status"] == "refuted" and "rests on A3 (room2 is a kitchen)" in exists["reason"]
     text = explain.render(explanation)
     assert "Room hypotheses tried (2):" in text and "room2 is a kitchen" in text
     assert "planned again (replan): unsolvable" in text
