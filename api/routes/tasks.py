@@ -192,6 +192,28 @@ async def read_trajectory(task: TaskDep, settings: SettingsDep) -> FileResponse:
     return FileResponse(path, media_type="image/png")
 
 
+@router.get(
+    "/{task_id}/recording.rrd",
+    response_class=FileResponse,
+    responses={200: {"content": {"application/octet-stream": {}}}, 404: {"model": Message}},
+)
+async def read_recording(task: TaskDep, settings: SettingsDep) -> FileResponse:
+    """The episode's Rerun recording (open it with `rerun FILE` or `avs view FILE`), once it
+    has ended; the service records when the viewer extra is installed (or AVS_RECORD=1)."""
+    path = settings.tasks_dir / task.id / "recording.rrd"
+    if not task.state.terminal or not path.is_file():
+        why = ("it has not ended yet" if not task.state.terminal else
+               "this service does not record episodes (install the viewer extra, "
+               "pip install 'avs-planner[viewer]', or set AVS_RECORD=1)"
+               if not settings.records() else "its episode left none")
+        raise HTTPException(
+            status.HTTP_404_NOT_FOUND,
+            detail=f"task {task.id} has no recording (state: {task.state.value}): {why}",
+        )
+    return FileResponse(path, media_type="application/octet-stream",
+                        filename=f"{task.id}.rrd")
+
+
 @router.get("/{task_id}/explanation", responses={404: {"model": Message}})
 def read_explanation(task: TaskDep, settings: SettingsDep) -> dict[str, Any]:
     """Why the episode went as it did: the assumption ledger (every assumption its plans used,

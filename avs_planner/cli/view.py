@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -46,6 +45,7 @@ def _recording(run_dir: str) -> Path:
 
 def run(args: argparse.Namespace) -> int:
     from avs_planner.viewer import ViewerError, require_rerun
+    from avs_planner.viewer.errors import display_missing
 
     try:
         rrd = _recording(args.run_dir)
@@ -67,10 +67,9 @@ def run(args: argparse.Namespace) -> int:
         command += ["--web-viewer", "--web-viewer-port", str(args.port), "--bind", "127.0.0.1"]
         print(f"avs: serving {rrd} to a browser at http://127.0.0.1:{args.port} (Ctrl-C stops)",
               file=sys.stderr)
-    elif sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
-                                                   or os.environ.get("WAYLAND_DISPLAY")):
-        print(f"avs: error: cannot open the Rerun viewer's window: no display here (DISPLAY "
-              f"and WAYLAND_DISPLAY are not set). Serve it to a browser with `avs view "
+    elif display_missing():
+        print(f"avs: error: cannot open the Rerun viewer's window: {display_missing()}. "
+              f"Serve it to a browser with `avs view "
               f"{args.run_dir} --web`, or copy {rrd} to a machine with a display and run "
               f"`rerun {rrd.name}` there; `avs view {args.run_dir} --check` reads it here.",
               file=sys.stderr)

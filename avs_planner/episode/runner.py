@@ -116,6 +116,14 @@ def _recording(spec: Mapping[str, Any]) -> dict[str, bool]:
             require_rerun("'record' / 'view'")
         except ViewerError as exc:
             raise EpisodeError(f"episode spec: {exc}") from None
+    if out["view"]:
+        from avs_planner.viewer.errors import display_missing
+
+        missing = display_missing()
+        if missing:
+            raise EpisodeError(f"episode spec: 'view' opens a live Rerun viewer, but there is "
+                               f"{missing}; record with 'record' (--record) and replay with "
+                               f"`avs view RUN_DIR --web` instead")
     return out
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import sys
 from types import ModuleType
 
 INSTALL = "pip install 'avs-planner[viewer]'"
@@ -13,6 +15,14 @@ class ViewerError(RuntimeError):
 
 class ViewerMissingError(ViewerError):
     """rerun-sdk is not installed."""
+
+
+def display_missing() -> str | None:
+    """Why no viewer window can open here (None: it may)."""
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY")
+                                                 or os.environ.get("WAYLAND_DISPLAY")):
+        return "no display here (DISPLAY and WAYLAND_DISPLAY are not set)"
+    return None
 
 
 def require_rerun(why: str = "recording an episode") -> ModuleType:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import colorsys
 import hashlib
+import logging
 import math
 import time
 from collections.abc import Mapping
@@ -26,7 +27,9 @@ from typing import Any
 
 import numpy as np
 
-from avs_planner.viewer.errors import ViewerError, require_rerun
+from avs_planner.viewer.errors import ViewerError, display_missing, require_rerun
+
+log = logging.getLogger(__name__)
 
 TIMELINE = "sim_time"
 _KNOWN = {  # category -> RGB, others get a stable colour from their name
@@ -64,6 +67,11 @@ class Recorder:
         self.rec = rr.RecordingStream("avs-planner", recording_id=name)
         sinks = []
         if spawn:
+            missing = display_missing()
+            if missing:
+                raise ViewerError(f"cannot open a live Rerun viewer: {missing}; record the "
+                                  f"episode with --record instead and replay it with `avs view "
+                                  f"RUN_DIR --web` (a browser) or where a display is available")
             try:
                 rr.spawn(connect=False, hide_welcome_screen=True)
             except Exception as exc:  # noqa: BLE001 - no display, no viewer binary
@@ -133,8 +141,11 @@ class Recorder:
             return
         started = time.perf_counter()
         self.closed = True
-        self.rec.flush()
-        self.rec.disconnect()
+        try:
+            self.rec.flush()
+            self.rec.disconnect()
+        except Exception as exc:  # noqa: BLE001 - a viewer that went away must not fail the run
+            log.warning("the Rerun recording could not be completed: %s", exc)
         self.cost_s += time.perf_counter() - started
 
     # ---- what is logged ---------------------------------------------------------------------

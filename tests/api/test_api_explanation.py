@@ -48,3 +48,18 @@ def test_reading_an_explanation_needs_no_key_like_every_read(
                            headers={"X-API-Key": "s3cret"}).json()
         wait_for(client, task["id"], {"gave_up", "failed"})
         assert client.get(f"/v1/tasks/{task['id']}/explanation").status_code == 200
+
+
+def test_the_recording_of_an_ended_task(make_settings: Callable[..., Settings],
+                                        wait_for: Wait) -> None:
+    with TestClient(create_app(make_settings(record=True))) as client:
+        task = client.post("/v1/tasks", json={"target": "explained", "world": "office"}).json()
+        wait_for(client, task["id"], {"gave_up", "failed"})
+        response = client.get(f"/v1/tasks/{task['id']}/recording.rrd")
+        assert response.status_code == 200 and response.content.startswith(b"RRF2")
+    with TestClient(create_app(make_settings(record=False))) as client:
+        task = client.post("/v1/tasks", json={"target": "explained", "world": "office"}).json()
+        wait_for(client, task["id"], {"gave_up", "failed"})
+        response = client.get(f"/v1/tasks/{task['id']}/recording.rrd")
+        assert response.status_code == 404
+        assert "does not record episodes" in response.json()["detail"]

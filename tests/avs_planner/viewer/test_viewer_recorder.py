@@ -128,3 +128,11 @@ def test_without_rerun_recording_is_a_clear_error(monkeypatch, tmp_path: Path, c
 def test_recording_spec_errors_name_the_key(spec: dict, message: str) -> None:
     with pytest.raises(EpisodeError, match=message):
         EpisodeSpec.from_dict({"target": "cerealbox", **spec})
+
+
+@needs_rerun
+def test_a_live_view_without_a_display_is_refused_before_the_run(monkeypatch) -> None:
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    with pytest.raises(EpisodeError, match="no display here.*avs view RUN_DIR --web"):
+        EpisodeSpec.from_dict({"target": "cerealbox", "view": True})
