@@ -321,37 +321,46 @@ class Recorder:
                                 for _, ok in self._detections], show_labels=False))
 
     def _view_cones(self) -> None:
+        """The last CREATEVIEWCONES' cones, shaded by P(target in cone): the DT's belief while
+        its search runs over them (the cone at the robot's pose is the one being processed),
+        else the cones' own prior."""
         cones = self.executor.cones
         latest = next(reversed(cones.values())) if cones else None
+        if latest is None or not latest.cones:
+            return
+        cone_list = list(latest.cones)
         session = getattr(self.executor, "dt_session", None)
-        belief = getattr(session, "belief", None) if session is not None else None
-        key = (id(latest), id(belief))
-        if latest is None or key == self._belief_key:
+        live = (session is not None and getattr(session, "problem", None) is not None
+                and [c.id for c in session.problem.cones] == [c.id for c in cone_list])
+        belief = session.belief if live else None
+        current = None
+        if live and not session.finished:
+            x, y = self.robot.pose[:2]
+            near = [(math.dist((x, y), c.pose[:2]), i) for i, c in enumerate(cone_list)]
+            d, i = min(near)
+            current = i if d < 0.3 else None
+        key = (id(latest), id(belief), current)
+        if key == self._belief_key:
             return
         self._belief_key = key
-        cone_list = list(latest.cones)
-        if not cone_list:
-            return
-        probs = [c.probability for c in cone_list]
-        live = belief is not None and len(belief.probs) == len(cone_list) + 1 and \
-            session.problem is not None and len(session.problem.cones) == len(cone_list)
-        if live:
-            probs = list(belief.probs[:-1])
+        probs = list(belief.probs[:-1]) if belief is not None else [c.probability
+                                                                     for c in cone_list]
         top = max(probs) or 1.0
-        strips, colours, labels = [], [], []
+        strips, colours, labels, radii = [], [], [], []
         half, reach = self.camera.hfov / 2, self.camera.detect_range
-        for cone, p in zip(cone_list, probs, strict=True):
+        for i, (cone, p) in enumerate(zip(cone_list, probs, strict=True)):
             x, y, yaw = cone.pose[:3]
             yaw += (cone.head or (0.0, 0.0))[0]
             left = (x + reach * math.cos(yaw + half), y + reach * math.sin(yaw + half), 0.2)
             right = (x + reach * math.cos(yaw - half), y + reach * math.sin(yaw - half), 0.2)
             strips.append([(x, y, 0.2), left, right, (x, y, 0.2)])
             shade = int(60 + 195 * p / top)
-            colours.append((shade, 40, 255 - shade))
-            labels.append(f"{cone.id}: p={p:.2f}")
-        self.rec.log("world/cones", self.rr.LineStrips3D(strips, colors=colours, radii=0.02,
+            colours.append((255, 230, 0) if i == current else (shade, 40, 255 - shade))
+            radii.append(0.05 if i == current else 0.02)
+            labels.append(f"{cone.id}: p={p:.2f}" + (" (processing)" if i == current else ""))
+        self.rec.log("world/cones", self.rr.LineStrips3D(strips, colors=colours, radii=radii,
                                                          labels=labels))
-        if live:
+        if belief is not None:
             self.rec.log("dt/belief", self.rr.BarChart(np.asarray(belief.probs, dtype=float)))
 
 

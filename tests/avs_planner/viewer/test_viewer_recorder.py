@@ -136,3 +136,18 @@ def test_a_live_view_without_a_display_is_refused_before_the_run(monkeypatch) ->
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     with pytest.raises(EpisodeError, match="no display here.*avs view RUN_DIR --web"):
         EpisodeSpec.from_dict({"target": "cerealbox", "view": True})
+
+
+@needs_rerun
+@pytest.mark.slow
+def test_a_dt_search_records_its_cones_and_belief(tmp_path: Path) -> None:
+    """Scenario f (the marker in the meeting room, one DT search over its view cones)."""
+    from avs_planner.episode import run_episode
+    from avs_planner.episode.scenarios import load_scenario
+    from avs_planner.viewer.replay import contents
+
+    spec = dict(load_scenario("f").spec, seed=1, output_dir=str(tmp_path), record=True)
+    summary = run_episode(spec)
+    assert summary["dt_calls"] >= 1
+    entities = contents(tmp_path / "recording.rrd")["entities"]
+    assert entities.get("/world/cones", 0) >= 2 and entities.get("/dt/belief", 0) >= 1
