@@ -280,8 +280,9 @@ class Ledger:
                        "assumptive": flags[i]} for i, s in enumerate(steps)],
             "replan": replan["index"] if replan else None,
         })
-        if event.get("status") == "timeout":
-            return  # the fallback search follows at once; the old plan's entries stay
+        if why == "timeout" and not steps:  # the CP hit its node or time limit
+            self._pending_replan = replan  # the fallback search follows at once and
+            return  # answers the same replan; the old plan's entries stay till then
         signatures = self._signatures([s for s, a in zip(steps, flags, strict=False) if a])
         keep = set(signatures.values())
         cause = (f"plan {index} ({why}) no longer uses it" if steps else
@@ -651,7 +652,13 @@ def render(explanation: Mapping[str, Any]) -> str:
             marked = [("[assume] " if s.get("assumptive") else "") + s["action"]
                       + (f" p={_p(s['p'])}" if s.get("assumptive") and s.get("p") is not None
                          else "") for s in steps]
-            body = "; ".join(marked) if marked else f"no plan ({plan.get('status')})"
+            if marked:
+                body = "; ".join(marked)
+            elif plan.get("why") == "timeout":
+                body = (f"the planner stopped at its limit ({plan.get('status')}); planned again "
+                        f"with the fallback heuristic")
+            else:
+                body = f"no plan ({plan.get('status')})"
             out.append(f"  #{plan['index']} t={_t(plan.get('t'))} {plan.get('why')}, "
                        f"p={_p(plan.get('probability'))}: {body}")
         out.append("")

@@ -208,3 +208,15 @@ def test_scenario_c_explains_every_room_hypothesis_it_gave_up_on(tmp_path: Path)
     for kind, subject, category in tried:
         assert (f"a {category} lies behind {subject}" if kind == "assume-leads-to-room"
                 else f"{subject} is a {category}") in text
+
+
+def test_a_planner_timeout_keeps_the_assumptions_until_the_fallback_plan() -> None:
+    trace = found_trace()
+    at = next(i for i, e in enumerate(trace) if e["type"] == "plan" and e["why"] == "replan")
+    trace.insert(at, {"t": 20.0, "type": "plan", "why": "timeout", "status": "node_limit",
+                      "plan": [], "planning_time_s": 20.0})
+    explanation = explain.build(trace)
+    assert [p["replan"] for p in explanation["plans"]] == [None, 1, 1, 2]
+    assert [e["status"] for e in explanation["assumptions"]] == [
+        "refuted", "refuted", "confirmed", "confirmed"]
+    assert "planned again with the fallback heuristic" in explain.render(explanation)
