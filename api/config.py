@@ -52,6 +52,9 @@ class Settings(BaseSettings):
         "trusted ('*' for any); default: none, the TCP peer is the client")
     plan_results_kept: int = Field(100, ge=1, le=10_000, description="finished async plan jobs "
                                    "kept for polling (oldest dropped first)")
+    record: bool | None = Field(
+        None, description="write a Rerun recording (recording.rrd) of each task's episode; "
+        "default: when the viewer extra (rerun-sdk) is installed and episodes run locally")
     ray_address: str | None = Field(
         None, description="run episode tasks as Ray tasks on this cluster ('local': start Ray "
         "on this machine); default: local worker processes"
@@ -64,6 +67,15 @@ class Settings(BaseSettings):
     @property
     def tasks_dir(self) -> Path:
         return self.data_dir / "tasks"
+
+    def records(self) -> bool:
+        """Whether episodes write recording.rrd (AVS_RECORD, else: the viewer extra is
+        installed here and episodes run here, not on a Ray cluster that may lack it)."""
+        if self.record is not None:
+            return self.record
+        import importlib.util
+
+        return self.ray_address is None and importlib.util.find_spec("rerun") is not None
 
     def is_open(self) -> bool:
         """True when no API key is configured (then the service must stay on loopback)."""

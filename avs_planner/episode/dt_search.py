@@ -38,6 +38,7 @@ class ViewConeSearch:
                             rewards=DTRewards(self.ex.config.miss_penalty,
                                               self.ex.config.miss_penalty),
                             seed=self.ex.seed + self.ex.stats.dt_calls)
+        self.ex.dt_session = session  # the running session, for observers (the recorder)
         while True:
             action = session.next_action()
             if session.finished:

@@ -86,6 +86,7 @@ class Executor:
         self.stats = Stats()
         self.watching = True  # the detector looks for the target as the robot moves
         self.seen_while_moving: dict[str, set[Atom]] = {}
+        self.dt_session: Any = None  # the last SEARCHFOROBJECT's DTSession (read by observers)
         self._unplaced: list[SeenLike] = []
 
     # ---- sensing along the way --------------------------------------------------------------

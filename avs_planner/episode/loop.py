@@ -256,6 +256,11 @@ class SwitchingLoop:
                                      observed=outcome.observed or None)
         if update.matched:
             self.trace.emit("belief", matched=dict(update.matched))
+        report = update.report
+        self.trace.emit("monitor", verdict=report.status.value if report else "",
+                        confirmed=list(update.confirmed),
+                        assumptions={a: round(p, 5) for a, p in report.assumptions}
+                        if report else {})
         if update.decision is Decision.CONTINUE:
             return None
         report = update.report
@@ -273,6 +278,8 @@ class SwitchingLoop:
         self.result.cp_times.append(result.planning_time_s)
         self.trace.emit("plan", why=why, status=result.status.value,
                         plan=[s.label for s in result.plan],
+                        step_p=[round(s.probability, 5) for s in result.plan],
+                        assumptive=[i for i, s in enumerate(result.plan) if s.assumptive],
                         probability=round(result.probability, 5), cost=round(result.cost, 2),
                         planning_time_s=round(result.planning_time_s, 4),
                         expanded=result.expanded)

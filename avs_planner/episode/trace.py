@@ -19,13 +19,9 @@ class Trace:
         self.clock = clock
         self.events: list[dict[str, Any]] = []
         self._sink = sink
+        self._listeners: list[Sink] = []
         self._start = time.perf_counter()
         self._file: TextIO | None = path.open("w", encoding="utf-8") if path else None
-        self._subscribers: list[Sink] = []
-
-    def subscribe(self, subscriber: Sink) -> None:
-        """Call `subscriber(event)` after each event is recorded (it may emit more events)."""
-        self._subscribers.append(subscriber)
 
     @property
     def wall(self) -> float:
@@ -40,9 +36,14 @@ class Trace:
             self._file.flush()
         if self._sink is not None:
             self._sink(event)
-        for subscriber in self._subscribers:
-            subscriber(event)
+        for listener in self._listeners:
+            listener(event)
         return event
+
+    def subscribe(self, listener: Sink) -> None:
+        """Call `listener(event)` after each event is recorded (the map snapshots, the Rerun
+        recorder; a listener may emit more events)."""
+        self._listeners.append(listener)
 
     def close(self) -> None:
         if self._file is not None:
