@@ -63,3 +63,15 @@ def test_the_recording_of_an_ended_task(make_settings: Callable[..., Settings],
         response = client.get(f"/v1/tasks/{task['id']}/recording.rrd")
         assert response.status_code == 404
         assert "does not record episodes" in response.json()["detail"]
+
+
+def test_recording_needs_no_address_space_limit(make_settings: Callable[..., Settings]) -> None:
+    """The Rerun recorder reserves more address space than the worker's limit allows (the
+    worker died on every recorded task): recording is refused with a limit, and off by
+    default when one is set."""
+    import pydantic
+    import pytest
+
+    with pytest.raises(pydantic.ValidationError, match="AVS_MEMORY_LIMIT_MB=0"):
+        make_settings(record=True, memory_limit_mb=2048)
+    assert not make_settings(memory_limit_mb=2048).records()
