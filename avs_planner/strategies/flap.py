@@ -26,8 +26,10 @@ import time
 import weakref
 from dataclasses import dataclass
 
+import numpy as np
+
 from avs_planner.episode.mind import KnownObject
-from avs_planner.episode.outcome import Outcome, SearchResult, StepStatus
+from avs_planner.episode.outcome import Outcome, SearchResult, StepOutcome, StepStatus
 from avs_planner.flap import (
     FlapOptions,
     FlapSearch,
@@ -38,8 +40,11 @@ from avs_planner.flap import (
     View,
     ViewPose,
 )
+from avs_planner.flap.errors import FlapError
 from avs_planner.strategies.context import SearchContext
-from avs_planner.strategies.looking import _look
+from avs_planner.strategies.looking import _look, known_target
+from conceptual_map.errors import MapError
+from conceptual_map.metric import plan_path
 
 SURVEY_TILTS = (0.0, -0.6)  # rad: depth frames per survey heading (ahead, down at tables)
 SURVEY_DEPTH_COLUMNS = 48  # before the clock (the prior map)
@@ -88,6 +93,10 @@ def survey(ctx: SearchContext, depth: bool, find: bool, until_support: bool = Fa
         mind.tried_placeholders[target] = mind.tried_placeholders.get(target, 0) + 1
         goal = mind.place_map.placeholders[target].position
         outcome = ex.drive_to(goal, stop=lambda t=target: t not in mind.place_map.placeholders)
+        if find and found is None:
+            found = known_target(ctx)  # the executor's watch confirmed it on the way
+            if found is not None:
+                break
         if outcome.status is StepStatus.DONE:
             ex.look_around()
             found = _survey_stop(ctx, depth, find, columns)
@@ -97,6 +106,8 @@ def survey(ctx: SearchContext, depth: bool, find: bool, until_support: bool = Fa
 def _survey_stop(ctx: SearchContext, depth: bool, find: bool, columns: int
                  ) -> KnownObject | None:
     robot, headings = ctx.robot, ctx.options["survey_headings"]
+    if find and (known := known_target(ctx)) is not None:
+        return known  # confirmed by the executor's watch (its look around, or on the way)
     supports = _support_labels(ctx)
     labels = [*supports, ctx.target] if find else supports
     yaw = robot.pose[2]
@@ -205,6 +216,44 @@ def support_volumes(ctx: SearchContext, skip: set[str] = frozenset()) -> list[Ta
             for lo, hi, _, p, ids in boxes]
 
 
+def task_volumes(ctx: SearchContext) -> list[TargetVolume]:
+    """The region the task gives (option `volumes`, as the seed's search tasks do)."""
+    return parse_volumes(ctx.options["volumes"], ctx.options["p_volume"])
+
+
+def parse_volumes(given: object, p_default: float) -> list[TargetVolume]:
+    """Option `volumes`: one box per entry {lo, hi, p (default `p_volume`), name}. Raises
+    FlapError naming the bad entry."""
+    if not isinstance(given, list):
+        raise FlapError(f"option 'volumes' must be a list of boxes, got {given!r}")
+    out = []
+    for k, entry in enumerate(given):
+        where = f"option 'volumes' entry {k}"
+        if not isinstance(entry, dict) or not {"lo", "hi"} <= set(entry):
+            raise FlapError(f"{where}: need a mapping with lo and hi, got {entry!r}")
+        unknown = sorted(set(entry) - {"lo", "hi", "p", "name"})
+        if unknown:
+            raise FlapError(f"{where}: unknown key(s) {', '.join(unknown)}")
+        try:
+            lo = tuple(float(v) for v in entry["lo"])
+            hi = tuple(float(v) for v in entry["hi"])
+            p = float(entry.get("p", p_default))
+        except (TypeError, ValueError) as exc:
+            raise FlapError(f"{where}: lo, hi and p must be numbers ({exc})") from None
+        volume = TargetVolume(lo, hi, p, str(entry.get("name", f"volume{k}")))
+        try:
+            volume.check()
+        except FlapError as exc:
+            raise FlapError(f"{where}: {exc}") from None
+        out.append(volume)
+    return out
+
+
+def check_options(options: dict) -> None:
+    """The registry's check of flap's options beyond their types."""
+    parse_volumes(options["volumes"], options["p_volume"])
+
+
 def _p_on(ctx: SearchContext, obj: KnownObject) -> float:
     try:
         return float(ctx.mind.cmap.p_object_at(ctx.target, ("on", obj.id)))
@@ -222,6 +271,11 @@ def run(ctx: SearchContext) -> SearchResult:
     head = _Head(torso=max(0.0, ctx.robot.camera_height - ctx.body.camera_height))
     searched: set[str] = set()
     reset, why = bool(ctx.options["reset_region"]), "no support of the target is known"
+    given = task_volumes(ctx)
+    if given:  # the task's region: searched once, to the omega test
+        ended = _search_region(ctx, result, given, head, reset)
+        return ended or ctx.end(result, Outcome.GAVE_UP,
+                                "the given region is searched (p(V̂(S)) < omega)")
     while True:
         stop = ctx.budget_spent()
         if stop:
@@ -250,7 +304,8 @@ def _search_region(ctx: SearchContext, result: SearchResult, volumes: list[Targe
     """The FLAP cycle over one region until the target is found (the ended result), the
     budget is spent (ditto), or p(V̂(S)) < omega (None)."""
     o, mind, robot = ctx.options, ctx.mind, ctx.robot
-    mind.integrate_depth(robot.depth(_size(o["depth_columns"])))  # makes the map if none
+    mind.integrate_depth(_detectable(robot.depth(_size(o["depth_columns"])), ctx.body))  # (makes
+    # the map if there is none)
     if reset:
         for volume in volumes:
             mind.voxels.reset_box(volume.lo, volume.hi)
@@ -308,7 +363,8 @@ def _visit(ctx: SearchContext, view: View, head: _Head) -> KnownObject | None:
     """Drive to the view, stand on its pose, point the head at its target, take a depth frame
     into the 3D map and look for the target."""
     robot, body, pose = ctx.robot, ctx.body, view.pose
-    outcome = ctx.executor.drive_to((pose.x, pose.y))
+    outcome = (ctx.executor.drive_to((pose.x, pose.y)) if ctx.options["sense_en_route"]
+               else _drive_quietly(ctx, (pose.x, pose.y)))
     head.drive = outcome.status.value if not outcome.detail else f"{outcome.status.value}: " \
         f"{outcome.detail}"
     if outcome.status is StepStatus.DONE and math.dist(robot.pose[:2], (pose.x, pose.y)) > 0.02:
@@ -322,8 +378,45 @@ def _visit(ctx: SearchContext, view: View, head: _Head) -> KnownObject | None:
     robot.turn_to(math.atan2(ty - y, tx - x) - head.pan)
     robot.set_torso(head.torso)
     robot.look(head.pan, head.tilt)
-    ctx.mind.integrate_depth(robot.depth(_size(ctx.options["depth_columns"])))
-    return _look(ctx)
+    ctx.mind.integrate_depth(_detectable(robot.depth(_size(ctx.options["depth_columns"])), body))
+    return known_target(ctx) or _look(ctx)  # (the watch may have confirmed it on the way)
+
+
+@dataclass(frozen=True)
+class _Frame:
+    """A depth frame (conceptual_map's DepthFrameLike) with a shorter max range."""
+
+    origin: np.ndarray
+    directions: np.ndarray
+    ranges: np.ndarray
+    max_range: float
+    time: float
+
+
+def _detectable(frame, body) -> _Frame:  # noqa: ANN001 - a DepthFrameLike and a RobotBody
+    """A search view's depth frame cut at the detector's range: a cell the depth camera sees
+    beyond it was not searched (the detector could not have recognised the target there), and
+    the sampler predicts a view's cells within that range. Beyond it the rays say nothing."""
+    return _Frame(frame.origin, frame.directions, frame.ranges,
+                  min(float(frame.max_range), body.detect_range), frame.time)
+
+
+def _drive_quietly(ctx: SearchContext, goal: tuple[float, float]) -> StepOutcome:
+    """The seed's transition: follow one A* path on the robot's grid to the view, with one
+    laser scan at the end, and no sensing on the way (the executor's drive scans every metre,
+    classifies each new place and watches for the target: about a third of the search time
+    in `flap_two_rooms`, which the transition model does not predict). Falls back to the
+    executor's drive when there is no path or the base refuses it."""
+    robot, mind = ctx.robot, ctx.mind
+    try:
+        path = plan_path(mind.grid, robot.pose[:2], goal, mind.config.robot_radius)
+    except MapError:
+        path = None
+    if path is None or not path.found or not robot.move_along(list(path.waypoints[1:])):
+        return ctx.executor.drive_to(goal)
+    ctx.executor.stats.distance += path.length
+    mind.sense(robot.scan(), [robot.pose], robot.clock)
+    return StepOutcome(StepStatus.DONE)
 
 
 def _found(ctx: SearchContext, result: SearchResult, obj: KnownObject) -> SearchResult:
