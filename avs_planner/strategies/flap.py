@@ -180,6 +180,16 @@ def _size(columns: int) -> tuple[int, int]:
 
 # ---- the search region -----------------------------------------------------------------------
 
+def support_box(obj: KnownObject, reach: float, height: float, below: float
+                ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """The box where a target on a detected support would be: `reach` m either side of its
+    detected centre, from `below` (< 0: the top is a noisy estimate) under its top (twice the
+    detected centre's height: a detection's centre is half the support's) to `height` above."""
+    x, y, z = obj.position
+    top = max(0.3, 2.0 * z)
+    return (x - reach, y - reach, top + below), (x + reach, y + reach, top + height)
+
+
 def support_volumes(ctx: SearchContext, skip: set[str] = frozenset()) -> list[TargetVolume]:
     """One box above each known support of the target (but those in `skip`); overlapping
     boxes of a label merge. A volume's name lists its supports' ids joined by '+'."""
@@ -190,12 +200,9 @@ def support_volumes(ctx: SearchContext, skip: set[str] = frozenset()) -> list[Ta
     for obj in mind.objects.values():
         if obj.label not in labels or obj.id in skip:
             continue
-        x, y, z = obj.position
-        top = max(0.3, 2.0 * z)  # a detection's centre is half the support's height
         p = o["p_volume"] if o["p_volume"] > 0 else _p_on(ctx, obj)
-        low = top + ctx.executor.config.above_support[0]  # the top is a noisy estimate
-        boxes.append([[x - reach, y - reach, low], [x + reach, y + reach, top + height],
-                      obj.label, p, [obj.id]])
+        lo, hi = support_box(obj, reach, height, ctx.executor.config.above_support[0])
+        boxes.append([list(lo), list(hi), obj.label, p, [obj.id]])
     merged = True
     while merged:
         merged = False

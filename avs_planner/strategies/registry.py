@@ -89,6 +89,9 @@ def _convert(strategy: str, key: str, value: Any, default: Any) -> Any:
 # the loop's settings, less what the episode spec gives (budgets, where to dump problems)
 _SWITCHING_OPTIONS = {f.name: f.default for f in fields(LoopConfig)
                       if f.name not in ("time_budget_s", "wall_budget_s", "dump_dir")}
+# the view cones of a search on a support: "cones" (2D, around it) or "flap" (FLAP's views in
+# the 3D map; avs_planner/strategies/flap_views.py)
+_SWITCHING_OPTIONS["views"] = "cones"
 
 _FLAP_OPTIONS = {  # avs_planner/strategies/flap.py
     "greedy": False,  # next best view by p/t (the seed's baseline) instead of branch and bound
@@ -114,7 +117,8 @@ _FLAP_OPTIONS = {  # avs_planner/strategies/flap.py
 STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
     Strategy("switching", "the switching planner: continual PDDL planner with assumptions + "
              "POMDP view-cone search (Goebelbecker et al.)",
-             "avs_planner.strategies.switching:run", _SWITCHING_OPTIONS),
+             "avs_planner.strategies.switching:run", _SWITCHING_OPTIONS,
+             check="avs_planner.strategies.switching:check_options"),
     Strategy("exhaustive", "baseline: frontier exploration, nearest placeholder first, "
              "looking all round at every stop; no priors",
              "avs_planner.strategies.baselines:run_exhaustive",
