@@ -44,7 +44,8 @@ CELLS = [("map", True, False), ("map", True, True), ("no map", False, False),
          ("no map", False, True)]  # (label, prior_map, greedy)
 SEED_DIFF = {"map": -10.0, "no map": -7.0}  # %: the seed's planner vs greedy (§5)
 OPTIONS = {"time_limit_s": 0.5, "max_views": 60, "survey_on": False,
-           "sense_en_route": False}  # one region per trial; transitions as the seed models them
+           "sense_en_route": False,  # one region per trial; transitions as the seed models them
+           "depth_columns": 64}
 
 
 def start_pose(seed: int) -> list[float]:

@@ -120,7 +120,7 @@ class FlapSearch:
         fresh = self.options.fit_pairs if not self.fit_samples else self.options.refit_pairs
         table = build_table(self.body, grid, pose, [v.pose for v in views], self.options.clusters,
                             fit_pairs=fresh, seed=self.cycle, known=self.fit_samples)
-        self.fit_samples = list(table.samples[-self.options.fit_pairs * 2:])
+        self.fit_samples[:] = table.samples[-self.options.fit_pairs * 2:]  # (in place: shared)
         views = [views[k] for k in table.kept]
         clock.lap("transitions")
         problem = SequencingProblem.build([v.cells for v in views], belief.log_miss(),

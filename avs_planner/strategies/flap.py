@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 import time
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -47,6 +47,8 @@ from conceptual_map.errors import MapError
 from conceptual_map.metric import plan_path
 
 SURVEY_TILTS = (0.0, -0.6)  # rad: depth frames per survey heading (ahead, down at tables)
+SEARCH_SURVEY_TILTS = (-0.3,)  # while the clock runs: one frame per heading, where the
+# detector looks (half the depth work of two tilts; FLAP's own views map the region densely)
 SURVEY_DEPTH_COLUMNS = 48  # before the clock (the prior map)
 SEARCH_SURVEY_DEPTH_COLUMNS = 32  # while the clock runs: cheaper; FLAP's views map densely
 MAX_SURVEY_STOPS = 60
@@ -60,6 +62,7 @@ class _Head:
     pan: float = 0.0
     tilt: float = 0.0
     drive: str = ""  # how the last drive to a view ended
+    fit: list = field(default_factory=list)  # driving-time samples, kept from region to region
 
 
 # ---- preparation and survey ------------------------------------------------------------------
@@ -74,14 +77,15 @@ def prepare(ctx: SearchContext) -> None:
 
 
 def survey(ctx: SearchContext, depth: bool, find: bool, until_support: bool = False,
-           columns: int = SURVEY_DEPTH_COLUMNS) -> KnownObject | None:
+           columns: int = SURVEY_DEPTH_COLUMNS,
+           tilts: tuple[float, ...] = SURVEY_TILTS) -> KnownObject | None:
     """Visit placeholders nearest-first (frontier exploration), looking all round at every
     stop for supports (and the target when `find`); returns the target once confirmed. With
     `until_support` it stops after the first stop that registered a new support."""
     mind, ex = ctx.mind, ctx.executor
     known = len(_support_names(ctx))
     ex.look_around()
-    found = _survey_stop(ctx, depth, find, columns)
+    found = _survey_stop(ctx, depth, find, columns, tilts)
     for _ in range(MAX_SURVEY_STOPS):
         if found is not None or (find and ctx.budget_spent()):
             break
@@ -99,12 +103,12 @@ def survey(ctx: SearchContext, depth: bool, find: bool, until_support: bool = Fa
                 break
         if outcome.status is StepStatus.DONE:
             ex.look_around()
-            found = _survey_stop(ctx, depth, find, columns)
+            found = _survey_stop(ctx, depth, find, columns, tilts)
     return found
 
 
-def _survey_stop(ctx: SearchContext, depth: bool, find: bool, columns: int
-                 ) -> KnownObject | None:
+def _survey_stop(ctx: SearchContext, depth: bool, find: bool, columns: int,
+                 tilts: tuple[float, ...]) -> KnownObject | None:
     robot, headings = ctx.robot, ctx.options["survey_headings"]
     if find and (known := known_target(ctx)) is not None:
         return known  # confirmed by the executor's watch (its look around, or on the way)
@@ -114,7 +118,7 @@ def _survey_stop(ctx: SearchContext, depth: bool, find: bool, columns: int
     for k in range(headings):
         robot.turn_to(yaw + 2 * math.pi * k / headings)
         if depth:
-            for tilt in SURVEY_TILTS:
+            for tilt in tilts:
                 robot.look(0.0, tilt)
                 ctx.mind.integrate_depth(robot.depth(_size(columns)))
         robot.look(0.0, SURVEY_TILTS[-1] / 2)
@@ -300,7 +304,7 @@ def run(ctx: SearchContext) -> SearchResult:
             return ctx.end(result, Outcome.GAVE_UP, f"{why}; nothing left to explore")
         else:
             found = survey(ctx, depth=True, find=True, until_support=True,
-                           columns=SEARCH_SURVEY_DEPTH_COLUMNS)
+                           columns=SEARCH_SURVEY_DEPTH_COLUMNS, tilts=SEARCH_SURVEY_TILTS)
             if found is not None:
                 return _found(ctx, result, found)
         reset = False  # only the map known before the search is taken as out of date
@@ -325,6 +329,7 @@ def _search_region(ctx: SearchContext, result: SearchResult, volumes: list[Targe
     planner = PlannerOptions(omega=o["omega"], time_limit=o["time_limit_s"] or None)
     search = FlapSearch(ctx.body, volumes, FlapOptions(views=o["views"], clusters=o["clusters"],
                                                        planner=planner, greedy=o["greedy"]))
+    search.fit_samples = head.fit  # the same robot on the same floor: fewer A* to price
     for k in range(o["max_views"]):
         stop = ctx.budget_spent()
         if stop:

@@ -104,7 +104,7 @@ _FLAP_OPTIONS = {  # avs_planner/strategies/flap.py
     "reset_region": True,  # forget the 3D map inside the search region at the start
     "support_reach": 0.7,  # m: half width of a support's box around its detected centre
     "volume_height": 0.3,  # m: height of a support's box above its top
-    "depth_columns": 64,  # depth frame columns at a view (rows: 3/4 of them)
+    "depth_columns": 48,  # depth frame columns at a view (rows: 3/4 of them)
     "survey_headings": 6,  # headings looked at per survey stop
     "survey_on": True,  # after a region is searched, survey on for more supports
     "sense_en_route": True,  # drive to views with the executor (scans every metre, place
