@@ -6,12 +6,15 @@
 World `flap_two_rooms` (after the seed's Fig. 4), a PR2, trials with seeds 0..N-1, each from a
 random start pose (drawn by the experimenter from the world file, the same for all four cells
 of a seed). Every episode runs `avs simulate --strategy flap` with `pre_explore`: the robot
-surveys the building before the clock starts, registering the supports it detects (their boxes
-are the search region, P_i = 0.2 each as in the seed); with a prior map the survey also
-integrates depth frames, so the 3D map exists before the search; without one only the 2D map
-and the supports are known (the seed: "only walls are known"). The region is reset to unknown at
-the start in both. The target label (`stapler`) is absent, so every trial runs until the omega
-test (p(V̂(S)) < 0.05) ends it, as the seed's trials do.
+surveys the building before the clock starts; with a prior map the survey also integrates depth
+frames, so the 3D map exists before the search; without one only the 2D map is known (the
+seed: "only walls are known"). The search region is the seed's, given by the task (option
+`volumes`, as the seed's tasks give it): a box over each of the six supports of its Fig. 4 (two
+shelf arrangements, one single shelf, three tables), P_i = 0.2 each; it is reset to unknown at
+the start in both. Drives between views follow one path with no sensing on the way
+(`sense_en_route: false`), so executed transitions are what the planner's time model predicts,
+as in the seed's simulation. The target label (`stapler`) is absent, so every trial runs until
+the omega test (p(V̂(S)) < 0.05) ends it, as the seed's trials do.
 
 Measures per trial, as the seed's (its footnote 4: eq. 4 on the executed sequence): the
 expected search time E[T] = sum_k S_{k-1} (t_k - t_{k-1}), S_k the probability that the target
