@@ -20,7 +20,8 @@ false-negative/false-positive model as before. How the two are combined:
   target); the set's coverage is the share all cones see. `ConeSet.probability` is the mass
   the cones hold (P_i * coverage), so a rejected search reports the share of the box looked
   at (`ViewConeSearch._conclude`).
-- **Fallback**: no map cell in the box, no reachable view, or a FLAP error: the 2D cones.
+- **Fallback**: no unknown cell in the box, no view, no reachable view, or a FLAP or map
+  error: the 2D cones (the trace event `flap` / `cones` says which and why).
 
 Searches in a room (`ObjectAt(label, in, room)`) keep the 2D room cones.
 """
@@ -48,6 +49,7 @@ from avs_planner.flap import (
 )
 from avs_planner.flap.errors import FlapError
 from avs_planner.strategies.flap import _detectable, _size, support_box
+from conceptual_map.errors import MapError
 
 VIEWS = ("cones", "flap")  # values of the switching strategy's `views` option
 
@@ -78,7 +80,7 @@ class FlapViews:
         began = time.perf_counter()
         try:
             made, note = self._flap_cones(mind, support, p, key)
-        except FlapError as exc:
+        except (FlapError, MapError) as exc:  # e.g. no view reachable: the 2D cones
             made, note = None, str(exc)
         if made is None:
             made = support_cones(mind, support, p, camera, key)
