@@ -107,3 +107,18 @@ def test_a_given_region_is_searched_to_the_omega_test_with_quiet_drives():
     during = [e for e in events if e["t"] > started]
     assert not [e for e in during if e["type"] == "observation" and e.get("watching")]
     assert [e for e in during if e.get("event") == "view"]
+
+
+def test_a_target_the_watch_confirmed_on_the_way_ends_the_survey():
+    """A target the executor's watch confirmed while driving is a known object: the next
+    survey stop reports it without looking (flap's own look skips detections near known
+    objects, so it used to search on and give up with the target known)."""
+    from types import SimpleNamespace
+
+    from avs_planner.episode.mind import KnownObject
+    from avs_planner.strategies.flap import _survey_stop
+
+    cup = KnownObject("object7", "cup", (1.0, 2.0, 0.8), "room_a")
+    ctx = SimpleNamespace(robot=None, options={"survey_headings": 6}, target="cup",
+                          category=None, mind=SimpleNamespace(objects={cup.id: cup}))
+    assert _survey_stop(ctx, depth=True, find=True, columns=32, tilts=(0.0,)) is cup
