@@ -92,6 +92,8 @@ class Executor:
         self.found_sids: dict[str, int] = {}
         self.stats = Stats()
         self.watching = True  # the detector looks for the target as the robot moves
+        self.support_views: Callable[..., ConeSet] | None = None  # replaces support_cones
+        self.on_look: Callable[[], None] | None = None  # before each DT look (e.g. depth)
         self.seen_while_moving: dict[str, set[Atom]] = {}
         self.dt_session: Any = None  # the last SEARCHFOROBJECT's DTSession (read by observers)
         self._unplaced: list[SeenLike] = []
@@ -470,7 +472,7 @@ class Executor:
                 return StepOutcome(StepStatus.FAILED, f"{location} is not a known object")
             if p is None:
                 p = self.mind.cmap.p_object_at(label, ("on", location))
-            made = support_cones(self.mind, support, p, self.camera, key)
+            made = (self.support_views or support_cones)(self.mind, support, p, self.camera, key)
         else:
             if location not in self.mind.place_map.rooms:
                 return StepOutcome(StepStatus.FAILED, f"{location} is not a known room")
