@@ -265,8 +265,12 @@ class Executor:
             if obj is None:
                 return StepOutcome(StepStatus.FAILED, f"{step.args[0]} is not a known object")
             if obj.label == self.builder.task.target and not self.verify(obj):
+                # a false detection: forgotten, so the planner searches on without it
+                self.mind.forget_object(obj.id)
+                self.found_sids.pop(obj.id, None)
                 return StepOutcome(StepStatus.FAILED, f"{obj.label} not seen again at "
-                                   f"{obj.position} when looked at before reporting")
+                                   f"{obj.position} when looked at before reporting; "
+                                   f"{obj.id} forgotten")
             return StepOutcome(StepStatus.FOUND, f"{obj.label} at {obj.position}", reported=obj)
         return StepOutcome(StepStatus.FAILED, f"no skill executes {step.name}")
 

@@ -187,11 +187,19 @@ class Mind:
                 else self.room_at(position[:2]))
         if room is None:
             raise ValueError(f"no room known near {position[:2]}")
-        oid = f"object{len(self.objects) + 1}"
+        n = len(self.objects) + 1
+        while f"object{n}" in self.objects or f"object{n}" in self.cmap.objects.objects:
+            n += 1
+        oid = f"object{n}"
         self.cmap.observe_object(label, room, on=support, object_id=oid)
         known = KnownObject(oid, label, position, room, support)
         self.objects[oid] = known
         return known
+
+    def forget_object(self, oid: str) -> None:
+        """A known object proved a false detection: the mind and the map drop it."""
+        self.cmap.forget_object(oid)
+        self.objects.pop(oid, None)
 
     def failed_search(self, label: str, relation: str, location: str, coverage: float,
                       p_detect: float) -> None:

@@ -92,6 +92,22 @@ class ObjectLedger:
         self._counts.setdefault(record.location, Counter())[label] += 1
         return record
 
+    def remove(self, object_id: str) -> ObjectRecord:
+        """Take back a detected object (it proved a false detection); objects on it first."""
+        record = self.objects.get(object_id)
+        if record is None:
+            raise ConceptualError(f"unknown object {object_id!r}")
+        held = [o for o, r in self.objects.items() if r.support == object_id]
+        if held:
+            raise ConceptualError(f"object {object_id!r} still holds {', '.join(held)}")
+        del self.objects[object_id]
+        counts = self._counts.get(record.location)
+        if counts is not None:
+            counts[record.label] -= 1
+            if counts[record.label] <= 0:
+                del counts[record.label]
+        return record
+
     def _check_support(self, room: str, relation: str | None, support: str) -> None:
         if relation not in RELATIONS:
             raise ConceptualError(f"relation must be one of {RELATIONS}, got {relation!r}")

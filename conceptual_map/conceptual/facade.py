@@ -162,6 +162,11 @@ class ConceptualMap:
         self._refresh_object_evidence(room)
         return record.object_id
 
+    def forget_object(self, object_id: str) -> None:
+        """A detected object proved false (not seen again where it was): as if never seen."""
+        record = self.objects.remove(object_id)
+        self._refresh_object_evidence(record.room)
+
     def observe_search(
         self, label: str, location: Location | tuple[str, str], coverage: float, p_detect: float
     ) -> None:

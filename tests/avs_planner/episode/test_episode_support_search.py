@@ -142,6 +142,11 @@ def test_the_target_is_looked_at_again_before_it_is_reported(corridor, monkeypat
     assert not frames  # all three frames were taken
     yaw = executor.robot.pose[2]
     assert math.isclose(math.cos(yaw - math.atan2(1.0, 1.0)), 1.0, abs_tol=1e-2)
+    # the false detection is forgotten: the planner may search its room again
+    assert obj.id not in mind.objects and obj.id not in mind.cmap.objects.objects
+    assert ("defined-exists", target, "in", obj.room) not in builder.build().atoms
+    obj = mind.add_object(target, (x + 1.0, y + 1.0, 0.5))
+    step = PlanStep("reportposition", (obj.id, target), 0.0, 1.0, False)
     frames[:] = [[], [Seen(7, target, (x + 1.1, y + 1.0, 0.5), 0.8)]]
     assert executor._run(step, builder.build()).status is StepStatus.FOUND
     executor.config = replace(executor.config, verify_frames=0)

@@ -122,3 +122,22 @@ def test_bad_object_input_raises_clear_errors(action, message):
     cmap.observe_object("table", "r")
     with pytest.raises(ConceptualError, match=message):
         action(cmap)
+
+
+def test_a_forgotten_object_leaves_the_beliefs_as_if_never_seen():
+    """A detection that proved false is taken back: room category beliefs return to what
+    they were before it, and a support still holding an object cannot be forgotten."""
+    cmap = ConceptualMap()
+    cmap.add_room("room1")
+    before = cmap.room_category("room1")
+    oid = cmap.observe_object("cerealbox", "room1")
+    assert cmap.room_category("room1") != pytest.approx(before)
+    cmap.forget_object(oid)
+    assert oid not in cmap.objects.objects
+    assert cmap.room_category("room1") == pytest.approx(before)
+    table = cmap.observe_object("table", "room1")
+    cmap.observe_object("cerealbox", "room1", on=table)
+    with pytest.raises(ConceptualError, match="still holds"):
+        cmap.forget_object(table)
+    with pytest.raises(ConceptualError, match="unknown object"):
+        cmap.forget_object("object99")
