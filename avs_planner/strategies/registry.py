@@ -78,8 +78,9 @@ def _convert(strategy: str, key: str, value: Any, default: Any) -> Any:
 
 
 # the loop's settings, less what the episode spec gives (budgets, where to dump problems)
-_SWITCHING_OPTIONS = {f.name: f.default for f in fields(LoopConfig)
-                      if f.name not in ("time_budget_s", "wall_budget_s", "dump_dir")}
+_SWITCHING_OPTIONS = {**{f.name: f.default for f in fields(LoopConfig)
+                         if f.name not in ("time_budget_s", "wall_budget_s", "dump_dir")},
+                      "qsr_cones": "on"}  # on|off|observe: strategies/switching.py
 
 _FLAP_OPTIONS = {  # avs_planner/strategies/flap.py
     "greedy": False,  # next best view by p/t (the seed's baseline) instead of branch and bound
