@@ -92,13 +92,14 @@ class EpisodeSpec:
             output_dir=spec.get("output_dir"), pre_explore=bool(spec.get("pre_explore")),
             dt_policy=str(spec.get("dt_policy") or "pouct"), strategy=strategy.name,
             strategy_options=options, generate=generate, world_text=spec.get("world_file"),
-            qsr=_qsr(spec.get("qsr")),
+            qsr=qsr_descriptions(spec.get("qsr")),
         )
 
 
-def _qsr(data: Any) -> Any:
-    """The task's QSR descriptions (a list in the format of conceptual_map/qsr/README.md)
-    validated against the default knowledge's relations and landmarks; None when not given."""
+def qsr_descriptions(data: Any, source: str = "episode spec: qsr") -> Any:
+    """The task's QSR descriptions (a list in the format of conceptual_map/qsr/README.md, or
+    {descriptions: [...]}) validated against the default knowledge's relations and landmarks,
+    as a QsrKnowledge; None when not given. EpisodeError names the bad entry."""
     if data is None:
         return None
     from conceptual_map.errors import KnowledgeError
@@ -111,7 +112,7 @@ def _qsr(data: Any) -> Any:
                            f"like [{{target: cup, relations: [right, close], of: keyboard, "
                            f"count: 1}}], got {data!r}")
     try:
-        return parse_descriptions(data, load_qsr(), source="episode spec: qsr")
+        return parse_descriptions(data, load_qsr(), source=source)
     except KnowledgeError as exc:
         raise EpisodeError(str(exc)) from None
 
