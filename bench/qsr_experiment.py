@@ -144,7 +144,7 @@ def density_at_cups(world: str) -> dict[str, float]:
 
 def ordering(table: dict[str, dict[str, Any]], variant: str = "A") -> list[str]:
     """The issue's claim, qsr < supporting-planes < random, per measure: means in order, and
-    whether neighbouring 95% intervals are disjoint."""
+    for each neighbouring pair whether their 95% intervals are disjoint."""
     names = ("qsr", "supporting-planes", "random")
     rows = [table[f"{m}/{variant}"] for m in names]
     out = []
@@ -155,12 +155,23 @@ def ordering(table: dict[str, dict[str, Any]], variant: str = "A") -> list[str]:
             continue
         ordered = means[0] < means[1] < means[2]
         cis = [r[f"{key}_ci"] or 0.0 for r in rows]
-        apart = all(means[i] + cis[i] < means[i + 1] - cis[i + 1] for i in range(2))
+        pairs = [f"{names[i]}/{names[i + 1]} intervals "
+                 f"{'disjoint' if means[i] + cis[i] < means[i + 1] - cis[i + 1] else 'overlap'}"
+                 for i in range(2)]  # fmt: skip
         text = " < ".join(f"{n} {m:.2f}±{c:.2f}" for n, m, c in zip(names, means, cis,
                                                                    strict=True))
-        out.append(f"{key} ({unit}): {text}: {'holds' if ordered else 'FAILS'}"
-                   f"{', intervals disjoint' if apart else ', intervals overlap'}")
+        out.append(f"{key} ({unit}): {text}: {'holds' if ordered else 'FAILS'}; "
+                   + ", ".join(pairs))
     return out
+
+
+def with_failures(runs: list[dict[str, Any]], abort_s: float = 120.0) -> tuple[float, float]:
+    """Mean search time and poses over all trials, a failed one counted at the monitor's
+    abort time with the poses it had searched (the seed's means leave failures out)."""
+    ok = [r["outcome"] == "found" and r["correct"] for r in runs]
+    time_s = statistics.fmean(r["search_time_s"] if good else max(abort_s, r["search_time_s"])
+                              for r, good in zip(runs, ok, strict=True))  # fmt: skip
+    return time_s, statistics.fmean(r["poses"] for r in runs)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -172,6 +183,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--tables", default="II,III", help="which tables: II, III or II,III")
     parser.add_argument("--scene", default="kitchen", choices=SCENES,
                         help="worlds qsr_SCENE_{a,b,c} (default kitchen)")
+    parser.add_argument("--from-json", metavar="FILE",
+                        help="print the tables of an earlier --json run instead of running")
     args = parser.parse_args(argv)
     options = {}
     for text in args.option:
@@ -180,15 +193,25 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     tables = {t.strip().upper() for t in args.tables.split(",")}
     cells: dict[str, list[dict[str, Any]]] = {}
-    for method in ("random", "supporting-planes", "qsr") if "II" in tables else ("qsr",):
+    if args.from_json:
+        with open(args.from_json, encoding="utf-8") as fh:
+            saved = json.load(fh)
+        cells, options = saved["runs"], saved["options"]
+        args.scene = saved.get("scene", args.scene)
+        args.trials = max(len(runs) for runs in cells.values())
+        tables = {t for t, key in (("II", "random/A"), ("III", "qsr/C")) if key in cells}
+    methods = ("random", "supporting-planes", "qsr") if "II" in tables else ("qsr",)
+    for method in () if args.from_json else methods:
         cells[f"{method}/A"] = run_cell(method, "A", args.trials, options, args.scene)
-    for variant in ("B", "C") if "III" in tables else ():
+    for variant in ("B", "C") if "III" in tables and not args.from_json else ():
         cells[f"qsr/{variant}"] = run_cell("qsr", variant, args.trials, options, args.scene)
     table = {key: stats(runs) for key, runs in cells.items()}
     print(f"seed 002 experiments, scene {args.scene}, {args.trials} trials per cell "
           f"(seeds 0..{args.trials - 1}), "
           f"options {options or 'default'}; ours beside the seed's (10 trials); time and poses "
-          f"over successful trials; wall {time.perf_counter() - start:.0f} s\n")
+          f"over successful trials; "
+          + (f"from {args.from_json}\n" if args.from_json else
+             f"wall {time.perf_counter() - start:.0f} s\n"))
     if "II" in tables:
         mass = density_at_cups(f"qsr_{args.scene}_a")
         table["density_at_cups"] = mass
@@ -203,12 +226,15 @@ def main(argv: list[str] | None = None) -> int:
               "intervals):")
         for line in ordering(table):
             print(f"  {line}")
+        print("all trials, a failure counted at the 120 s abort: " + "; ".join(
+            "{} {:.1f} s, {:.2f} poses".format(m, *with_failures(cells[f"{m}/A"]))
+            for m in ("qsr", "supporting-planes", "random")))
         print()
     if "III" in tables:
         print_table("Table III: qsr under false beliefs",
                     [(f"{v} ({w})", table[f"qsr/{v}"], TABLE_III[v]) for v, w in
                      (("A", "correct QSRs"), ("B", "partially correct"), ("C", "wrong QSRs"))])
-    if args.json:
+    if args.json and not args.from_json:
         with open(args.json, "w", encoding="utf-8") as fh:
             json.dump({"scene": args.scene, "options": options, "tables": table, "runs": cells},
                       fh, indent=1)
