@@ -153,3 +153,31 @@ def test_the_switching_option_is_checked():
     with pytest.raises(StrategyError, match="qsr_cones"):
         run_episode({"target": "cup", "world": "qsr_desks_a", "strategy": "switching",
                      "strategy_options": {"qsr_cones": "maybe"}, "time_budget_s": 5})
+
+
+def test_room_cones_keep_the_uniform_set_and_coverage_and_lean_half_on_the_density(
+        monkeypatch):
+    """In a room the cones and their coverage stay the uniform ones (a rejected room is no
+    more certain than before); half of their probability follows the QSR density."""
+    import avs_planner.episode.qsr_cones as module
+    from avs_planner.dt import ViewCone
+    from avs_planner.episode.viewcones import ConeSet
+
+    east = ViewCone("r-0", (3.0, 4.3, 0.0), 0.3)  # looks along y = 4.3, away from the counter
+    north = ViewCone("r-1", (3.0, 4.3, math.pi / 2), 0.2)  # looks at the counter
+    uniform = ConeSet((east, north), 0.5, 0.8)
+    cells = np.array([[4.0, 4.3], [4.5, 4.3], [2.3, 5.35], [3.7, 5.35], [3.3, 5.35]])
+    monkeypatch.setattr(module, "room_cones", lambda *args: uniform)
+    monkeypatch.setattr(module, "_room_cells", lambda *args: cells)
+    ex = _executor()
+    ex.mind.room_at = lambda xy: "lab"
+    qsr = QsrCones(ex, _knowledge("right"), "cup", "task")
+    _seen_twice(qsr)
+    made = qsr.room_cones("cup", "lab", 0.8, "r")
+    assert [c.pose for c in made.cones] == [east.pose, north.pose]
+    assert (made.coverage, made.probability) == (0.5, 0.8)
+    assert sum(c.probability for c in made.cones) == pytest.approx(0.5)
+    by_id = {c.id: c.probability for c in made.cones}
+    assert by_id["r-1"] > 0.2 and by_id["r-0"] < 0.3  # towards the keyboard's right
+    assert by_id["r-1"] <= 0.5 * 0.5 + 0.5 * 0.2 + 1e-9  # only half follows the density
+    assert qsr.room_cones("stapler", "lab", 0.8, "r") is None
