@@ -7,6 +7,7 @@ executor and switching loop (mind side), and writes trace.jsonl, summary.json, t
 from __future__ import annotations
 
 import math
+import reprlib
 import tempfile
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -110,7 +111,7 @@ def qsr_descriptions(data: Any, source: str = "episode spec: qsr") -> Any:
     if not isinstance(data, list) or not data:
         raise EpisodeError(f"episode spec: 'qsr' must be a non-empty list of QSR descriptions "
                            f"like [{{target: cup, relations: [right, close], of: keyboard, "
-                           f"count: 1}}], got {data!r}")
+                           f"count: 1}}], got {reprlib.repr(data)}")
     try:
         return parse_descriptions(data, load_qsr(), source=source)
     except KnowledgeError as exc:
