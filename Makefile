@@ -27,8 +27,10 @@ $(VENV)/.installed-bench: pyproject.toml $(NATIVE) | $(BIN)/python
 
 ## run: set up .venv and run the main job: one object-search episode in the built-in office
 ## world (seed 003, Fig. 3a: start in the corridor, find the cereal box), outputs in runs/
+## (with the viewer extra installed also a Rerun recording: `avs view runs/office-cerealbox`)
 run: $(VENV)/.installed
-	$(BIN)/avs simulate --scenario a --seed 1 --out runs/office-cerealbox
+	$(BIN)/avs simulate --scenario a --seed 1 --out runs/office-cerealbox \
+		$$($(BIN)/python -c 'import rerun' 2>/dev/null && echo --record)
 
 ## test: set up .venv with test extras and run the fast test suite
 test: $(VENV)/.installed-dev

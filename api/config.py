@@ -6,7 +6,7 @@ import ipaddress
 from pathlib import Path
 from typing import Literal
 
-from pydantic import Field
+from pydantic import Field, model_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 DEFAULT_EPISODE_RUNNER = "avs_planner.jobs:run_episode"
@@ -52,10 +52,24 @@ class Settings(BaseSettings):
         "trusted ('*' for any); default: none, the TCP peer is the client")
     plan_results_kept: int = Field(100, ge=1, le=10_000, description="finished async plan jobs "
                                    "kept for polling (oldest dropped first)")
+    record: bool | None = Field(
+        None, description="write a Rerun recording (recording.rrd) of each task's episode; "
+        "needs memory_limit_mb=0 (the recorder reserves more address space than the limit "
+        "allows and the worker dies); default: when the viewer extra (rerun-sdk) is "
+        "installed, episodes run locally and there is no address-space limit")
     ray_address: str | None = Field(
         None, description="run episode tasks as Ray tasks on this cluster ('local': start Ray "
         "on this machine); default: local worker processes"
     )
+
+    @model_validator(mode="after")
+    def _recording_needs_no_address_limit(self) -> Settings:
+        if self.record and self.memory_limit_mb > 0:
+            raise ValueError(
+                f"record (AVS_RECORD=1) needs memory_limit_mb=0 (AVS_MEMORY_LIMIT_MB=0), got "
+                f"{self.memory_limit_mb}: the Rerun recorder reserves more address space than "
+                f"the limit allows and the worker process dies")
+        return self
 
     @property
     def db_path(self) -> Path:
@@ -64,6 +78,16 @@ class Settings(BaseSettings):
     @property
     def tasks_dir(self) -> Path:
         return self.data_dir / "tasks"
+
+    def records(self) -> bool:
+        """Whether episodes write recording.rrd (AVS_RECORD, else: the viewer extra is
+        installed here and episodes run here, not on a Ray cluster that may lack it)."""
+        if self.record is not None:
+            return self.record
+        import importlib.util
+
+        return (self.ray_address is None and self.memory_limit_mb == 0
+                and importlib.util.find_spec("rerun") is not None)
 
     def is_open(self) -> bool:
         """True when no API key is configured (then the service must stay on loopback)."""

@@ -19,6 +19,7 @@ from api.config import Settings
 from api.docs import add_docs
 from api.manager import TaskManager
 from api.middleware import BodyLimitMiddleware
+from api.pages import add_pages
 from api.plan_jobs import PlanJobs
 from api.routes import domains, misc, plans, tasks
 from api.security import RateLimiter
@@ -69,6 +70,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     for module in (tasks, plans, domains, misc):
         app.include_router(module.router, prefix=API_PREFIX)
     add_docs(app)
+    add_pages(app)
     _add_error_handlers(app)
     return app
 
@@ -108,6 +110,11 @@ def _method_not_allowed(request: Request) -> Response:
         pattern = re.sub(r"\\{[^/]+?\\}", "[^/]+", re.escape(template))
         if re.fullmatch(pattern, request.url.path):
             methods |= {m.upper() for m in operations}
+    for route in request.app.routes:  # the pages, which are not in the schema
+        regex, route_methods = getattr(route, "path_regex", None), getattr(route, "methods", None)
+        if regex is not None and route_methods and not getattr(route, "include_in_schema", True) \
+                and regex.fullmatch(request.url.path):
+            methods |= set(route_methods)
     if "GET" in methods:
         methods.add("HEAD")
     headers = {"Allow": ", ".join(sorted(methods))}

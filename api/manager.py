@@ -86,6 +86,7 @@ class TaskManager:
         self._cancels: dict[str, threading.Event] = {}
         self._lock = threading.Lock()
         self.task_checker: TaskChecker | None = None
+        self.record = settings.records()
 
     # -- life cycle -------------------------------------------------------------------------
 
@@ -174,7 +175,10 @@ class TaskManager:
     def _episode_spec(self, task: TaskRecord) -> dict[str, Any]:
         output_dir = self.settings.tasks_dir / task.id
         output_dir.mkdir(parents=True, exist_ok=True)
-        return {**task.request, "task_id": task.id, "output_dir": str(output_dir.resolve())}
+        spec = {**task.request, "task_id": task.id, "output_dir": str(output_dir.resolve())}
+        if self.record:
+            spec["record"] = True
+        return spec
 
     def _claim(self, task_id: str) -> bool:
         if not self.store.claim(task_id):

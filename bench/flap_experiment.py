@@ -6,12 +6,15 @@
 World `flap_two_rooms` (after the seed's Fig. 4), a PR2, trials with seeds 0..N-1, each from a
 random start pose (drawn by the experimenter from the world file, the same for all four cells
 of a seed). Every episode runs `avs simulate --strategy flap` with `pre_explore`: the robot
-surveys the building before the clock starts, registering the supports it detects (their boxes
-are the search region, P_i = 0.2 each as in the seed); with a prior map the survey also
-integrates depth frames, so the 3D map exists before the search; without one only the 2D map
-and the supports are known (the seed: "only walls are known"). The region is reset to unknown at
-the start in both. The target label (`stapler`) is absent, so every trial runs until the omega
-test (p(V̂(S)) < 0.05) ends it, as the seed's trials do.
+surveys the building before the clock starts; with a prior map the survey also integrates depth
+frames, so the 3D map exists before the search; without one only the 2D map is known (the
+seed: "only walls are known"). The search region is the seed's, given by the task (option
+`volumes`, as the seed's tasks give it): a box over each of the six supports of its Fig. 4 (two
+shelf arrangements, one single shelf, three tables), P_i = 0.2 each; it is reset to unknown at
+the start in both. Drives between views follow one path with no sensing on the way
+(`sense_en_route: false`), so executed transitions are what the planner's time model predicts,
+as in the seed's simulation. The target label (`stapler`) is absent, so every trial runs until
+the omega test (p(V̂(S)) < 0.05) ends it, as the seed's trials do.
 
 Measures per trial, as the seed's (its footnote 4: eq. 4 on the executed sequence): the
 expected search time E[T] = sum_k S_{k-1} (t_k - t_{k-1}), S_k the probability that the target
@@ -43,7 +46,9 @@ TARGET = "stapler"  # the knowledge puts it on shelves and tables; the world has
 CELLS = [("map", True, False), ("map", True, True), ("no map", False, False),
          ("no map", False, True)]  # (label, prior_map, greedy)
 SEED_DIFF = {"map": -10.0, "no map": -7.0}  # %: the seed's planner vs greedy (§5)
-OPTIONS = {"time_limit_s": 0.5, "max_views": 60, "survey_on": False}  # one region per trial
+OPTIONS = {"time_limit_s": 0.5, "max_views": 60, "survey_on": False,
+           "sense_en_route": False,  # one region per trial; transitions as the seed models them
+           "depth_columns": 64}
 
 
 def start_pose(seed: int) -> list[float]:
@@ -63,12 +68,45 @@ def start_pose(seed: int) -> list[float]:
                     round(float(rng.uniform(-math.pi, math.pi)), 3)]
 
 
+def seed_volumes(margin: float = 0.05, height: float = 0.3, gap: float = 0.3) -> list[dict]:
+    """The seed's search region (its Fig. 4: two shelf arrangements, one single shelf, three
+    tables), given by the experimenter as the seed's tasks give it: a box over each shelf's
+    and table's top (footprint + `margin`, `height` high), boxes of one label closer than
+    `gap` merged into one arrangement; P_i = 0.2 each."""
+    spec = load_spec(WORLD)
+    boxes: list[list] = []
+    for f in spec.furniture:
+        if f.label not in ("shelf", "table"):
+            continue
+        xy = np.asarray(f.footprint())
+        lo, hi = xy.min(axis=0) - margin, xy.max(axis=0) + margin
+        boxes.append([f.label, [*lo, f.size[2]], [*hi, f.size[2] + height], [f.name]])
+    merged = True
+    while merged:
+        merged = False
+        for i, a in enumerate(boxes):
+            for b in boxes[i + 1:]:
+                if a[0] == b[0] and all(a[1][k] - gap < b[2][k] and b[1][k] - gap < a[2][k]
+                                        for k in range(2)):
+                    a[1] = [min(a[1][k], b[1][k]) for k in range(3)]
+                    a[2] = [max(a[2][k], b[2][k]) for k in range(3)]
+                    a[3] += b[3]
+                    boxes.remove(b)
+                    merged = True
+                    break
+            if merged:
+                break
+    return [{"name": "+".join(names), "lo": [round(float(v), 3) for v in lo],
+             "hi": [round(float(v), 3) for v in hi], "p": 0.2} for _, lo, hi, names in boxes]
+
+
 def run_trial(seed: int, prior_map: bool, greedy: bool) -> dict:
     events: list[dict] = []
     spec = {"target": TARGET, "world": WORLD, "seed": seed, "start": start_pose(seed),
             "strategy": "flap", "pre_explore": True, "time_budget_s": 1200.0,
             "wall_budget_s": 900.0,
-            "strategy_options": {**OPTIONS, "prior_map": prior_map, "greedy": greedy}}
+            "strategy_options": {**OPTIONS, "prior_map": prior_map, "greedy": greedy,
+                                 "volumes": seed_volumes()}}
     began = time.perf_counter()
     summary = run_episode(spec, emit=lambda e: events.append(e) if e["type"] == "flap" else None)
     return {"seed": seed, "prior_map": prior_map, "greedy": greedy,

@@ -1,4 +1,5 @@
-"""/tasks: submit a search, list and read tasks, stream their events, cancel, trajectory picture."""
+"""/tasks: submit a search, list and read tasks, stream their events, cancel; the episode's
+trajectory picture and Rerun recording."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ import asyncio
 import hashlib
 import json
 from collections.abc import AsyncIterable
-from typing import Annotated
+from typing import Annotated, Any
 
 from fastapi import APIRouter, Header, HTTPException, Query, Request, Response, status
 from fastapi.responses import FileResponse
@@ -190,3 +191,57 @@ async def read_trajectory(task: TaskDep, settings: SettingsDep) -> FileResponse:
             detail=f"task {task.id} has no trajectory picture yet (state: {task.state.value})",
         )
     return FileResponse(path, media_type="image/png")
+
+
+@router.head("/{task_id}/recording.rrd", include_in_schema=False)
+@router.get(
+    "/{task_id}/recording.rrd",
+    response_class=FileResponse,
+    responses={200: {"content": {"application/octet-stream": {}}}, 404: {"model": Message}},
+)
+async def read_recording(task: TaskDep, settings: SettingsDep) -> FileResponse:
+    """The episode's Rerun recording (open it with `rerun FILE` or `avs view FILE`), once it
+    has ended; the service records when the viewer extra is installed (or AVS_RECORD=1)."""
+    path = settings.tasks_dir / task.id / "recording.rrd"
+    if not task.state.terminal or not path.is_file():
+        why = ("it has not ended yet" if not task.state.terminal else
+               "this service does not record episodes (install the viewer extra, "
+               "pip install 'avs-planner[viewer]', or set AVS_RECORD=1)"
+               if not settings.records() else "its episode left none")
+        raise HTTPException(
+            status.HTTP_404_NOT_FOUND,
+            detail=f"task {task.id} has no recording (state: {task.state.value}): {why}",
+        )
+    return FileResponse(path, media_type="application/octet-stream",
+                        filename=f"{task.id}.rrd")
+
+
+@router.get("/{task_id}/explanation", responses={404: {"model": Message}})
+def read_explanation(task: TaskDep, settings: SettingsDep) -> dict[str, Any]:
+    """Why the episode went as it did: the assumption ledger (every assumption its plans used,
+    with its probabilities, and whether and by which observation it was confirmed or refuted),
+    the reason for every replan, and for a give-up the room hypotheses tried; `avs explain`
+    prints the same as text. Available once the task has ended."""
+    from avs_planner.episode.explain import FILE_NAME, ExplainError, load
+
+    folder = settings.tasks_dir / task.id
+    if not task.state.terminal:
+        raise HTTPException(
+            status.HTTP_404_NOT_FOUND,
+            detail=f"task {task.id} has no explanation yet: it is {task.state.value}; the "
+            f"explanation is written when the episode ends",
+        )
+    if not (folder / FILE_NAME).is_file() and not (folder / "trace.jsonl").is_file():
+        raise HTTPException(
+            status.HTTP_404_NOT_FOUND,
+            detail=f"task {task.id} has no explanation (state: {task.state.value}): its "
+            f"episode left no trace" + (f" ({task.error})" if task.error else ""),
+        )
+    try:
+        return load(folder)  # explanation.json, or rebuilt from the trace (e.g. cancelled)
+    except ExplainError as exc:
+        raise HTTPException(
+            status.HTTP_404_NOT_FOUND,
+            detail=f"task {task.id} has no readable explanation: {exc}".replace(
+                str(folder), f"task {task.id}"),
+        ) from exc

@@ -108,8 +108,8 @@ def _serve(settings: Settings, log_level: str) -> int:
         raise ServeError(f"cannot listen on {settings.host}:{settings.port}: {exc}") from exc
     logging.basicConfig(level=log_level.upper(), format="%(levelname)s %(name)s: %(message)s")
     app = create_app(settings)
-    print(f"avs: serving on http://{settings.host}:{settings.port} (docs at /docs, data in "
-          f"{settings.data_dir}, pid {os.getpid()})", flush=True)
+    print(f"avs: serving on http://{settings.host}:{settings.port} (pages at /, docs at /docs, "
+          f"data in {settings.data_dir}, pid {os.getpid()})", flush=True)
     with sock:
         serve(app, settings, sock, log_level)
     return 0

@@ -52,6 +52,11 @@ def register(subparsers: Any) -> None:
                         "the clock starts (the strategy's own survey where it has one, e.g. "
                         "flap's with depth frames)")
     parser.add_argument("--out", default="avs-episode", help="output directory")
+    parser.add_argument("--record", action="store_true", help="also write OUT/recording.rrd, "
+                        "a Rerun recording (needs `pip install 'avs-planner[viewer]'`; replay "
+                        "it with `avs view OUT`)")
+    parser.add_argument("--view", action="store_true", help="stream the episode live to a "
+                        "Rerun viewer spawned for it (needs the viewer extra and a display)")
     parser.add_argument("--json", action="store_true", help="print the summary as JSON")
     parser.set_defaults(func=run)
 
@@ -103,6 +108,10 @@ def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
         spec["strategy_options"] = dict(_option(text) for text in args.option)
     if args.qsr:
         spec["qsr"] = _qsr_file(args.qsr)
+    if args.record:
+        spec["record"] = True
+    if args.view:
+        spec["view"] = True
     if not spec.get("target"):
         raise ValueError("--target LABEL (or --scenario) is required")
     spec["output_dir"] = args.out
@@ -174,4 +183,9 @@ def _print_summary(summary: dict[str, Any], out: Path) -> None:
     print(f"  simulated {summary['sim_time_s']:.1f} s, drove {summary['distance_m']:.1f} m, "
           f"{summary['plans']} plans (CP {sum(cp):.2f} s), {summary['dt_calls']} DT searches, "
           f"{summary['views_processed']} views, wall {summary['wall_time_s']:.1f} s")
-    print(f"  wrote {out / 'trace.jsonl'}, {out / 'summary.json'}, {out / 'trajectory.png'}")
+    files = [out / name for name in ("trace.jsonl", "summary.json", "explanation.json",
+                                      "trajectory.png", "recording.rrd")
+             if (out / name).exists()]
+    print(f"  wrote {', '.join(str(f) for f in files)}")
+    print(f"  why: avs explain {out}" + (f"; replay: avs view {out}"
+                                          if (out / "recording.rrd").exists() else ""))

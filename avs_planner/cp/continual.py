@@ -107,12 +107,12 @@ class ContinualPlanner:
             self.pproblem = pproblem
         self.state = state
         task = ground(self.pproblem, state, self.cache)
-        matched: dict[str, str] = {}
-        if observed:
-            matched = match_virtual_objects(self.plan, task, observed)
         tasks = [task]
         if any(s.assumptive and task.action(s.name, s.args) is None for s in self.plan):
             tasks.append(ground(*before, self.cache))  # where the plan was made or last held
+        matched: dict[str, str] = {}
+        if observed:
+            matched = match_virtual_objects(self.plan, tasks, observed)
         drop = set(confirmed_assumptions(self.plan, tasks, state.true_atoms, matched))
         confirmed = tuple(s.label for i, s in enumerate(self.plan) if i in drop)
         if drop:

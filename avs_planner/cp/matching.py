@@ -25,18 +25,32 @@ def is_virtual_name(name: str) -> bool:
     return name.lower().startswith(VIRTUAL_PREFIX)
 
 
+def _tasks(task: GroundTask | Sequence[GroundTask]) -> Sequence[GroundTask]:
+    return [task] if isinstance(task, GroundTask) else task
+
+
+def _first_action(tasks: Sequence[GroundTask], step: PlanStep):  # noqa: ANN202
+    """(task, ground action) from the first task that has the step, or (None, None)."""
+    found = ((t, t.action(step.name, step.args)) for t in tasks)
+    return next(((t, a) for t, a in found if a is not None), (None, None))
+
+
 def assumed_descriptions(
-    plan: Sequence[PlanStep], task: GroundTask, is_virtual: Callable[[str], bool]
+    plan: Sequence[PlanStep], task: GroundTask | Sequence[GroundTask],
+    is_virtual: Callable[[str], bool]
 ) -> dict[str, set[Atom]]:
     """For each virtual object in the plan (plan order), the atoms assumptive steps add about
-    it as their subject."""
+    it as their subject. With several tasks, a step's effects come from the first that has
+    it (an assumption that came true is no longer possible in the current task)."""
     described: dict[str, set[Atom]] = {}
     for step in plan:
         for arg in step.args:
             if is_virtual(arg):
                 described.setdefault(arg, set())
-        action = task.action(step.name, step.args)
-        if not step.assumptive or action is None:
+        if not step.assumptive:
+            continue
+        task, action = _first_action(_tasks(task), step)
+        if task is None or action is None:
             continue
         for i in action.add_facts:
             atom = task.facts[i]
@@ -57,7 +71,7 @@ def _matches(description: set[Atom], virtual: str, real: str, observed: set[Atom
 
 def match_virtual_objects(
     plan: Sequence[PlanStep],
-    task: GroundTask,
+    task: GroundTask | Sequence[GroundTask],
     observations: Mapping[str, Iterable[Atom]],
     is_virtual: Callable[[str], bool] = is_virtual_name,
 ) -> dict[str, str]:
@@ -91,8 +105,7 @@ def confirmed_assumptions(
     for i, step in enumerate(plan):
         if not step.assumptive:
             continue
-        found = ((t, t.action(step.name, step.args)) for t in tasks)
-        task, action = next(((t, a) for t, a in found if a is not None), (None, None))
+        task, action = _first_action(tasks, step)
         if task is None or action is None or not action.add_facts:
             continue
         atoms = [task.facts[f] for f in action.add_facts]

@@ -37,6 +37,9 @@ class MonitorReport:
     detail: str = ""
     failed: tuple[str, ...] = field(default_factory=tuple)
     probability: float = 1.0
+    # (label, probability in this state) of each assumptive step checked, in plan order (0.0
+    # for a contradicted one): what the assumption ledger (`episode.explain`) records
+    assumptions: tuple[tuple[str, float], ...] = ()
 
     @property
     def valid(self) -> bool:
@@ -63,26 +66,32 @@ def monitor(
     """Check `plan` (the steps still to execute) from `state` (default: `task.init`)."""
     current = task.init if state is None else state
     probability = 1.0
+    assumed: list[tuple[str, float]] = []
     for i, step in enumerate(plan):
         action = task.action(step.name, step.args)
         if action is None or not action.applicable(current):
-            return _broken(i, step, action, task, current)
+            if step.assumptive:
+                assumed.append((step.label, 0.0))
+            return _broken(i, step, action, task, current, tuple(assumed))
+        if step.assumptive:
+            assumed.append((step.label, action.probability))
         if abs(action.probability - step.probability) > threshold:
             kind = "assumption" if step.assumptive else "action"
             return MonitorReport(
                 MonitorStatus.PROBABILITY_CHANGED, i, step.label,
                 f"{kind} probability changed from {step.probability:.3g} "
-                f"to {action.probability:.3g}",
+                f"to {action.probability:.3g}", assumptions=tuple(assumed),
             )
         probability *= action.probability
         current = action.apply(current)
     if not task.is_goal(current):
         return MonitorReport(MonitorStatus.GOAL_NOT_REACHED, len(plan), None,
-                             "the plan no longer reaches the goal")
-    return MonitorReport(MonitorStatus.VALID, probability=probability)
+                             "the plan no longer reaches the goal", assumptions=tuple(assumed))
+    return MonitorReport(MonitorStatus.VALID, probability=probability, assumptions=tuple(assumed))
 
 
-def _broken(i: int, step: PlanStep, action, task: GroundTask, state: int) -> MonitorReport:
+def _broken(i: int, step: PlanStep, action, task: GroundTask, state: int,  # noqa: ANN001
+            assumed: tuple[tuple[str, float], ...] = ()) -> MonitorReport:
     status = (
         MonitorStatus.ASSUMPTION_CONTRADICTED if step.assumptive
         else MonitorStatus.PRECONDITION_FAILED
@@ -90,10 +99,10 @@ def _broken(i: int, step: PlanStep, action, task: GroundTask, state: int) -> Mon
     if action is None:
         return MonitorReport(status, i, step.label,
                              "no longer possible (unreachable or probability 0)",
-                             probability=0.0)
+                             probability=0.0, assumptions=assumed)
     failed = _failed_conditions(action, task, state)
     return MonitorReport(status, i, step.label, "fails: " + " ".join(failed), failed,
-                         probability=0.0)
+                         probability=0.0, assumptions=assumed)
 
 
 def plan_probability(plan: Sequence[PlanStep]) -> float:

@@ -38,6 +38,7 @@ class ViewConeSearch:
                             rewards=DTRewards(self.ex.config.miss_penalty,
                                               self.ex.config.miss_penalty),
                             seed=self.ex.seed + self.ex.stats.dt_calls)
+        self.ex.dt_session = session  # the running session, for observers (the recorder)
         while True:
             action = session.next_action()
             if session.finished:
@@ -47,6 +48,8 @@ class ViewConeSearch:
                 self.ex.drive_to(cone.pose[:2])
                 self.ex.robot.turn_to(cone.pose[2])
                 self.ex.robot.look(*(cone.head or (0.0, 0.0)))
+                if cone.torso is not None:
+                    self.ex.robot.set_torso(cone.torso)
                 session.update(action)
                 continue
             match = self._look(label, relation, location)
@@ -61,6 +64,8 @@ class ViewConeSearch:
     def _look(self, label: str, relation: str, location: str) -> SeenLike | None:
         """PROCESSVIEWCONE: a detection in the searched location, seen twice."""
         self.ex.stats.views += 1
+        if self.ex.on_look is not None:
+            self.ex.on_look()
         match = self._detect_once(label, relation, location)
         if match is None:
             self.ex.emit("observation", label=label, detected=False)

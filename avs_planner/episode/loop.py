@@ -32,12 +32,16 @@ class LoopConfig:
     # or this many seconds (a safety net); either counts as "timed out" below
     cp_node_limit: int = 4000
     cp_timeout_s: float = 20.0
-    # a search that hit the limit is retried once with FF (its helpful actions find plans
-    # where h_add wanders: on the problems d timed out on, FF w=5 solved ~90% within 20000
-    # expansions, h_add none within 200000), greedier and with a larger limit
+    # a search that hit the limit is retried once in the CP's anytime mode (LAMA's schedule:
+    # greedy best-first with FF and helpful actions, then weighted A* restarts on the
+    # objective), each phase under `fallback_node_limit` expansions. On generated office
+    # worlds the single FF w=5 retry this replaces found no plan within 20000 expansions on
+    # most problems the first search timed out on, and the robot explored blindly instead;
+    # the anytime schedule solved them (or proved no plan reaches the threshold)
     fallback_heuristic: str = "ff"
     fallback_weight: float = 5.0
-    fallback_node_limit: int = 20000
+    fallback_node_limit: int = 30000
+    fallback_anytime: bool = True
     time_budget_s: float = 1200.0
     wall_budget_s: float = 600.0
     max_steps: int = 120
@@ -127,7 +131,8 @@ class SwitchingLoop:
         cfg = self.config
         self.planner.options = replace(options, heuristic=cfg.fallback_heuristic,
                                        weight=cfg.fallback_weight,
-                                       node_limit=cfg.fallback_node_limit)
+                                       node_limit=cfg.fallback_node_limit,
+                                       anytime=cfg.fallback_anytime)
         try:
             return self.planner.replan()
         finally:
@@ -251,6 +256,11 @@ class SwitchingLoop:
                                      observed=outcome.observed or None)
         if update.matched:
             self.trace.emit("belief", matched=dict(update.matched))
+        report = update.report
+        self.trace.emit("monitor", verdict=report.status.value if report else "",
+                        confirmed=list(update.confirmed),
+                        assumptions={a: round(p, 5) for a, p in report.assumptions}
+                        if report else {})
         if update.decision is Decision.CONTINUE:
             return None
         report = update.report
@@ -268,6 +278,8 @@ class SwitchingLoop:
         self.result.cp_times.append(result.planning_time_s)
         self.trace.emit("plan", why=why, status=result.status.value,
                         plan=[s.label for s in result.plan],
+                        step_p=[round(s.probability, 5) for s in result.plan],
+                        assumptive=[i for i, s in enumerate(result.plan) if s.assumptive],
                         probability=round(result.probability, 5), cost=round(result.cost, 2),
                         planning_time_s=round(result.planning_time_s, 4),
                         expanded=result.expanded)

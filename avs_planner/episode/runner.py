@@ -1,7 +1,8 @@
 """`run_episode`: one object-search episode from a plain-data spec, as the API and CLI call it.
 
 This is the wiring: it opens the simulated world (robot side), builds the mind, state builder,
-executor and switching loop (mind side), and writes trace.jsonl, summary.json, trajectory.png.
+executor and switching loop (mind side), and writes trace.jsonl, summary.json, trajectory.png,
+explanation.json (`episode.explain`) and, when asked (`record`), recording.rrd (`viewer`).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from avs_planner.episode.robot import (
     load_spec,
     open_world,
 )
+from avs_planner.episode.snapshots import MapSnapshots
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.trace import Trace, write_summary
 from avs_planner.episode.viewcones import CameraModel
@@ -34,7 +36,7 @@ Emit = Callable[[dict[str, Any]], None]
 
 _KEYS = {"target", "category", "world", "world_file", "robot", "start_room", "start", "seed",
          "time_budget_s", "wall_budget_s", "task_id", "output_dir", "pre_explore", "dt_policy",
-         "strategy", "strategy_options", "generate", "qsr"}
+         "strategy", "strategy_options", "generate", "qsr", "record", "view"}
 
 
 @dataclass(frozen=True)
@@ -58,7 +60,8 @@ class EpisodeSpec:
     generate: Mapping[str, Any] | None = None  # {seed, style, rooms}: a generated world
     world_text: str | None = field(default=None, repr=False)
     qsr: Any = field(default=None, repr=False)  # QsrKnowledge with the task's descriptions
-
+    record: bool = False  # write recording.rrd in output_dir (needs the viewer extra)
+    view: bool = False  # stream the recording to a Rerun viewer spawned for it
 
     @classmethod
     def from_dict(cls, spec: Mapping[str, Any]) -> EpisodeSpec:
@@ -93,8 +96,37 @@ class EpisodeSpec:
             output_dir=spec.get("output_dir"), pre_explore=bool(spec.get("pre_explore")),
             dt_policy=str(spec.get("dt_policy") or "pouct"), strategy=strategy.name,
             strategy_options=options, generate=generate, world_text=spec.get("world_file"),
-            qsr=qsr_descriptions(spec.get("qsr")),
+            qsr=qsr_descriptions(spec.get("qsr")), **_recording(spec),
         )
+
+
+def _recording(spec: Mapping[str, Any]) -> dict[str, bool]:
+    """`record` / `view`: booleans; recording needs an output_dir and the viewer extra."""
+    out = {}
+    for key in ("record", "view"):
+        value = spec.get(key, False)
+        if not isinstance(value, bool):
+            raise EpisodeError(f"episode spec: {key!r} must be true or false, got {value!r}")
+        out[key] = value
+    if out["record"] and not spec.get("output_dir"):
+        raise EpisodeError("episode spec: 'record' writes recording.rrd into 'output_dir', "
+                           "which is not given")
+    if out["record"] or out["view"]:
+        from avs_planner.viewer import ViewerError, require_rerun
+
+        try:
+            require_rerun("'record' / 'view'")
+        except ViewerError as exc:
+            raise EpisodeError(f"episode spec: {exc}") from None
+    if out["view"]:
+        from avs_planner.viewer.errors import display_missing
+
+        missing = display_missing()
+        if missing:
+            raise EpisodeError(f"episode spec: 'view' opens a live Rerun viewer, but there is "
+                               f"{missing}; record with 'record' (--record) and replay with "
+                               f"`avs view RUN_DIR --web` instead")
+    return out
 
 
 def qsr_descriptions(data: Any, source: str = "episode spec: qsr") -> Any:
@@ -157,6 +189,7 @@ class Episode:
         self.executor = Executor(self.robot, self.mind, self.builder, self.camera,
                                  self._emit, ExecutorConfig(dt_policy=spec.dt_policy),
                                  seed=spec.seed)
+        self.trace.subscribe(MapSnapshots(self.executor, self._emit).observe)
         from avs_planner.strategies import SearchContext
 
         self.context = SearchContext(
@@ -166,6 +199,26 @@ class Episode:
             wall_budget_s=spec.wall_budget_s, options=spec.strategy_options,
             should_stop=should_stop or (lambda: False), dump_dir=spec.output_dir,
             qsr=spec.qsr)
+        self.recorder = self._recorder()
+
+    def _recorder(self):  # noqa: ANN202 - a viewer.Recorder, or None
+        """The Rerun recorder, subscribed to the trace, when the spec asks for one."""
+        spec = self.spec
+        if not (spec.record or spec.view):
+            return None
+        from avs_planner.viewer import RECORDING, ViewerError
+        from avs_planner.viewer.recorder import Recorder
+
+        path = self.out / RECORDING if spec.record and self.out is not None else None
+        try:
+            recorder = Recorder(self.mind, self.executor, self.robot, self.camera, spec.target,
+                                path=path, spawn=spec.view,
+                                name=spec.output_dir or f"{spec.world}-{spec.target}")
+        except ViewerError as exc:
+            self.robot.world.close()
+            raise EpisodeError(str(exc)) from None
+        self.trace.subscribe(recorder)
+        return recorder
 
     def _world_spec(self):  # noqa: ANN202 - sim.WorldSpec
         spec = self.spec
@@ -199,9 +252,12 @@ class Episode:
             summary = self.summary(result, start_clock, start_distance)
             if self.out is not None:
                 write_summary(self.out / "summary.json", summary)
+                self._explanation()
                 self._picture()
             return summary
         finally:
+            if self.recorder is not None:
+                self.recorder.close()
             self.trace.close()
             self.robot.world.close()
 
@@ -258,6 +314,14 @@ class Episode:
             if item.name == name:
                 return item.label
         return None
+
+    def _explanation(self) -> None:
+        """explanation.json: the assumption ledger of the trace, with the final beliefs."""
+        from avs_planner.episode import explain
+
+        assert self.out is not None
+        final = explain.final_beliefs(self.mind, self.spec.target)
+        explain.write(self.out / explain.FILE_NAME, explain.build(self.trace.events, final))
 
     def _picture(self) -> None:
         from avs_planner.episode.picture import draw_trajectory

@@ -19,6 +19,7 @@ class Trace:
         self.clock = clock
         self.events: list[dict[str, Any]] = []
         self._sink = sink
+        self._listeners: list[Sink] = []
         self._start = time.perf_counter()
         self._file: TextIO | None = path.open("w", encoding="utf-8") if path else None
 
@@ -35,7 +36,14 @@ class Trace:
             self._file.flush()
         if self._sink is not None:
             self._sink(event)
+        for listener in self._listeners:
+            listener(event)
         return event
+
+    def subscribe(self, listener: Sink) -> None:
+        """Call `listener(event)` after each event is recorded (the map snapshots, the Rerun
+        recorder; a listener may emit more events)."""
+        self._listeners.append(listener)
 
     def close(self) -> None:
         if self._file is not None:

@@ -36,7 +36,14 @@ class StopReason(Enum):
 
 @dataclass(frozen=True)
 class PlannerOptions:
-    """xi: prune dominated views; psi: branching depth; phi: branch factor; omega: eq. 9."""
+    """xi: prune dominated views; psi: branching depth; phi: branch factor; omega: eq. 9.
+
+    deepen: search with branching depth 0 (the greedy plan), 1, 2, ... up to psi, each
+    depth-first branch and bound starting from the best plan so far, so that a limit strikes
+    in a deep search only after the alternatives for the first views were compared. Without
+    it a depth-first search cut short by a limit has only varied the last branching levels:
+    its first view, the only one a continual planner executes, is then the greedy one.
+    """
 
     xi: bool = True
     psi: int = 6
@@ -44,6 +51,7 @@ class PlannerOptions:
     omega: float = 0.05
     max_nodes: int | None = 200_000
     time_limit: float | None = None
+    deepen: bool = True
 
     def check(self) -> None:
         if self.psi < 0 or self.phi < 1.0:
@@ -52,7 +60,7 @@ class PlannerOptions:
             raise FlapError(f"omega must be in (0, 1), got {self.omega}")
 
 
-EXACT = PlannerOptions(xi=False, psi=10**9, phi=math.inf, max_nodes=None)
+EXACT = PlannerOptions(xi=False, psi=10**9, phi=math.inf, max_nodes=None, deepen=False)
 GREEDY = PlannerOptions(psi=0)
 
 
@@ -98,6 +106,7 @@ class _BranchAndBound:
         self.members = problem.members.astype(np.float64)
         self.atoms = [np.flatnonzero(row) for row in problem.members]
         self.overlaps: dict[int, sparse.csr_matrix] = {}
+        self.columns: sparse.csc_matrix | None = None
         self.threshold = survival_threshold(problem, options.omega)
         off = np.where(np.eye(problem.size, dtype=bool), np.inf, problem.times)
         self.row_min = off.min(axis=1)  # fastest way on from each view
@@ -105,6 +114,9 @@ class _BranchAndBound:
         self.best: tuple[float, tuple[int, ...], float] = (math.inf, (), 0.0)
         self.nodes, self.path = 0, []
         self.memo: dict[tuple[frozenset[int], int], float] = {}
+        self.psi = options.psi  # the branching depth of the current iteration
+        self.cut = False  # whether the current iteration's psi cut off some branching
+        self.depth = 0  # the deepest iteration run (PlanResult does not carry it)
 
     def run(self) -> PlanResult:
         began = time.perf_counter()
@@ -113,8 +125,14 @@ class _BranchAndBound:
             return PlanResult((), 0.0, 0.0, 0, StopReason.DONE, time.perf_counter() - began)
         gain = self.members @ self.p.weights
         stop = StopReason.SEARCHED
+        depths = range(self.o.psi + 1) if self.o.deepen else (self.o.psi,)
         try:
-            self._visit(gain, self.p.weights.copy(), -1, 0.0, 1.0)
+            for psi in depths:
+                self.psi, self.cut, self.depth = psi, False, psi
+                self.memo.clear()  # what lies below a node depends on psi
+                self._visit(gain, self.p.weights.copy(), -1, 0.0, 1.0)
+                if not self.cut:
+                    break  # psi limited nothing: a deeper search would be this one again
         except _Limit as limit:
             stop = limit.args[0]
         cost, seq, survive = self.best
@@ -182,7 +200,8 @@ class _BranchAndBound:
             cand, p, t = cand[keep], p[keep], t[keep]
         util = p / t
         order = np.argsort(-util, kind="stable")
-        if depth >= self.o.psi:
+        if depth >= self.psi:
+            self.cut = self.cut or cand.size > 1
             return cand[order[:1]]
         order = order[util[order] >= util[order[0]] / self.o.phi]
         return cand[order]
@@ -200,8 +219,9 @@ class _BranchAndBound:
     def _overlap(self, view: int) -> sparse.csr_matrix:
         """Which views share each of `view`'s atoms, sparse (n, atoms of view), built once."""
         if view not in self.overlaps:
-            self.overlaps[view] = sparse.csr_matrix(self.p.members[:, self.atoms[view]],
-                                                    dtype=np.float64)  # fmt: skip
+            if self.columns is None:  # column slices of a CSC matrix are cheap
+                self.columns = sparse.csc_matrix(self.p.members, dtype=np.float64)
+            self.overlaps[view] = self.columns[:, self.atoms[view]].tocsr()
         return self.overlaps[view]
 
     def _count(self) -> None:

@@ -48,6 +48,8 @@ class FlapOptions:
     planner: PlannerOptions = field(default_factory=PlannerOptions)
     sampler: SamplerOptions = field(default_factory=SamplerOptions)
     greedy: bool = False
+    fit_pairs: int = 16  # exact A* times for the first cycle's driving regression
+    refit_pairs: int = 4  # new ones per later cycle (the last 2 * fit_pairs are kept)
 
 
 @dataclass(frozen=True)
@@ -74,6 +76,7 @@ class FlapSearch:
         self.cycle = 0
         self.exhausted = np.zeros(0, dtype=bool)  # region cells given up on (see `sensed`)
         self.blocked: list[tuple[float, float]] = []  # view positions the robot failed to reach
+        self.fit_samples: list[tuple[float, float]] = []  # (grid m, driving s) for the table
 
     def unreachable(self, view: View, radius: float = 0.3) -> None:
         """The robot could not get to `view`: no view within `radius` m of it is planned again
@@ -114,7 +117,10 @@ class FlapSearch:
             self.planned = []
             status = SearchStatus.NO_VIEWS if not views else SearchStatus.DONE
             return Decision(status, None, None, p_all, len(views), clock.laps)
-        table = build_table(self.body, grid, pose, [v.pose for v in views], self.options.clusters)
+        fresh = self.options.fit_pairs if not self.fit_samples else self.options.refit_pairs
+        table = build_table(self.body, grid, pose, [v.pose for v in views], self.options.clusters,
+                            fit_pairs=fresh, seed=self.cycle, known=self.fit_samples)
+        self.fit_samples[:] = table.samples[-self.options.fit_pairs * 2:]  # (in place: shared)
         views = [views[k] for k in table.kept]
         clock.lap("transitions")
         problem = SequencingProblem.build([v.cells for v in views], belief.log_miss(),

@@ -33,6 +33,7 @@ class TransitionTable:
     kept: np.ndarray  # (n,) indices into the views given to build_table
     labels: np.ndarray  # (n,) cluster of each kept view
     drive_fit: tuple[float, float]  # seconds = a + b * grid distance (m)
+    samples: tuple[tuple[float, float], ...] = ()  # (grid m, driving s) pairs of this fit
 
 
 def fixed_time(body: RobotBody, a: ViewPose, b: ViewPose) -> float:
@@ -92,8 +93,13 @@ def build_table(
     clusters: int = 50,
     fit_pairs: int = 16,
     seed: int = 0,
+    known: Sequence[tuple[float, float]] = (),
 ) -> TransitionTable:
-    """The lookup table over clustered view poses; views unreachable from the start are left out."""
+    """The lookup table over clustered view poses; views unreachable from the start are left out.
+
+    The driving regression is fitted on `fit_pairs` exact A* times plus the (grid distance,
+    driving seconds) pairs in `known` (e.g. an earlier cycle's `samples`: a continual search
+    then prices only a few new paths per cycle)."""
     if not poses:
         raise FlapError("a transition table needs at least one view")
     rng = np.random.default_rng(seed)
@@ -109,11 +115,13 @@ def build_table(
     poses = [poses[i] for i in kept]
     from_start = at_views[0, kept]
     lengths = _view_lengths(labels[kept], at_views[1:][:, kept], from_start)
-    fit = _fit_drive(body, grid, start, poses, from_start, lengths, fit_pairs, rng)
+    new = _drive_samples(body, grid, start, poses, from_start, lengths, fit_pairs, rng)
+    samples = (*known, *new)
+    fit = _fit_drive(body, samples)
     return TransitionTable(
         start=_compose(body, [start], poses, from_start[None, :], fit)[0],
         times=_compose(body, poses, poses, lengths, fit),
-        kept=kept, labels=labels[kept], drive_fit=fit,
+        kept=kept, labels=labels[kept], drive_fit=fit, samples=samples,
     )  # fmt: skip
 
 
@@ -141,7 +149,7 @@ def _view_lengths(labels: np.ndarray, fields: np.ndarray, from_start: np.ndarray
     return lengths
 
 
-def _fit_drive(
+def _drive_samples(
     body: RobotBody,
     grid: OccupancyGrid,
     start: ViewPose,
@@ -150,11 +158,11 @@ def _fit_drive(
     lengths: np.ndarray,
     pairs: int,
     rng: np.random.Generator,
-) -> tuple[float, float]:
-    """Least-squares a, b of driving seconds = a + b * grid distance over exact A* times."""
+) -> list[tuple[float, float]]:
+    """(grid distance, driving seconds of the exact A* time) for up to `pairs` random pairs."""
     everyone = [start] + poses
     grid_len = np.vstack([from_start[None, :], lengths])  # row 0: the start
-    xs, ys = [], []
+    out = []
     for _ in range(pairs):
         i, j = int(rng.integers(len(everyone))), int(rng.integers(len(poses)))
         if grid_len[i, j] < 1e-6:
@@ -162,11 +170,18 @@ def _fit_drive(
         a, b = everyone[i], poses[j]
         exact = exact_time(body, grid, a, b)
         if math.isfinite(exact):
-            xs.append(grid_len[i, j])
-            ys.append(exact - fixed_time(body, a, b) - turn_estimate(body, a, b))
-    if len(xs) < 3 or np.ptp(xs) < 1e-3:
+            out.append((float(grid_len[i, j]),
+                        exact - fixed_time(body, a, b) - turn_estimate(body, a, b)))
+    return out
+
+
+def _fit_drive(body: RobotBody, samples: Sequence[tuple[float, float]]) -> tuple[float, float]:
+    """Least-squares a, b of driving seconds = a + b * grid distance."""
+    xs = np.array([x for x, _ in samples])
+    ys = np.array([y for _, y in samples])
+    if xs.size < 3 or np.ptp(xs) < 1e-3:
         return 0.0, 1.0 / body.linear_speed
-    coef, *_ = np.linalg.lstsq(np.stack([np.ones(len(xs)), xs], axis=1), np.asarray(ys), rcond=None)
+    coef, *_ = np.linalg.lstsq(np.stack([np.ones(xs.size), xs], axis=1), ys, rcond=None)
     return float(coef[0]), float(coef[1])
 
 

@@ -46,7 +46,7 @@ def check_problem(domain: Domain, source: PddlSource, usage: Usage) -> list[Diag
         _goal_true_in_init(problem, values.atoms, report)
     if problem.metric is not None:
         _check_metric(problem.metric, init_checker)
-    _check_probabilities(problem, usage, values.numbers, report)
+    _check_probabilities(domain, names, problem, usage, values.numbers, report)
     _check_missing_values(domain, names, usage, values.numbers, report, problem.init_node)
     return report.items
 
@@ -140,6 +140,8 @@ def _check_metric(metric: SList, checker: FormulaChecker) -> None:
 
 
 def _check_probabilities(
+    domain: Domain,
+    names: dict[str, Typed],
     problem: Problem,
     usage: Usage,
     numbers: dict[str, list[tuple[SList, Atom]]],
@@ -148,7 +150,7 @@ def _check_probabilities(
     anchor: Node = problem.init_node or problem.goal_node or Atom("", 1, 1, 0)
     for name in usage.probability_fluents:
         assigned = numbers.get(name, [])
-        if not assigned:
+        if not assigned and _groundable(domain, names, name):
             report.add(
                 anchor,
                 "probability-not-in-init",
@@ -227,6 +229,16 @@ def _check_missing_values(
                 + (f" and {count - 1} more instance(s)" if count > 1 else ""),
                 warning=not is_probability,
             )
+
+
+def _groundable(domain: Domain, names: dict[str, Typed], name: str) -> bool:
+    """Whether the function has a ground instance at all (an object for every parameter);
+    one over a type with no objects (no placeholders left, say) needs no :init value."""
+    function = domain.functions.get(name)
+    if function is None:
+        return True
+    return all(any(domain.is_subtype(e.type, p.type) for e in names.values())
+               for p in function.params)
 
 
 def _missing(

@@ -24,10 +24,12 @@ from __future__ import annotations
 import math
 import time
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+import numpy as np
 
 from avs_planner.episode.mind import KnownObject
-from avs_planner.episode.outcome import Outcome, SearchResult, StepStatus
+from avs_planner.episode.outcome import Outcome, SearchResult, StepOutcome, StepStatus
 from avs_planner.flap import (
     FlapOptions,
     FlapSearch,
@@ -38,10 +40,15 @@ from avs_planner.flap import (
     View,
     ViewPose,
 )
+from avs_planner.flap.errors import FlapError
 from avs_planner.strategies.context import SearchContext
-from avs_planner.strategies.looking import _look
+from avs_planner.strategies.looking import _look, known_target
+from conceptual_map.errors import MapError
+from conceptual_map.metric import plan_path
 
 SURVEY_TILTS = (0.0, -0.6)  # rad: depth frames per survey heading (ahead, down at tables)
+SEARCH_SURVEY_TILTS = (-0.3,)  # while the clock runs: one frame per heading, where the
+# detector looks (half the depth work of two tilts; FLAP's own views map the region densely)
 SURVEY_DEPTH_COLUMNS = 48  # before the clock (the prior map)
 SEARCH_SURVEY_DEPTH_COLUMNS = 32  # while the clock runs: cheaper; FLAP's views map densely
 MAX_SURVEY_STOPS = 60
@@ -55,6 +62,7 @@ class _Head:
     pan: float = 0.0
     tilt: float = 0.0
     drive: str = ""  # how the last drive to a view ended
+    fit: list = field(default_factory=list)  # driving-time samples, kept from region to region
 
 
 # ---- preparation and survey ------------------------------------------------------------------
@@ -69,14 +77,15 @@ def prepare(ctx: SearchContext) -> None:
 
 
 def survey(ctx: SearchContext, depth: bool, find: bool, until_support: bool = False,
-           columns: int = SURVEY_DEPTH_COLUMNS) -> KnownObject | None:
+           columns: int = SURVEY_DEPTH_COLUMNS,
+           tilts: tuple[float, ...] = SURVEY_TILTS) -> KnownObject | None:
     """Visit placeholders nearest-first (frontier exploration), looking all round at every
     stop for supports (and the target when `find`); returns the target once confirmed. With
     `until_support` it stops after the first stop that registered a new support."""
     mind, ex = ctx.mind, ctx.executor
     known = len(_support_names(ctx))
     ex.look_around()
-    found = _survey_stop(ctx, depth, find, columns)
+    found = _survey_stop(ctx, depth, find, columns, tilts)
     for _ in range(MAX_SURVEY_STOPS):
         if found is not None or (find and ctx.budget_spent()):
             break
@@ -88,22 +97,28 @@ def survey(ctx: SearchContext, depth: bool, find: bool, until_support: bool = Fa
         mind.tried_placeholders[target] = mind.tried_placeholders.get(target, 0) + 1
         goal = mind.place_map.placeholders[target].position
         outcome = ex.drive_to(goal, stop=lambda t=target: t not in mind.place_map.placeholders)
+        if find and found is None:
+            found = known_target(ctx)  # the executor's watch confirmed it on the way
+            if found is not None:
+                break
         if outcome.status is StepStatus.DONE:
             ex.look_around()
-            found = _survey_stop(ctx, depth, find, columns)
+            found = _survey_stop(ctx, depth, find, columns, tilts)
     return found
 
 
-def _survey_stop(ctx: SearchContext, depth: bool, find: bool, columns: int
-                 ) -> KnownObject | None:
+def _survey_stop(ctx: SearchContext, depth: bool, find: bool, columns: int,
+                 tilts: tuple[float, ...]) -> KnownObject | None:
     robot, headings = ctx.robot, ctx.options["survey_headings"]
+    if find and (known := known_target(ctx)) is not None:
+        return known  # confirmed by the executor's watch (its look around, or on the way)
     supports = _support_labels(ctx)
     labels = [*supports, ctx.target] if find else supports
     yaw = robot.pose[2]
     for k in range(headings):
         robot.turn_to(yaw + 2 * math.pi * k / headings)
         if depth:
-            for tilt in SURVEY_TILTS:
+            for tilt in tilts:
                 robot.look(0.0, tilt)
                 ctx.mind.integrate_depth(robot.depth(_size(columns)))
         robot.look(0.0, SURVEY_TILTS[-1] / 2)
@@ -169,6 +184,16 @@ def _size(columns: int) -> tuple[int, int]:
 
 # ---- the search region -----------------------------------------------------------------------
 
+def support_box(obj: KnownObject, reach: float, height: float, below: float
+                ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """The box where a target on a detected support would be: `reach` m either side of its
+    detected centre, from `below` (< 0: the top is a noisy estimate) under its top (twice the
+    detected centre's height: a detection's centre is half the support's) to `height` above."""
+    x, y, z = obj.position
+    top = max(0.3, 2.0 * z)
+    return (x - reach, y - reach, top + below), (x + reach, y + reach, top + height)
+
+
 def support_volumes(ctx: SearchContext, skip: set[str] = frozenset()) -> list[TargetVolume]:
     """One box above each known support of the target (but those in `skip`); overlapping
     boxes of a label merge. A volume's name lists its supports' ids joined by '+'."""
@@ -179,12 +204,9 @@ def support_volumes(ctx: SearchContext, skip: set[str] = frozenset()) -> list[Ta
     for obj in mind.objects.values():
         if obj.label not in labels or obj.id in skip:
             continue
-        x, y, z = obj.position
-        top = max(0.3, 2.0 * z)  # a detection's centre is half the support's height
         p = o["p_volume"] if o["p_volume"] > 0 else _p_on(ctx, obj)
-        low = top + ctx.executor.config.above_support[0]  # the top is a noisy estimate
-        boxes.append([[x - reach, y - reach, low], [x + reach, y + reach, top + height],
-                      obj.label, p, [obj.id]])
+        lo, hi = support_box(obj, reach, height, ctx.executor.config.above_support[0])
+        boxes.append([list(lo), list(hi), obj.label, p, [obj.id]])
     merged = True
     while merged:
         merged = False
@@ -205,6 +227,44 @@ def support_volumes(ctx: SearchContext, skip: set[str] = frozenset()) -> list[Ta
             for lo, hi, _, p, ids in boxes]
 
 
+def task_volumes(ctx: SearchContext) -> list[TargetVolume]:
+    """The region the task gives (option `volumes`, as the seed's search tasks do)."""
+    return parse_volumes(ctx.options["volumes"], ctx.options["p_volume"])
+
+
+def parse_volumes(given: object, p_default: float) -> list[TargetVolume]:
+    """Option `volumes`: one box per entry {lo, hi, p (default `p_volume`), name}. Raises
+    FlapError naming the bad entry."""
+    if not isinstance(given, list):
+        raise FlapError(f"option 'volumes' must be a list of boxes, got {given!r}")
+    out = []
+    for k, entry in enumerate(given):
+        where = f"option 'volumes' entry {k}"
+        if not isinstance(entry, dict) or not {"lo", "hi"} <= set(entry):
+            raise FlapError(f"{where}: need a mapping with lo and hi, got {entry!r}")
+        unknown = sorted(set(entry) - {"lo", "hi", "p", "name"})
+        if unknown:
+            raise FlapError(f"{where}: unknown key(s) {', '.join(unknown)}")
+        try:
+            lo = tuple(float(v) for v in entry["lo"])
+            hi = tuple(float(v) for v in entry["hi"])
+            p = float(entry.get("p", p_default))
+        except (TypeError, ValueError) as exc:
+            raise FlapError(f"{where}: lo, hi and p must be numbers ({exc})") from None
+        volume = TargetVolume(lo, hi, p, str(entry.get("name", f"volume{k}")))
+        try:
+            volume.check()
+        except FlapError as exc:
+            raise FlapError(f"{where}: {exc}") from None
+        out.append(volume)
+    return out
+
+
+def check_options(options: dict) -> None:
+    """The registry's check of flap's options beyond their types."""
+    parse_volumes(options["volumes"], options["p_volume"])
+
+
 def _p_on(ctx: SearchContext, obj: KnownObject) -> float:
     try:
         return float(ctx.mind.cmap.p_object_at(ctx.target, ("on", obj.id)))
@@ -222,6 +282,11 @@ def run(ctx: SearchContext) -> SearchResult:
     head = _Head(torso=max(0.0, ctx.robot.camera_height - ctx.body.camera_height))
     searched: set[str] = set()
     reset, why = bool(ctx.options["reset_region"]), "no support of the target is known"
+    given = task_volumes(ctx)
+    if given:  # the task's region: searched once, to the omega test
+        ended = _search_region(ctx, result, given, head, reset)
+        return ended or ctx.end(result, Outcome.GAVE_UP,
+                                "the given region is searched (p(V̂(S)) < omega)")
     while True:
         stop = ctx.budget_spent()
         if stop:
@@ -239,7 +304,7 @@ def run(ctx: SearchContext) -> SearchResult:
             return ctx.end(result, Outcome.GAVE_UP, f"{why}; nothing left to explore")
         else:
             found = survey(ctx, depth=True, find=True, until_support=True,
-                           columns=SEARCH_SURVEY_DEPTH_COLUMNS)
+                           columns=SEARCH_SURVEY_DEPTH_COLUMNS, tilts=SEARCH_SURVEY_TILTS)
             if found is not None:
                 return _found(ctx, result, found)
         reset = False  # only the map known before the search is taken as out of date
@@ -250,7 +315,8 @@ def _search_region(ctx: SearchContext, result: SearchResult, volumes: list[Targe
     """The FLAP cycle over one region until the target is found (the ended result), the
     budget is spent (ditto), or p(V̂(S)) < omega (None)."""
     o, mind, robot = ctx.options, ctx.mind, ctx.robot
-    mind.integrate_depth(robot.depth(_size(o["depth_columns"])))  # makes the map if none
+    mind.integrate_depth(_detectable(robot.depth(_size(o["depth_columns"])), ctx.body))  # (makes
+    # the map if there is none)
     if reset:
         for volume in volumes:
             mind.voxels.reset_box(volume.lo, volume.hi)
@@ -263,6 +329,7 @@ def _search_region(ctx: SearchContext, result: SearchResult, volumes: list[Targe
     planner = PlannerOptions(omega=o["omega"], time_limit=o["time_limit_s"] or None)
     search = FlapSearch(ctx.body, volumes, FlapOptions(views=o["views"], clusters=o["clusters"],
                                                        planner=planner, greedy=o["greedy"]))
+    search.fit_samples = head.fit  # the same robot on the same floor: fewer A* to price
     for k in range(o["max_views"]):
         stop = ctx.budget_spent()
         if stop:
@@ -308,7 +375,8 @@ def _visit(ctx: SearchContext, view: View, head: _Head) -> KnownObject | None:
     """Drive to the view, stand on its pose, point the head at its target, take a depth frame
     into the 3D map and look for the target."""
     robot, body, pose = ctx.robot, ctx.body, view.pose
-    outcome = ctx.executor.drive_to((pose.x, pose.y))
+    outcome = (ctx.executor.drive_to((pose.x, pose.y)) if ctx.options["sense_en_route"]
+               else _drive_quietly(ctx, (pose.x, pose.y)))
     head.drive = outcome.status.value if not outcome.detail else f"{outcome.status.value}: " \
         f"{outcome.detail}"
     if outcome.status is StepStatus.DONE and math.dist(robot.pose[:2], (pose.x, pose.y)) > 0.02:
@@ -322,8 +390,45 @@ def _visit(ctx: SearchContext, view: View, head: _Head) -> KnownObject | None:
     robot.turn_to(math.atan2(ty - y, tx - x) - head.pan)
     robot.set_torso(head.torso)
     robot.look(head.pan, head.tilt)
-    ctx.mind.integrate_depth(robot.depth(_size(ctx.options["depth_columns"])))
-    return _look(ctx)
+    ctx.mind.integrate_depth(_detectable(robot.depth(_size(ctx.options["depth_columns"])), body))
+    return known_target(ctx) or _look(ctx)  # (the watch may have confirmed it on the way)
+
+
+@dataclass(frozen=True)
+class _Frame:
+    """A depth frame (conceptual_map's DepthFrameLike) with a shorter max range."""
+
+    origin: np.ndarray
+    directions: np.ndarray
+    ranges: np.ndarray
+    max_range: float
+    time: float
+
+
+def _detectable(frame, body) -> _Frame:  # noqa: ANN001 - a DepthFrameLike and a RobotBody
+    """A search view's depth frame cut at the detector's range: a cell the depth camera sees
+    beyond it was not searched (the detector could not have recognised the target there), and
+    the sampler predicts a view's cells within that range. Beyond it the rays say nothing."""
+    return _Frame(frame.origin, frame.directions, frame.ranges,
+                  min(float(frame.max_range), body.detect_range), frame.time)
+
+
+def _drive_quietly(ctx: SearchContext, goal: tuple[float, float]) -> StepOutcome:
+    """The seed's transition: follow one A* path on the robot's grid to the view, with one
+    laser scan at the end, and no sensing on the way (the executor's drive scans every metre,
+    classifies each new place and watches for the target: about a third of the search time
+    in `flap_two_rooms`, which the transition model does not predict). Falls back to the
+    executor's drive when there is no path or the base refuses it."""
+    robot, mind = ctx.robot, ctx.mind
+    try:
+        path = plan_path(mind.grid, robot.pose[:2], goal, mind.config.robot_radius)
+    except MapError:
+        path = None
+    if path is None or not path.found or not robot.move_along(list(path.waypoints[1:])):
+        return ctx.executor.drive_to(goal)
+    ctx.executor.stats.distance += path.length
+    mind.sense(robot.scan(), [robot.pose], robot.clock)
+    return StepOutcome(StepStatus.DONE)
 
 
 def _found(ctx: SearchContext, result: SearchResult, obj: KnownObject) -> SearchResult:

@@ -10,6 +10,7 @@ from typing import Any
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.loop import LoopConfig
 from avs_planner.episode.outcome import SearchResult
+from avs_planner.errors import AvsError
 from avs_planner.strategies.context import SearchContext
 from avs_planner.strategies.qsr_options import OPTIONS as _QSR_OPTIONS
 
@@ -31,6 +32,8 @@ class Strategy:
     options: Mapping[str, Any]
     prepare: str | None = None  # "module:function" run by `pre_explore` instead of the plain
     # frontier exploration, before the clock starts (e.g. FLAP's survey with depth frames)
+    check: str | None = None  # "module:function" checking the converted options further
+    # (raises an AvsError naming the option)
 
     def load(self) -> Run:
         return _load(self.entry)
@@ -46,8 +49,14 @@ class Strategy:
             known = ", ".join(sorted(self.options)) or "none"
             raise StrategyError(f"strategy {self.name!r}: unknown option(s) "
                                 f"{', '.join(unknown)} (known: {known})")
-        return {key: _convert(self.name, key, given.get(key, default), default)
-                for key, default in self.options.items()}
+        options = {key: _convert(self.name, key, given.get(key, default), default)
+                   for key, default in self.options.items()}
+        if self.check:
+            try:
+                _load(self.check)(options)
+            except AvsError as exc:
+                raise StrategyError(f"strategy {self.name!r}: {exc}") from None
+        return options
 
 
 def _load(entry: str) -> Callable[..., Any]:
@@ -78,31 +87,40 @@ def _convert(strategy: str, key: str, value: Any, default: Any) -> Any:
 
 
 # the loop's settings, less what the episode spec gives (budgets, where to dump problems)
-_SWITCHING_OPTIONS = {**{f.name: f.default for f in fields(LoopConfig)
-                         if f.name not in ("time_budget_s", "wall_budget_s", "dump_dir")},
-                      "qsr_cones": "on"}  # on|off|observe: strategies/switching.py
+_SWITCHING_OPTIONS = {f.name: f.default for f in fields(LoopConfig)
+                      if f.name not in ("time_budget_s", "wall_budget_s", "dump_dir")}
+# the view cones of a search on a support: "cones" (2D, around it) or "flap" (FLAP's views in
+# the 3D map; avs_planner/strategies/flap_views.py)
+_SWITCHING_OPTIONS["views"] = "cones"
+# QSR-weighted cones when QSRs are known for the target: on|off|observe (strategies/switching.py)
+_SWITCHING_OPTIONS["qsr_cones"] = "on"
 
 _FLAP_OPTIONS = {  # avs_planner/strategies/flap.py
     "greedy": False,  # next best view by p/t (the seed's baseline) instead of branch and bound
     "views": 200,  # view samples per cycle (the views still planned count towards them)
     "clusters": 50,  # transition table clusters
-    "time_limit_s": 2.0,  # planner wall limit per cycle (0: none); no plan by then: greedy
+    "time_limit_s": 0.5,  # planner wall limit per cycle (0: none); its first plan is greedy
     "omega": 0.05,  # give up once p(V̂(S)) < omega
     "p_volume": 0.2,  # P_i per support volume (seed: 0.2); <= 0: the conceptual map's belief
     "prior_map": True,  # the preparation (pre_explore) builds the 3D map with depth frames
     "reset_region": True,  # forget the 3D map inside the search region at the start
     "support_reach": 0.7,  # m: half width of a support's box around its detected centre
     "volume_height": 0.3,  # m: height of a support's box above its top
-    "depth_columns": 64,  # depth frame columns at a view (rows: 3/4 of them)
+    "depth_columns": 48,  # depth frame columns at a view (rows: 3/4 of them)
     "survey_headings": 6,  # headings looked at per survey stop
     "survey_on": True,  # after a region is searched, survey on for more supports
+    "sense_en_route": True,  # drive to views with the executor (scans every metre, place
+    # classification, the target watch); false: one path, no sensing on the way (the seed's)
     "max_views": 80,
+    "volumes": [],  # the task's search region: [{lo: [x, y, z], hi: [x, y, z], p, name}, ...]
+    # (the seed's experiments give the volumes); empty: boxes above the known supports
 }
 
 STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
     Strategy("switching", "the switching planner: continual PDDL planner with assumptions + "
              "POMDP view-cone search (Goebelbecker et al.)",
-             "avs_planner.strategies.switching:run", _SWITCHING_OPTIONS),
+             "avs_planner.strategies.switching:run", _SWITCHING_OPTIONS,
+             check="avs_planner.strategies.switching:check_options"),
     Strategy("exhaustive", "baseline: frontier exploration, nearest placeholder first, "
              "looking all round at every stop; no priors",
              "avs_planner.strategies.baselines:run_exhaustive",
@@ -123,7 +141,8 @@ STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
     Strategy("flap", "FLAP (seed 000): frontier view sampling in the 3D map and expected-time "
              "view sequencing over the target's known supports (greedy: true is its baseline)",
              "avs_planner.strategies.flap:run", _FLAP_OPTIONS,
-             prepare="avs_planner.strategies.flap:prepare"),
+             prepare="avs_planner.strategies.flap:prepare",
+             check="avs_planner.strategies.flap:check_options"),
 )}
 
 

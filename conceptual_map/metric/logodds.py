@@ -94,7 +94,13 @@ class LogOddsGrid:
     def inside(self, cells: np.ndarray) -> np.ndarray:
         """Which integer cell coordinates (N, D) lie in the grid."""
         cells = np.asarray(cells)
-        return np.all((cells >= 0) & (cells < np.asarray(self.shape)), axis=1)
+        if cells.ndim != 2 or cells.shape[1] != self.ndim:
+            return np.all((cells >= 0) & (cells < np.asarray(self.shape)), axis=1)
+        ok = (cells[:, 0] >= 0) & (cells[:, 0] < self.shape[0])
+        for axis in range(1, self.ndim):  # column by column: no (N, D) temporaries
+            column = cells[:, axis]
+            ok &= (column >= 0) & (column < self.shape[axis])
+        return ok
 
     def integrate(self, rays: Rays, grow: bool = True) -> UpdateSummary:
         """Add one batch of rays: cells passed become freer, end cells of hits more occupied."""

@@ -11,8 +11,6 @@ import numpy as np
 from conceptual_map.metric.logodds import CellState, LogOddsGrid, SensorModel, UpdateSummary
 from conceptual_map.metric.sensors import DepthFrameLike, Rays, depth_rays
 
-_SIX = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
-
 
 class VoxelMap(LogOddsGrid):
     """Dense 3D grid over a fixed box (an office of 12 x 8 x 2 m at 5 cm is 1.5 MB)."""
@@ -120,26 +118,31 @@ class VoxelMap(LogOddsGrid):
     def _refresh_frontier(self, changed_flat: np.ndarray) -> None:
         if changed_flat.size == 0:
             return
-        coords = np.stack(np.unravel_index(changed_flat, self.shape), axis=1)
-        around = [changed_flat]
-        for off in _SIX:
-            nb = coords + off
-            ok = self.inside(nb)
-            around.append(np.ravel_multi_index(tuple(nb[ok].T), self.shape))
+        coords = np.unravel_index(changed_flat, self.shape)
+        around = [changed_flat] + [nb[ok] for ok, nb in self._six(changed_flat, coords)]
         cells = self.unique_flat(np.concatenate(around))
         self.frontier.reshape(-1)[cells] = self._is_frontier(cells)
+
+    def _six(self, flat: np.ndarray, coords: tuple[np.ndarray, ...]
+             ) -> list[tuple[np.ndarray, np.ndarray]]:
+        """(inside, flat index) of each cell's six face neighbours, by index arithmetic."""
+        strides = np.cumprod((1,) + self.shape[:0:-1])[::-1]  # C order
+        out = []
+        for axis in range(3):
+            c, step = coords[axis], int(strides[axis])
+            out.append((c > 0, flat - step))
+            out.append((c < self.shape[axis] - 1, flat + step))
+        return out
 
     def _is_frontier(self, flat: np.ndarray) -> np.ndarray:
         """Frontier status of the given cells (flat indices), from the current log-odds."""
         values = self.logodds.reshape(-1)
-        unknown = self._classify(values[flat]) == CellState.UNKNOWN
-        coords = np.stack(np.unravel_index(flat, self.shape), axis=1)
+        mine = values[flat]
+        unknown = (mine > self.model.free_at) & (mine < self.model.occupied_at)
         near_free = np.zeros(flat.size, dtype=bool)
-        for off in _SIX:
-            nb = coords + off
-            ok = self.inside(nb)
-            nb_flat = np.ravel_multi_index(tuple(nb[ok].T), self.shape)
-            near_free[ok] |= self._classify(values[nb_flat]) == CellState.FREE
+        for ok, nb in self._six(flat, np.unravel_index(flat, self.shape)):
+            # outside the grid: look at the cell itself, which is not free where it matters
+            near_free |= values[np.where(ok, nb, flat)] <= self.model.free_at
         return unknown & near_free
 
 

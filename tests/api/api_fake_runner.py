@@ -34,6 +34,8 @@ def run(spec: dict[str, Any], emit: Any, should_stop: Any) -> dict[str, Any]:
         return {"outcome": "found", "target": spec["target"], "seed": spec["seed"]}
     if behaviour == "hopeless":
         return {"outcome": "gave_up", "target": spec["target"]}
+    if behaviour == "explained":  # a switching episode's trace and its explanation.json
+        return _explained(spec, emit)
     if behaviour == "boom":
         raise RuntimeError("runner exploded on purpose")
     if behaviour == "hog":
@@ -53,3 +55,38 @@ def run(spec: dict[str, Any], emit: Any, should_stop: Any) -> dict[str, Any]:
             time.sleep(0.01)
         return {"outcome": "found"}
     return {"outcome": "nonsense"}
+
+
+def _explained(spec: dict[str, Any], emit: Any) -> dict[str, Any]:
+    """Writes trace.jsonl and explanation.json as the real runner does, from a hand-made
+    give-up: one room hypothesis, refuted when its placeholder was explored."""
+    import json
+
+    from avs_planner.episode import explain
+
+    assume = "(assume-leads-to-room placeholder3 kitchen new-room1)"
+    events = [
+        {"t": 0.0, "type": "start", "target": "explained", "world": "office",
+         "strategy": "switching", "seed": 0},
+        {"t": 1.0, "type": "plan", "why": "initial", "status": "solved",
+         "plan": [assume, "(move place1 placeholder3)"], "step_p": [0.3, 1.0],
+         "assumptive": [0], "probability": 0.3},
+        {"t": 9.0, "type": "action", "action": "(move place1 placeholder3)", "status": "done",
+         "detail": "explored on the way"},
+        {"t": 9.0, "type": "monitor", "verdict": "assumption_contradicted", "confirmed": [],
+         "assumptions": {assume: 0.0}},
+        {"t": 9.0, "type": "replan", "status": "assumption_contradicted", "action": assume,
+         "detail": "no longer possible (unreachable or probability 0)"},
+        {"t": 9.0, "type": "plan", "why": "replan", "status": "unsolvable", "plan": [],
+         "probability": 0.0},
+        {"t": 9.0, "type": "done", "outcome": "gave_up", "reason": "no plan"},
+    ]
+    out = Path(spec["output_dir"])
+    with (out / "trace.jsonl").open("w", encoding="utf-8") as trace:
+        for event in events:
+            trace.write(json.dumps(event) + "\n")
+            emit(event)
+    explain.write(out / explain.FILE_NAME, explain.build(events))
+    if spec.get("record"):  # the real runner writes a Rerun recording
+        (out / "recording.rrd").write_bytes(b"RRF2-not-a-real-recording")
+    return {"outcome": "gave_up", "target": spec["target"]}

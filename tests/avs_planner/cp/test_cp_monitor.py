@@ -155,3 +155,16 @@ def test_a_confirmed_assumption_is_dropped_instead_of_replanning(corridor_text):
     fresh.plan = tuple(s for s in fresh.plan if s.label not in executed)
     kept = fresh.update(state)
     assert "(assume-obj-exists-in table new-room1 kitchen new-object1)" not in kept.confirmed
+
+
+def test_the_report_gives_each_assumptions_probability_in_the_new_state(planned):
+    """What the assumption ledger records after every step (`monitor` trace events)."""
+    planner, _ = planned
+    leads = next(s.label for s in planner.plan if s.name == "assume-leads-to-room")
+    assumed = [s.label for s in planner.plan if s.assumptive]
+    moved = planner.state.updated(values={("p-placeholder-category", "place1", "kitchen"): 0.55})
+    report = _check(planner, moved)
+    assert [label for label, _ in report.assumptions] == assumed
+    assert dict(report.assumptions)[leads] == pytest.approx(0.55)
+    gone = _check(planner, planner.state.updated(add=[("defined-leads-to", "place1")]))
+    assert gone.assumptions == ((leads, 0.0),)  # the first one, contradicted

@@ -184,3 +184,32 @@ def test_same_actions_and_plan_as_without_limits(name, make, monkeypatch):
     assert [s.label for s in limited.plan] == [s.label for s in full.plan]
     assert (limited.cost, limited.objective, limited.expanded) == (
         full.cost, full.objective, full.expanded)
+
+
+NEVER_UNDONE_DOMAIN = """(define (domain chores)
+  (:requirements :strips :typing :negative-preconditions)
+  (:types job)
+  (:predicates (done ?j - job) (ready ?j - job) (paid))
+  (:action work :parameters (?j - job) :precondition (and (ready ?j) (not (done ?j)))
+    :effect (and (done ?j) (not (ready ?j))))
+  (:action collect :parameters (?j - job) :precondition (done ?j) :effect (paid)))"""
+
+NEVER_UNDONE_PROBLEM = """(define (problem p) (:domain chores)
+  (:objects a b - job)
+  (:init (done a) (ready a) (ready b))
+  (:goal (paid)))"""
+
+
+def test_an_action_needing_false_an_atom_true_for_good_is_not_grounded():
+    """`(done a)` is true and no action deletes it: `work a` can never apply, so it is left
+    out of the ground task (the delete relaxation would otherwise count it); `work b` and a
+    negative precondition on an atom some action deletes (`ready`) are kept."""
+    task = ground(read_text(NEVER_UNDONE_DOMAIN, NEVER_UNDONE_PROBLEM, "d.pddl", "p.pddl"))
+    assert task.action("work", ("a",)) is None
+    assert task.action("work", ("b",)) is not None
+    assert task.action("collect", ("a",)) is not None
+    with_undo = NEVER_UNDONE_DOMAIN.replace(
+        "(:action collect", "(:action undo :parameters (?j - job) :precondition (paid)\n"
+        "    :effect (not (done ?j)))\n  (:action collect")
+    task = ground(read_text(with_undo, NEVER_UNDONE_PROBLEM, "d.pddl", "p.pddl"))
+    assert task.action("work", ("a",)) is not None

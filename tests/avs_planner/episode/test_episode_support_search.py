@@ -102,3 +102,48 @@ def test_categories_believed_certain_are_doubted_once_before_giving_up(corridor)
     assert any(k[:2] == ("p-room-category", room) for k in state.values)
     assert events and events[0][1]["doubt_categories"] == 1.0
     assert not loop._doubt_categories()  # once per episode
+
+
+def test_a_search_that_hits_its_node_limit_is_retried_in_the_anytime_mode(corridor) -> None:
+    """The first CP call stops at its (tiny) expansion limit; the fallback runs the anytime
+    schedule (greedy FF first, then weighted A* restarts) and returns a plan."""
+    from avs_planner.cp.continual import ContinualPlanner
+
+    _, builder, executor = corridor
+    trace = Trace(lambda: executor.robot.clock)
+    loop = SwitchingLoop(builder, executor, trace, LoopConfig(cp_node_limit=1))
+    state = builder.build()
+    loop.planner = ContinualPlanner(state.skeleton(), loop._options(),
+                                    min_success=loop.config.min_success)
+    first = loop.planner.replan(state.world_state())
+    assert first.status.value == "node_limit"
+    retried = loop._fallback(first)
+    assert retried.solved and "anytime" in retried.extra
+    assert loop.planner.options.node_limit == 1  # the loop's own options are restored
+
+
+def test_the_target_is_looked_at_again_before_it_is_reported(corridor, monkeypatch) -> None:
+    """REPORTPOSITION faces the found target and needs one of `verify_frames` frames to see
+    it again: a phantom that two frames once agreed on is not reported."""
+    import math
+
+    from avs_planner.cp.search import PlanStep
+
+    mind, builder, executor = corridor
+    _, (x, y) = _here(mind)
+    target = builder.task.target
+    obj = mind.add_object(target, (x + 1.0, y + 1.0, 0.5))
+    step = PlanStep("reportposition", (obj.id, target), 0.0, 1.0, False)
+    frames: list[list[Seen]] = [[], [], []]
+    monkeypatch.setattr(executor.robot, "detect",
+                        lambda labels=None: frames.pop(0) if frames else [])
+    outcome = executor._run(step, builder.build())
+    assert outcome.status is StepStatus.FAILED and "not seen again" in outcome.detail
+    assert not frames  # all three frames were taken
+    yaw = executor.robot.pose[2]
+    assert math.isclose(math.cos(yaw - math.atan2(1.0, 1.0)), 1.0, abs_tol=1e-2)
+    frames[:] = [[], [Seen(7, target, (x + 1.1, y + 1.0, 0.5), 0.8)]]
+    assert executor._run(step, builder.build()).status is StepStatus.FOUND
+    executor.config = replace(executor.config, verify_frames=0)
+    frames[:] = []
+    assert executor._run(step, builder.build()).status is StepStatus.FOUND

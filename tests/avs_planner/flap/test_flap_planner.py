@@ -127,3 +127,28 @@ def test_limits_keep_the_first_complete_plan() -> None:
 def test_bad_options_are_flap_errors(options: PlannerOptions) -> None:
     with pytest.raises(FlapError):
         plan_views(random_problem(3, np.random.default_rng(0)), options)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_deepening_finds_the_same_optimum_without_limits(seed: int) -> None:
+    problem = random_problem(12, np.random.default_rng(100 + seed))
+    for psi, phi in ((2, 2.0), (3, 3.0)):
+        plain = plan_views(problem, PlannerOptions(psi=psi, phi=phi, max_nodes=None,
+                                                   deepen=False))
+        deep = plan_views(problem, PlannerOptions(psi=psi, phi=phi, max_nodes=None))
+        assert deep.stop is StopReason.SEARCHED
+        assert deep.expected_time == pytest.approx(plain.expected_time, rel=1e-9)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_limit_in_a_deep_search_keeps_the_shallow_searches_best_plan(seed: int) -> None:
+    """Deepening runs psi = 0, 1, ... in turn, so a node budget that covers psi <= 1 returns
+    a plan at least as good as the complete psi = 1 search, whatever psi was asked for (a
+    plain depth-first search cut short has varied only its last levels)."""
+    problem = random_problem(30, np.random.default_rng(200 + seed), atoms=40)
+    shallow = plan_views(problem, PlannerOptions(psi=1, phi=3.0, max_nodes=None))
+    assert shallow.stop is StopReason.SEARCHED
+    limited = plan_views(problem, PlannerOptions(psi=6, phi=3.0, max_nodes=shallow.nodes))
+    assert limited.stop is StopReason.NODE_LIMIT
+    assert limited.expected_time <= shallow.expected_time + 1e-9
+    assert limited.expected_time <= plan_greedy(problem).expected_time + 1e-9

@@ -109,3 +109,22 @@ def test_pyparsing_errors_keep_their_position() -> None:
 def test_up_messages_with_positions_are_used() -> None:
     error = _convert(SyntaxError("bad thing\nError from line: 4, col 7 to line: 4, col 9"), "d")
     assert (error.line, error.column) == (4, 7) and "bad thing" in error.message
+
+
+def test_probability_fluent_over_a_type_with_no_objects_needs_no_value() -> None:
+    """An episode's problem with no placeholder left has no (p-placeholder-category ...)
+    instance at all: nothing to give a value to, so no error (the file is still read)."""
+    domain = DOMAIN.replace("(:types block table - object)", "(:types block table bin - object)")
+    domain = domain.replace(
+        "(lift-cost ?x - block) - number)",
+        "(lift-cost ?x - block) - number\n              (p-toss ?b - bin) - number)",
+    )
+    domain = domain.replace("(:action place", """(:action toss
+    :parameters (?x - block ?b - bin)
+    :precondition (holding ?x)
+    :effect (and (probabilistic (p-toss ?b) (not (holding ?x))) (increase (total-cost) 1)))
+  (:action place""")
+    assert _codes(domain) == []
+    read_text(domain, PROBLEM)
+    with_bin = PROBLEM.replace("desk - table)", "desk - table bin1 - bin)")
+    assert ("probability-not-in-init", "error") in _codes(domain, with_bin)

@@ -2,9 +2,11 @@
 
 import json
 
+import pytest
+
 from avs_planner.cli import main as avs_main
 from avs_planner.episode import run_episode
-from avs_planner.strategies import get_strategy
+from avs_planner.strategies import StrategyError, get_strategy
 
 # small cycles keep the tests quick; the experiment uses the defaults (200 views, 50 clusters)
 # no wall-clock limit on the planner: its node limit keeps the episodes the same under any load
@@ -65,3 +67,58 @@ def test_flap_gives_up_on_an_absent_label_through_the_omega_test():
     assert known[-1] > known[0]
     survival = [v["survival"] for v in views]
     assert all(b <= a + 1e-9 for a, b in zip(survival, survival[1:], strict=False))
+
+
+def test_the_task_can_give_the_region():
+    """Option `volumes` (the seed's tasks give the volumes): checked with the other options,
+    errors naming the entry."""
+    flap = get_strategy("flap")
+    given = [{"lo": [1, 2, 0.7], "hi": [2, 3, 1.0], "p": 0.3, "name": "t"}, {"lo": [0, 0, 0],
+                                                                          "hi": [1, 1, 1]}]
+    assert flap.check_options({"volumes": given})["volumes"] == given
+    for bad, message in (
+            ("box", r"option 'volumes' must be a list"),
+            ([{"lo": [0, 0, 0]}], r"entry 0: need a mapping with lo and hi"),
+            ([{"lo": [0, 0, 0], "hi": [1, 1, 1], "P": 0.2}], r"entry 0: unknown key\(s\) P"),
+            ([{"lo": [0, 0, 1], "hi": [1, 1, 0]}], r"entry 0: .*need lo <= hi"),
+            ([{"lo": [0, 0, 0], "hi": [1, 1, 1], "p": 1.5}], r"entry 0: .*probability")):
+        with pytest.raises(StrategyError, match=message):
+            flap.check_options({"volumes": bad})
+
+
+def test_a_given_region_is_searched_to_the_omega_test_with_quiet_drives():
+    """The seed's experiment: the six volumes of `flap_two_rooms`, `sense_en_route: false`
+    (transitions are driving, turning, torso, head and sensing only: no place classification
+    or watch on the way), one region, ended by omega."""
+    from bench.flap_experiment import seed_volumes
+
+    events = []
+    volumes = seed_volumes()
+    summary = run_episode({"target": "stapler", "world": "flap_two_rooms", "seed": 2,
+                           "start": [2.5, 3.6, 1.57], "strategy": "flap", "pre_explore": True,
+                           "strategy_options": {**QUICK, "omega": 0.4, "volumes": volumes,
+                                                "sense_en_route": False,
+                                                "survey_on": False}}, events.append)
+    assert summary["outcome"] == "gave_up" and "given region" in summary["reason"]
+    region = next(e for e in events if e.get("event") == "region")
+    assert [v["name"] for v in region["volumes"]] == [v["name"] for v in volumes]
+    assert region["p_total"] == pytest.approx(1 - 0.8 ** 6, abs=1e-3)
+    started = region["t"]
+    during = [e for e in events if e["t"] > started]
+    assert not [e for e in during if e["type"] == "observation" and e.get("watching")]
+    assert [e for e in during if e.get("event") == "view"]
+
+
+def test_a_target_the_watch_confirmed_on_the_way_ends_the_survey():
+    """A target the executor's watch confirmed while driving is a known object: the next
+    survey stop reports it without looking (flap's own look skips detections near known
+    objects, so it used to search on and give up with the target known)."""
+    from types import SimpleNamespace
+
+    from avs_planner.episode.mind import KnownObject
+    from avs_planner.strategies.flap import _survey_stop
+
+    cup = KnownObject("object7", "cup", (1.0, 2.0, 0.8), "room_a")
+    ctx = SimpleNamespace(robot=None, options={"survey_headings": 6}, target="cup",
+                          category=None, mind=SimpleNamespace(objects={cup.id: cup}))
+    assert _survey_stop(ctx, depth=True, find=True, columns=32, tilts=(0.0,)) is cup

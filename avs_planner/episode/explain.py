@@ -1,0 +1,751 @@
+"""Explanations of an episode: the assumption ledger, the reasons for replans, and give-ups.
+
+Everything here is rebuilt from the episode's trace events (`trace.jsonl`), so any finished run
+can be explained again (`avs explain RUN_DIR`). The switching loop records, per plan, every
+step's probability and which steps are assumptive (`plan` events), and after every executed
+step the monitor's verdict with the probability of each assumption still in the plan and the
+assumptions that came true (`monitor` events); `replan` events name the broken step and why.
+
+The ledger follows each assumption (an `assume-*` step, e.g. "a kitchen lies behind
+placeholder10") from the plan that first used it: its probability then and at every later
+check, and how it ended: **confirmed** (it came true: the monitor dropped it from the plan),
+**refuted** (the monitor found it contradicted or impossible), **dropped** (a new plan no
+longer used it) or **unresolved** (still assumed when the episode ended). An assumption about a
+virtual object (`new-room1`) is tied to the assumption that introduced that object: when the
+room hypothesis falls, the object assumed in it falls with it, and the next plan's assumption
+of the same name is a new entry.
+
+Strategies that do not plan with assumptions (baselines, flap, qsr) get the smaller part every
+explanation has: what was searched, what was seen, and why the search ended.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+EXPLANATION_VERSION = 1
+FILE_NAME = "explanation.json"
+
+
+class ExplainError(ValueError):
+    """A run folder or trace that cannot be explained (the message names the file)."""
+
+
+@dataclass
+class Assumption:
+    """One assumption's life in the ledger."""
+
+    id: str
+    action: str
+    meaning: str
+    kind: str
+    assumed_at: float
+    plan: int  # the plan that first used it (1-based)
+    p_first: float | None
+    history: list[dict[str, Any]] = field(default_factory=list)  # {t, p, source}
+    plans: list[int] = field(default_factory=list)
+    status: str = "open"  # open | confirmed | refuted | dropped | unresolved
+    ended_at: float | None = None
+    by: str | None = None  # the observation that settled it
+    reason: str | None = None
+    subject: str | None = None  # the room or placeholder it is about
+    category: str | None = None
+    label: str | None = None  # the object label it is about (obj-exists)
+
+    @property
+    def p_last(self) -> float | None:
+        return self.history[-1]["p"] if self.history else self.p_first
+
+
+def _strip(label: str) -> list[str]:
+    return label.strip().strip("()").split()
+
+
+def _virtual(name: str) -> bool:
+    return name.startswith("new-")
+
+
+def _a(noun: str) -> str:
+    return f"{'an' if noun[:1].lower() in 'aeiou' else 'a'} {noun}"
+
+
+def describe(action: str) -> tuple[str, dict[str, str | None]]:
+    """What an assumptive step assumes, in words, and its subject, category and label."""
+    name, *args = _strip(action) or [""]
+    if name == "assume-leads-to-room" and len(args) == 3:
+        return (f"{_a(args[1])} lies behind {args[0]} ({args[2]})",
+                {"subject": args[0], "category": args[1], "label": None})
+    if name == "assume-category" and len(args) == 2:
+        return f"{args[0]} is {_a(args[1])}", {"subject": args[0], "category": args[1],
+                                                "label": None}
+    if name == "assume-obj-exists-in" and len(args) == 4:
+        return (f"{_a(args[0])} is in {args[1]} (as {_a(args[2])}) ({args[3]})",
+                {"subject": args[1], "category": args[2], "label": args[0]})
+    if name == "assume-obj-exists-on" and len(args) == 6:
+        return (f"{_a(args[0])} is on {args[1]} ({_a(args[2])} in {args[4]}, as "
+                f"{_a(args[3])}) ({args[5]})",
+                {"subject": args[1], "category": args[3], "label": args[0]})
+    return f"{action} holds", {"subject": args[0] if args else None, "category": None,
+                               "label": None}
+
+
+def _evidence(event: Mapping[str, Any]) -> str | None:
+    """One event as evidence, in words (None for events that say nothing new)."""
+    kind = event.get("type")
+    if kind == "action" and event.get("status") not in (None, "start"):
+        detail = event.get("detail") or ""
+        text = f"{event.get('action')} {event.get('status')}" + (f": {detail}" if detail else "")
+        category = event.get("category")
+        if isinstance(category, Mapping) and category:
+            text += " (now " + _dist(category) + ")"
+        return text
+    if kind == "observation":
+        where = event.get("position")
+        at = f" at ({where[0]:.2f}, {where[1]:.2f})" if isinstance(where, list | tuple) and \
+            len(where) >= 2 else ""
+        seen = "confirmed" if event.get("detected") else "not confirmed"
+        if event.get("detected") is False and not at:
+            return None  # a look that saw nothing: the dt event sums these up
+        return f"{event.get('label')} {seen}{at}"
+    if kind == "dt":
+        return (f"DT search for {event.get('label')} {event.get('relation')} "
+                f"{event.get('location')}: {event.get('result')} after {event.get('steps')} "
+                f"steps (p {event.get('probability')})")
+    if kind == "belief":
+        if "blocked" in event:
+            return f"blocked: {event.get('detail')}"
+        if "doubt_categories" in event:
+            return (f"room categories believed below {event['doubt_categories']} doubted "
+                    f"again ({event.get('reason')})")
+        if "retry_blocked" in event:
+            return f"blocked spots tried again: {', '.join(event['retry_blocked'])}"
+        if "cut_off" in event:
+            return "cut off: " + "; ".join(event["cut_off"])
+        if "dropped_support" in event:
+            return f"support label {event['dropped_support']} dropped ({event.get('reason')})"
+        if "matched" in event:
+            return "matched " + ", ".join(f"{k} = {v}" for k, v in event["matched"].items())
+    return None
+
+
+def _destination(action: str) -> str | None:
+    """Where a move or explore step went."""
+    words = _strip(action)
+    if len(words) == 3 and words[0] == "move":
+        return words[2]
+    if len(words) == 2 and words[0] == "explore":
+        return words[1]
+    return None
+
+
+def _why_refuted(entry: Assumption, detail: str, went_to: Mapping[str, float]) -> str:
+    """The monitor's verdict on a contradicted assumption, read with where the robot went."""
+    if entry.kind == "assume-leads-to-room" and "no longer possible" in detail:
+        if went_to.get(entry.subject or "", -math.inf) >= float(entry.assumed_at or 0.0):
+            return (f"{entry.subject} was explored (the robot went there): it is no longer "
+                    f"a placeholder, so no unseen {entry.category} can be assumed behind it "
+                    f"(monitor: {detail})")
+        return (f"{entry.subject} is no longer a placeholder (the map grew over it), so no "
+                f"unseen {entry.category} can be assumed behind it (monitor: {detail})")
+    if entry.kind == "assume-category" and "no longer possible" in detail:
+        return (f"the planner no longer offers {entry.category} for {entry.subject}: its "
+                f"category belief is taken as settled, or the room changed as the map grew "
+                f"(monitor: {detail})")
+    if entry.kind.startswith("assume-obj-exists") and "defined-exists" in detail:
+        where = "in" if entry.kind == "assume-obj-exists-in" else "on"
+        return (f"{_a(entry.label or 'object')} may no longer be assumed {where} "
+                f"{entry.subject}: the searches there came back empty (or one was found "
+                f"there already) (monitor: {detail})")
+    return f"monitor: {detail}"
+
+
+def _dist(category: Mapping[str, Any], n: int = 2) -> str:
+    items = sorted(category.items(), key=lambda kv: -float(kv[1]))[:n]
+    return ", ".join(f"{k} {float(v):.2f}" for k, v in items)
+
+
+def _r(value: Any) -> float | None:
+    return None if value is None else round(float(value), 4)
+
+
+class Ledger:
+    """Consumes trace events one at a time (`feed`), or all at once (`build`)."""
+
+    def __init__(self) -> None:
+        self.start: dict[str, Any] = {}
+        self.done: dict[str, Any] | None = None
+        self.plans: list[dict[str, Any]] = []
+        self.replans: list[dict[str, Any]] = []
+        self.assumptions: list[Assumption] = []
+        self.open: dict[tuple, Assumption] = {}  # signature -> entry, for the current plan
+        self.current: dict[str, tuple] = {}  # label -> signature in the current plan
+        self.actions: list[dict[str, Any]] = []
+        self.searches: list[dict[str, Any]] = []
+        self.observations = {"confirmed": 0, "not_confirmed": 0}
+        self.notes: list[str] = []
+        self.flap: dict[str, Any] = {"regions": [], "decisions": 0, "views": 0,
+                                     "last_decision": None}
+        self.since: list[str] = []  # evidence since the last monitor check
+        self.last_done: dict[str, Any] | None = None
+        self.went_to: dict[str, float] = {}  # move/explore destination -> when it was done
+        self._pending_replan: dict[str, Any] | None = None
+        self._monitor_evidence: str | None = None
+        self.tail: list[str] = []  # what happened since the last plan that was found
+        self.events = 0
+
+    # ---- feeding -----------------------------------------------------------------------------
+
+    def feed(self, event: Mapping[str, Any]) -> None:
+        self.events += 1
+        kind = event.get("type")
+        handler = getattr(self, f"_on_{kind}", None)
+        text = _evidence(event)
+        if text is not None:
+            self.since.append(text)
+            self.tail.append(f"t={float(event.get('t') or 0.0):.1f} s: {text}")
+        if handler is not None:
+            handler(event)
+
+    def _on_start(self, event: Mapping[str, Any]) -> None:
+        self.start = {k: event.get(k) for k in ("target", "world", "robot", "seed", "strategy")}
+
+    def _on_action(self, event: Mapping[str, Any]) -> None:
+        if event.get("status") == "start" or not event.get("action"):
+            return
+        record = {"t": event.get("t"), "action": event.get("action"),
+                  "status": event.get("status"), "detail": event.get("detail") or ""}
+        self.actions.append(record)
+        self.last_done = record
+        where = _destination(str(record["action"]))
+        if where is not None:
+            self.went_to[where] = float(record["t"] or 0.0)
+
+    def _on_observation(self, event: Mapping[str, Any]) -> None:
+        self.observations["confirmed" if event.get("detected") else "not_confirmed"] += 1
+
+    def _on_dt(self, event: Mapping[str, Any]) -> None:
+        self.searches.append({k: event.get(k) for k in
+                              ("t", "label", "relation", "location", "result", "probability",
+                               "steps", "cones")})
+
+    def _on_belief(self, event: Mapping[str, Any]) -> None:
+        if isinstance(event.get("matched"), Mapping):
+            self._matched(event["matched"], event.get("t"))
+        for key in ("cut_off", "doubt_categories", "retry_blocked", "dropped_support",
+                    "most_likely"):
+            if key in event:
+                text = _evidence(event)
+                if text is None:  # most_likely: the baselines' next room or placeholder
+                    text = (f"most likely {event.get('kind')}: {event['most_likely']} "
+                            f"(p {event.get('probability')})")
+                self.notes.append(f"t={float(event.get('t', 0.0)):.1f} s: {text}")
+
+    def _on_flap(self, event: Mapping[str, Any]) -> None:
+        """FLAP's view planning: the regions searched, its decisions and views."""
+        kind = event.get("event")
+        if kind == "region":
+            self.flap["regions"] = [{"name": v.get("name"), "p": v.get("p")}
+                                    for v in event.get("volumes") or []]
+        elif kind == "decision":
+            self.flap["decisions"] += 1
+            self.flap["last_decision"] = {k: event.get(k) for k in
+                                          ("t", "cycle", "status", "p_remaining", "planned")}
+        elif kind == "view":
+            self.flap["views"] += 1
+
+    def _on_plan(self, event: Mapping[str, Any]) -> None:
+        steps = list(event.get("plan") or [])
+        probs = list(event.get("step_p") or [])
+        assumptive = event.get("assumptive")
+        flags = ([i in set(assumptive) for i in range(len(steps))] if assumptive is not None
+                 else [s.startswith("(assume-") for s in steps])
+        index = len(self.plans) + 1
+        why = event.get("why", "")
+        replan = self._pending_replan
+        self._pending_replan = None
+        if steps:
+            self.tail = []
+        else:
+            self.tail.append(f"t={float(event.get('t') or 0.0):.1f} s: planned again ({why}): "
+                             f"{event.get('status')}")
+        self.plans.append({
+            "index": index, "t": event.get("t"), "why": why, "status": event.get("status"),
+            "probability": event.get("probability"), "cost": event.get("cost"),
+            "steps": [{"action": s, "p": probs[i] if i < len(probs) else None,
+                       "assumptive": flags[i]} for i, s in enumerate(steps)],
+            "replan": replan["index"] if replan else None,
+        })
+        if why == "timeout" and not steps:  # the CP hit its node or time limit
+            self._pending_replan = replan  # the fallback search follows at once and
+            return  # answers the same replan; the old plan's entries stay till then
+        signatures = self._signatures([s for s, a in zip(steps, flags, strict=False) if a])
+        keep = set(signatures.values())
+        cause = (f"plan {index} ({why}) no longer uses it" if steps else
+                 f"no plan found ({event.get('status')}) when planning {why}")
+        if replan is not None and steps:
+            cause += f"; replanned because {replan['summary']}"
+        for sig, entry in list(self.open.items()):
+            if sig not in keep and sig in self.open:
+                self._close(entry, "dropped", event.get("t"), cause)
+        self.current = {}
+        for i, step in enumerate(steps):
+            if not flags[i]:
+                continue
+            sig = signatures[step]
+            p = probs[i] if i < len(probs) else None
+            entry = self.open.get(sig)
+            if entry is None:
+                meaning, about = describe(step)
+                name = _strip(step)[0] if _strip(step) else step
+                entry = Assumption(f"A{len(self.assumptions) + 1}", step, meaning, name,
+                                   event.get("t"), index, _r(p), plans=[index], **about)
+                self.assumptions.append(entry)
+                self.open[sig] = entry
+            else:
+                entry.plans.append(index)
+                if p is not None and (entry.p_last is None or abs(entry.p_last - p) > 1e-4):
+                    entry.history.append({"t": event.get("t"), "p": _r(p),
+                                          "source": f"plan {index}"})
+            self.current[step] = sig
+
+    @staticmethod
+    def _signatures(steps: list[str]) -> dict[str, tuple]:
+        """An assumption's identity: its label and the identities of the earlier assumptions
+        it rests on: those that introduced the virtual objects it mentions, and the one that
+        gave its room the category it assumes an object for."""
+        introduced: dict[Any, tuple] = {}
+        out: dict[str, tuple] = {}
+        for step in steps:
+            name, *args = _strip(step) or [""]
+            uses: list[Any] = [n for n in args if _virtual(n)]
+            if name == "assume-obj-exists-in" and len(args) == 4:
+                uses.append(("category", args[1], args[2]))
+            elif name == "assume-obj-exists-on" and len(args) == 6:
+                uses.append(("category", args[4], args[3]))
+            deps: list[tuple] = []
+            for key in uses:
+                if key in introduced and introduced[key] not in deps:
+                    deps.append(introduced[key])
+            sig = (step, tuple(deps))
+            out[step] = sig
+            provides: list[Any] = [n for n in args if _virtual(n)]
+            if name == "assume-category" and len(args) == 2:
+                provides.append(("category", args[0], args[1]))
+            elif name == "assume-leads-to-room" and len(args) == 3:
+                provides.append(("category", args[2], args[1]))
+            for key in provides:
+                introduced.setdefault(key, sig)
+        return out
+
+    def _matched(self, matched: Mapping[str, str], t: Any) -> None:
+        """A real object matched a virtual one: the assumption that introduced the virtual
+        object came true; the plan's other steps now name the real object."""
+        evidence = "; ".join(self.since) if self.since else "a detection"
+        for virtual, real in matched.items():
+            for entry in list(self.open.values()):
+                names = _strip(entry.action)[1:]
+                if entry.kind.startswith("assume-obj-exists") and names[-1:] == [virtual]:
+                    self._close(entry, "confirmed", t, f"{virtual} matched {real}: a "
+                                f"{entry.label} was found there", evidence)
+        renamed: dict[str, tuple] = {}
+        for label, sig in self.current.items():
+            words = _strip(label)
+            new = "(" + " ".join(matched.get(w, w) for w in words) + ")"
+            renamed[label] = sig
+            if new != label:
+                renamed[new] = sig
+        self.current = renamed
+
+    def _entry(self, label: str | None) -> Assumption | None:
+        sig = self.current.get(label) if label else None
+        return self.open.get(sig) if sig is not None else None
+
+    def _on_monitor(self, event: Mapping[str, Any]) -> None:
+        t = event.get("t")
+        evidence = self._evidence_now()
+        for label in event.get("confirmed") or []:
+            entry = self._entry(label)
+            if entry is not None:
+                self._close(entry, "confirmed", t, "it came true", evidence)
+        for label, p in (event.get("assumptions") or {}).items():
+            entry = self._entry(label)
+            if entry is None:
+                continue
+            if entry.p_last is None or abs(entry.p_last - float(p)) > 1e-4:
+                entry.history.append({"t": t, "p": _r(p), "source": "monitor"})
+        self._monitor_evidence = evidence
+
+    def _evidence_now(self) -> str:
+        text = "; ".join(self.since) if self.since else "no new observation"
+        self.since = []
+        return text
+
+    def _on_replan(self, event: Mapping[str, Any]) -> None:
+        t = event.get("t")
+        verdict = event.get("status") or ""
+        step = event.get("action")
+        detail = event.get("detail") or ""
+        evidence = getattr(self, "_monitor_evidence", None) or self._evidence_now()
+        self._monitor_evidence = None
+        after = self.last_done
+        summary = f"{verdict.replace('_', ' ')}: {step}" + (f" ({detail})" if detail else "")
+        record = {"index": len(self.replans) + 1, "t": t, "verdict": verdict, "step": step,
+                  "detail": detail, "after": after["action"] if after else None,
+                  "after_detail": after["detail"] if after else None, "evidence": evidence,
+                  "plan_before": len(self.plans), "summary": summary}
+        entry = self._entry(step)
+        if entry is not None:
+            record["assumption"] = entry.id
+            if verdict == "assumption_contradicted":
+                if entry.p_last != 0.0:
+                    entry.history.append({"t": t, "p": 0.0, "source": "monitor"})
+                why = _why_refuted(entry, detail or verdict, self.went_to)
+                self._close(entry, "refuted", t, why, evidence)
+        self.replans.append(record)
+        self._pending_replan = record
+
+    def _on_done(self, event: Mapping[str, Any]) -> None:
+        self.done = {"t": event.get("t"), "outcome": event.get("outcome"),
+                     "reason": event.get("reason")}
+        for entry in list(self.open.values()):
+            self._close(entry, "unresolved", event.get("t"),
+                        f"still assumed when the episode ended ({event.get('outcome')})")
+
+    def _close(self, entry: Assumption, status: str, t: Any, reason: str,
+               by: str | None = None) -> None:
+        entry.status, entry.ended_at, entry.reason = status, t, reason
+        entry.by = by
+        sig = next((s for s, e in self.open.items() if e is entry), None)
+        if sig is None:
+            return
+        del self.open[sig]
+        if status == "confirmed":  # what rests on it now rests on a fact
+            self._rekey(sig)
+        if status in ("refuted", "dropped"):  # what rests on it falls with it
+            for other_sig, other in list(self.open.items()):
+                if sig in other_sig[1]:
+                    if status == "refuted":
+                        other.history.append({"t": t, "p": 0.0, "source": "monitor"})
+                    self._close(other, status, t, f"rests on {entry.id} ({entry.meaning}), "
+                                f"which was {status}", by)
+
+    def _rekey(self, fact: tuple) -> None:
+        """An assumption came true: the entries resting on it no longer do (a next plan
+        without it continues them)."""
+        for sig, entry in list(self.open.items()):
+            if fact in sig[1]:
+                new = (sig[0], tuple(d for d in sig[1] if d != fact))
+                del self.open[sig]
+                self.open[new] = entry
+                self.current = {k: new if v == sig else v for k, v in self.current.items()}
+
+    # ---- the explanation ---------------------------------------------------------------------
+
+    def explanation(self, final: Mapping[str, Any] | None = None) -> dict[str, Any]:
+        """The explanation as plain data; `final` holds the mind's beliefs at the end
+        (rooms with category beliefs and P(target), placeholders), when known."""
+        outcome = self.done or {"t": None, "outcome": "unfinished",
+                                "reason": "the trace has no done event"}
+        out: dict[str, Any] = {
+            "version": EXPLANATION_VERSION, **self.start, **outcome,
+            "events": self.events,
+            "plans": self.plans, "replans": self.replans,
+            "assumptions": [asdict(a) | {"p_last": a.p_last} for a in self.assumptions],
+            "search": self._search(),
+            "notes": self.notes,
+        }
+        if final:
+            out["final_beliefs"] = dict(final)
+        if outcome["outcome"] == "gave_up":
+            out["give_up"] = self._give_up(final)
+        out["summary"] = self._summary(out)
+        return out
+
+    def _search(self) -> dict[str, Any]:
+        kinds: dict[str, int] = {}
+        visited: dict[str, list[str]] = {}  # explore -> placeholders, sweep -> rooms, ...
+        for a in self.actions:
+            words = _strip(a["action"]) or [a["action"]]
+            kinds[words[0]] = kinds.get(words[0], 0) + 1
+            target = words[-1] if len(words) > 1 else None
+            if target is not None and words[0] in ("explore", "sweep", "classify", "move"):
+                seen = visited.setdefault(words[0], [])
+                if target not in seen:
+                    seen.append(target)
+        out = {"actions": self.actions, "action_counts": kinds, "visited": visited,
+               "dt_searches": self.searches, "observations": dict(self.observations)}
+        if self.flap["decisions"] or self.flap["regions"]:
+            out["flap"] = dict(self.flap)
+        return out
+
+    def _give_up(self, final: Mapping[str, Any] | None) -> dict[str, Any]:
+        """The room hypotheses tried (where a plan assumed the target could be) with their
+        first and final probability and why each was dropped; the rooms searched."""
+        rooms = (final or {}).get("rooms") or {}
+        placeholders = (final or {}).get("placeholders")
+        hypotheses: dict[tuple, dict[str, Any]] = {}
+        for a in self.assumptions:
+            if a.kind not in ("assume-leads-to-room", "assume-category"):
+                continue
+            key = (a.kind, a.subject, a.category)
+            h = hypotheses.get(key)
+            if h is None:
+                h = hypotheses[key] = {
+                    "hypothesis": a.meaning.split(" (new-")[0], "kind": a.kind,
+                    "subject": a.subject, "category": a.category, "assumptions": [],
+                    "plans": [], "p_first": a.p_first}
+            h["assumptions"].append(a.id)
+            h["plans"] += a.plans
+            h["p_last"] = a.p_last
+            h["status"], h["why_dropped"], h["by"], h["ended_at"] = (
+                a.status, a.reason, a.by, a.ended_at)
+            posterior = None
+            if a.kind == "assume-category" and a.subject in rooms:
+                posterior = (rooms[a.subject].get("category") or {}).get(a.category)
+                h["final_note"] = f"{a.subject} believed " + _dist(
+                    rooms[a.subject].get("category") or {}, 3)
+            elif a.kind == "assume-leads-to-room" and placeholders is not None:
+                if a.subject in placeholders:
+                    posterior = (placeholders[a.subject].get("category") or {}).get(a.category)
+                else:
+                    h["final_note"] = f"{a.subject} was explored (no longer a placeholder)"
+                    posterior = 0.0
+            h["p_final"] = _r(posterior) if posterior is not None else h["p_last"]
+        searched = [f"{s['label']} {s['relation']} {s['location']}: {s['result']}"
+                    for s in self.searches]
+        if not self.plans:  # a strategy without plans: what it went through is the story
+            return {"reason": (self.done or {}).get("reason"), "hypotheses": [],
+                    "searched": searched, "then": []}
+        return {"reason": (self.done or {}).get("reason"),
+                "hypotheses": list(hypotheses.values()), "searched": searched,
+                "then": list(self.tail)}
+
+    def _summary(self, out: Mapping[str, Any]) -> list[str]:
+        lines = [f"{out.get('target')} in {out.get('world')} ({out.get('strategy')}, seed "
+                 f"{out.get('seed')}): {out.get('outcome')}: {out.get('reason')}"]
+        if self.plans:
+            counts: dict[str, int] = {}
+            for a in self.assumptions:
+                counts[a.status] = counts.get(a.status, 0) + 1
+            lines.append(f"{len(self.plans)} plans, {len(self.replans)} replans, "
+                         f"{len(self.assumptions)} assumptions ("
+                         + ", ".join(f"{n} {s}" for s, n in sorted(counts.items())) + ")")
+        if "give_up" in out:
+            hyps = out["give_up"]["hypotheses"]
+            lines.append(f"gave up after trying {len(hyps)} room hypotheses: " + "; ".join(
+                f"{h['hypothesis']} ({h['status']})" for h in hyps))
+        return lines
+
+
+def build(events: Iterable[Mapping[str, Any]], final: Mapping[str, Any] | None = None
+          ) -> dict[str, Any]:
+    """The explanation of a whole trace."""
+    ledger = Ledger()
+    for event in events:
+        ledger.feed(event)
+    return ledger.explanation(final)
+
+
+def read_trace(path: Path) -> list[dict[str, Any]]:
+    """The events of a trace.jsonl; a bad line is an error naming the file and line."""
+    events = []
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except OSError as exc:
+        raise ExplainError(f"{path}: cannot read the trace ({exc.strerror})") from None
+    for n, line in enumerate(lines, 1):
+        if not line.strip():
+            continue
+        try:
+            event = json.loads(line)
+        except json.JSONDecodeError as exc:
+            raise ExplainError(f"{path}:{n}: not a JSON event ({exc.msg})") from None
+        if not isinstance(event, dict):
+            raise ExplainError(f"{path}:{n}: an event must be a JSON object")
+        events.append(event)
+    return events
+
+
+def load(run_dir: Path, rebuild: bool = False) -> dict[str, Any]:
+    """A run folder's explanation: its explanation.json, or rebuilt from its trace.jsonl
+    (when there is none, or `rebuild`)."""
+    run_dir = Path(run_dir)
+    if not run_dir.is_dir():
+        raise ExplainError(f"{run_dir}: no such run folder")
+    saved = run_dir / FILE_NAME
+    if saved.is_file() and not rebuild:
+        try:
+            data = json.loads(saved.read_text(encoding="utf-8"))
+        except (OSError, json.JSONDecodeError) as exc:
+            raise ExplainError(f"{saved}: not a readable explanation ({exc})") from None
+        if not isinstance(data, dict):
+            raise ExplainError(f"{saved}: an explanation must be a JSON object")
+        return data
+    trace = run_dir / "trace.jsonl"
+    if not trace.is_file():
+        raise ExplainError(f"{run_dir}: neither {FILE_NAME} nor trace.jsonl is there (is it "
+                           f"an episode's output folder?)")
+    return build(read_trace(trace))
+
+
+def write(path: Path, explanation: Mapping[str, Any]) -> None:
+    path.write_text(json.dumps(explanation, indent=2, default=str) + "\n", encoding="utf-8")
+
+
+def final_beliefs(mind: Any, target: str) -> dict[str, Any]:
+    """The mind's beliefs at the end of an episode: each room's category belief and P(target
+    in it), each placeholder's belief about what lies behind it."""
+    cmap, pm = mind.cmap, mind.place_map
+    rooms: dict[str, Any] = {}
+    for rid in sorted(pm.rooms):
+        if not cmap.graph.has_room(rid):
+            continue
+        category = cmap.room_category(rid)
+        try:
+            p_target = cmap.p_object_at(target, rid)
+        except Exception:  # noqa: BLE001 - a label the knowledge base does not know
+            p_target = None
+        rooms[rid] = {"category": _top(category), "p_target": _r(p_target)}
+    placeholders: dict[str, Any] = {}
+    for pid in sorted(pm.placeholders):
+        try:
+            category = cmap.placeholder_category(pid)
+        except Exception:  # noqa: BLE001 - a placeholder the conceptual map has not seen yet
+            continue
+        placeholders[pid] = {"category": _top(category)}
+    return {"rooms": rooms, "placeholders": placeholders}
+
+
+def _top(dist: Mapping[str, float], n: int = 4) -> dict[str, float]:
+    items = sorted(dist.items(), key=lambda kv: -kv[1])[:n]
+    return {k: round(float(v), 4) for k, v in items}
+
+
+# ---- text ------------------------------------------------------------------------------------
+
+
+def _p(value: Any) -> str:
+    return "?" if value is None else f"{float(value):.3g}"
+
+
+def _t(value: Any) -> str:
+    return "?" if value is None else f"{float(value):.1f} s"
+
+
+def render(explanation: Mapping[str, Any]) -> str:
+    """The explanation as readable text (what `avs explain` prints)."""
+    e = explanation
+    out: list[str] = []
+    head = (f"Episode: find {e.get('target')} in {e.get('world')} ({e.get('strategy')}, "
+            f"{e.get('robot')}, seed {e.get('seed')})")
+    out += [head, f"Outcome: {e.get('outcome')} at t={_t(e.get('t'))}: {e.get('reason')}", ""]
+    plans = e.get("plans") or []
+    if plans:
+        out.append(f"Plans ({len(plans)}):")
+        for plan in plans:
+            steps = plan.get("steps") or []
+            marked = [("[assume] " if s.get("assumptive") else "") + s["action"]
+                      + (f" p={_p(s['p'])}" if s.get("assumptive") and s.get("p") is not None
+                         else "") for s in steps]
+            if marked:
+                body = "; ".join(marked)
+            elif plan.get("why") == "timeout":
+                body = (f"the planner stopped at its limit ({plan.get('status')}); planned again "
+                        f"with the fallback heuristic")
+            else:
+                body = f"no plan ({plan.get('status')})"
+            out.append(f"  #{plan['index']} t={_t(plan.get('t'))} {plan.get('why')}, "
+                       f"p={_p(plan.get('probability'))}: {body}")
+        out.append("")
+    assumptions = e.get("assumptions") or []
+    if assumptions:
+        out.append(f"Assumptions ({len(assumptions)}):")
+        for a in assumptions:
+            history = " -> ".join(_p(h["p"]) for h in a.get("history") or [])
+            trail = f"p {_p(a.get('p_first'))}" + (f" -> {history}" if history else "")
+            out.append(f"  {a['id']} {a['meaning']}: assumed at t={_t(a.get('assumed_at'))} "
+                       f"(plan {a.get('plan')}), {trail}")
+            line = f"     {a['status']} at t={_t(a.get('ended_at'))}: {a.get('reason')}"
+            out.append(line)
+            if a.get("by"):
+                out.append(f"     by: {a['by']}")
+        out.append("")
+    replans = e.get("replans") or []
+    if replans:
+        out.append(f"Replans ({len(replans)}):")
+        for r in replans:
+            after = f" after {r['after']}" if r.get("after") else ""
+            if r.get("after_detail"):
+                after += f" ({r['after_detail']})"
+            out.append(f"  t={_t(r.get('t'))}{after}: {r.get('summary')}")
+        out.append("")
+    give_up = e.get("give_up")
+    if give_up and plans:
+        hyps = give_up.get("hypotheses") or []
+        out.append(f"Gave up: {give_up.get('reason')}")
+        out.append(f"  Room hypotheses tried ({len(hyps)}):")
+        for h in hyps:
+            plans_ = ", ".join(str(p) for p in sorted(set(h.get("plans") or [])))
+            out.append(f"  - {h['hypothesis']}: p {_p(h.get('p_first'))} when first assumed, "
+                       f"final {_p(h.get('p_final'))} (plans {plans_})")
+            why = h.get("why_dropped")
+            out.append(f"      {h.get('status')} at t={_t(h.get('ended_at'))}: {why}")
+            if h.get("by"):
+                out.append(f"      by: {h['by']}")
+            if h.get("final_note"):
+                out.append(f"      at the end: {h['final_note']}")
+        if give_up.get("searched"):
+            out.append("  Searched: " + "; ".join(give_up["searched"]))
+        if give_up.get("then"):
+            out.append("  After the last plan:")
+            out += [f"    {line}" for line in give_up["then"]]
+        out.append("")
+    search = e.get("search") or {}
+    counts = search.get("action_counts") or {}
+    if plans and counts:
+        out.append("What it did:")
+    if not plans:
+        out.append(f"Search ({e.get('strategy')} does not plan with assumptions, so there is "
+                   f"no assumption ledger):")
+    if counts or not plans:
+        if counts:
+            out.append("  steps: " + ", ".join(f"{n}x {k}" for k, n in counts.items()))
+        for kind, targets in (search.get("visited") or {}).items():
+            if kind == "move":
+                continue
+            out.append(f"  {kind}: {', '.join(targets)} ({len(targets)})")
+        for s in search.get("dt_searches") or []:
+            out.append(f"  DT search t={_t(s.get('t'))}: {s.get('label')} {s.get('relation')} "
+                       f"{s.get('location')}: {s.get('result')} (p {_p(s.get('probability'))})")
+        flap = search.get("flap")
+        if flap:
+            regions = ", ".join(f"{r['name']} (p {_p(r['p'])})" for r in flap["regions"])
+            out.append(f"  FLAP: regions {regions or 'none'}; {flap['decisions']} decisions, "
+                       f"{flap['views']} views")
+            last = flap.get("last_decision")
+            if last:
+                out.append(f"    last decision (cycle {last['cycle']}): {last['status']}, "
+                           f"P(target still unseen in the regions) {_p(last['p_remaining'])}")
+        obs = search.get("observations") or {}
+        out.append(f"  detections: {obs.get('confirmed', 0)} confirmed, "
+                   f"{obs.get('not_confirmed', 0)} not confirmed")
+        if not plans:
+            out.append(f"  ended: {e.get('outcome')}: {e.get('reason')}")
+    final = e.get("final_beliefs") or {}
+    if final.get("rooms"):
+        out.append("")
+        out.append(f"Beliefs at the end (P({e.get('target')} in room), room category):")
+        for rid, room in final["rooms"].items():
+            out.append(f"  {rid}: P={_p(room.get('p_target'))}, "
+                       f"{_dist(room.get('category') or {}, 3)}")
+    notes = e.get("notes") or []
+    if notes:
+        out.append("")
+        out.append("Notes:")
+        out += [f"  {n}" for n in notes]
+    return "\n".join(out).rstrip() + "\n"
