@@ -55,6 +55,14 @@ class TaskCreate(BaseModel):
                           description="search strategy (GET /v1/strategies lists them)")
     strategy_options: dict[str, OptionValue] = Field(
         default_factory=dict, max_length=50, description="the strategy's options by name")
+    qsr: list[dict[str, Any]] | dict[str, Any] | None = Field(
+        None, description="QSR descriptions of where the target is (strategies qsr, "
+        "supporting-planes, random and the switching planner's cones): a list in the format of "
+        "the QSR knowledge file's `descriptions` (or {descriptions: [...]}), e.g. [{target: "
+        "cup, relations: [right, close], of: keyboard, count: 1}]; see "
+        "conceptual_map/qsr/README.md. Default: the built-in QSR knowledge",
+        examples=[[{"target": "cup", "relations": ["right", "close"], "of": "keyboard",
+                    "count": 1}]])
 
     @model_validator(mode="after")
     def _one_world(self) -> TaskCreate:

@@ -1,7 +1,8 @@
 """QSR indirect search (seed 002) timings: view selection, mixture fit, supporting planes.
 
 The scene is the seed-style desk room (`sim/worlds/qsr_desks.yaml`, 8 x 6 m, 5 cm voxels) as fully
-observed synthetic maps. View selection (Algorithm 1, 20 poses, 2D cones + nine 3D frustums) is
+observed synthetic maps. View selection (Algorithm 1, 20 poses, 2D cones + nine 3D frustums),
+without and with line of sight through the voxel map (what the strategies use), is
 printed beside the issue's 20 ms target and beside Algorithm 1's double loop written literally
 in Python (same poses, same voxels, same density), measured in the same run.
 Run: `.venv/bin/python -m bench.qsr_bench [--quick]`.
@@ -81,7 +82,7 @@ def main(argv: list[str] | None = None) -> int:
                     repeats)  # fmt: skip
     occluded = ViewOptions(occlusion=voxels)
     occluded_ms = timed(lambda i: select_view(grid, planes.points, density, PIONEER, "qsr",
-                                              rng=i, options=occluded), max(3, repeats // 5))
+                                              rng=i, options=occluded), repeats)
     poses = sample_poses(grid, planes.points, 20, 0.25, 4.0, np.random.default_rng(0))
     half = PIONEER.hfov / 2
     ours_score = timed(lambda i: score_cones(poses, planes.points, density, half, 4.0), repeats)
@@ -100,8 +101,7 @@ def main(argv: list[str] | None = None) -> int:
     rows = [
         ("view selection, 20 poses + 9 frustums (cold)", med(cold_ms), target),
         ("view selection, 20 poses + 9 frustums (warm)", med(warm_ms), target),
-        ("view selection with occlusion (strategies)", med(occluded_ms),
-         "no target (line of sight per pair)"),
+        ("view selection with line of sight (strategies)", med(occluded_ms), target),
         ("eq. 2 scores of 20 cones (numpy)", med(ours_score),
          f"{med(ref_score):.1f} ms literal loop ({med(ref_score) / med(ours_score):.0f}x)"),
         ("supporting-plane extraction", med(plane_ms), "no target"),
@@ -112,7 +112,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{name:<46} {ours:8.2f} {ref:>36}")
     print(f"literal Algorithm 1 gives the same sums: {same}; cold = the 2D map's clearance "
           f"recomputed, warm = cached")
-    return 0 if same and med(cold_ms) <= TARGET_VIEW_MS else 1
+    met = max(med(cold_ms), med(occluded_ms)) <= TARGET_VIEW_MS
+    print(f"view selection target (<= {TARGET_VIEW_MS:.0f} ms, with and without line of sight): "
+          f"{'met' if met else 'MISSED'}")
+    return 0 if same and met else 1
 
 
 if __name__ == "__main__":

@@ -97,6 +97,7 @@ class Executor:
         self.seen_while_moving: dict[str, set[Atom]] = {}
         self.dt_session: Any = None  # the last SEARCHFOROBJECT's DTSession (read by observers)
         self._unplaced: list[SeenLike] = []
+        self.qsr_cones: Any = None  # QSR-weighted support cones (episode/qsr_cones.install)
 
     # ---- sensing along the way --------------------------------------------------------------
 
@@ -476,13 +477,16 @@ class Executor:
                 return StepOutcome(StepStatus.FAILED, f"{location} is not a known object")
             if p is None:
                 p = self.mind.cmap.p_object_at(label, ("on", location))
-            made = (self.support_views or support_cones)(self.mind, support, p, self.camera, key)
+            made = (self.support_views is None and self.qsr_cones
+                    and self.qsr_cones.support_cones(label, support, p, key)) or \
+                (self.support_views or support_cones)(self.mind, support, p, self.camera, key)
         else:
             if location not in self.mind.place_map.rooms:
                 return StepOutcome(StepStatus.FAILED, f"{location} is not a known room")
             if p is None:
                 p = self.mind.cmap.p_object_at(label, location)
-            made = room_cones(self.mind, location, label, p, self.camera, key)
+            made = (self.qsr_cones and self.qsr_cones.room_cones(label, location, p, key)) or \
+                room_cones(self.mind, location, label, p, self.camera, key)
         self.cones[(label, relation, location)] = made
         self.mind.cones_made.add((label, relation, location))
         self.emit("action", action="createviewcones", cones=len(made.cones),

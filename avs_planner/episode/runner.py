@@ -8,6 +8,7 @@ explanation.json (`episode.explain`) and, when asked (`record`), recording.rrd (
 from __future__ import annotations
 
 import math
+import reprlib
 import tempfile
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -95,7 +96,7 @@ class EpisodeSpec:
             output_dir=spec.get("output_dir"), pre_explore=bool(spec.get("pre_explore")),
             dt_policy=str(spec.get("dt_policy") or "pouct"), strategy=strategy.name,
             strategy_options=options, generate=generate, world_text=spec.get("world_file"),
-            qsr=_qsr(spec.get("qsr")), **_recording(spec),
+            qsr=qsr_descriptions(spec.get("qsr")), **_recording(spec),
         )
 
 
@@ -128,9 +129,10 @@ def _recording(spec: Mapping[str, Any]) -> dict[str, bool]:
     return out
 
 
-def _qsr(data: Any) -> Any:
-    """The task's QSR descriptions (a list in the format of conceptual_map/qsr/README.md)
-    validated against the default knowledge's relations and landmarks; None when not given."""
+def qsr_descriptions(data: Any, source: str = "episode spec: qsr") -> Any:
+    """The task's QSR descriptions (a list in the format of conceptual_map/qsr/README.md, or
+    {descriptions: [...]}) validated against the default knowledge's relations and landmarks,
+    as a QsrKnowledge; None when not given. EpisodeError names the bad entry."""
     if data is None:
         return None
     from conceptual_map.errors import KnowledgeError
@@ -141,9 +143,9 @@ def _qsr(data: Any) -> Any:
     if not isinstance(data, list) or not data:
         raise EpisodeError(f"episode spec: 'qsr' must be a non-empty list of QSR descriptions "
                            f"like [{{target: cup, relations: [right, close], of: keyboard, "
-                           f"count: 1}}], got {data!r}")
+                           f"count: 1}}], got {reprlib.repr(data)}")
     try:
-        return parse_descriptions(data, load_qsr(), source="episode spec: qsr")
+        return parse_descriptions(data, load_qsr(), source=source)
     except KnowledgeError as exc:
         raise EpisodeError(str(exc)) from None
 

@@ -39,7 +39,7 @@ class FieldProblem:
 def check_task(task: Mapping[str, Any], world_path: Path | None = None) -> list[FieldProblem]:
     """Everything wrong with `task` (the episode spec keys), or []; `world_path` is the file of
     the built-in world `task["world"]` names (ignored when `world_file` is given)."""
-    problems = _check_strategy(task) + _check_labels(task, _knowledge())
+    problems = _check_strategy(task) + _check_labels(task, _knowledge()) + _check_qsr(task)
     field = "world_file" if task.get("world_file") is not None else "world"
     try:
         spec = _world(task, world_path)
@@ -82,6 +82,20 @@ def _check_labels(task: Mapping[str, Any], knowledge: Knowledge) -> list[FieldPr
         problems.append(FieldProblem("category", f"unknown room category {category!r}; the "
                                      f"knowledge base knows {_listed(knowledge.categories)}"))
     return problems
+
+
+def _check_qsr(task: Mapping[str, Any]) -> list[FieldProblem]:
+    """The task's QSR descriptions, checked as the episode runner reads them (each message
+    names the entry, e.g. `qsr: descriptions[1].of: unknown landmark label 'sofa' ...`)."""
+    if task.get("qsr") is None:
+        return []
+    from avs_planner.episode.runner import qsr_descriptions
+
+    try:
+        qsr_descriptions(task["qsr"], source="qsr")
+    except EpisodeError as exc:
+        return [FieldProblem("qsr", str(exc).removeprefix("episode spec: "))]
+    return []
 
 
 def _listed(names: Sequence[str] | frozenset[str]) -> str:

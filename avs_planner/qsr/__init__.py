@@ -1,6 +1,7 @@
 """QSR view selection (Kunze et al., eq. 2 and Algorithm 1): where to stand and where to look."""
 
 from avs_planner.qsr.geometry import in_frustums, in_view_cones, line_of_sight
+from avs_planner.qsr.landmarks import OPEN_SIDE_RADIUS, LandmarkTracker, landmarks_from, open_side
 from avs_planner.qsr.poses import candidate_cells, reachable, sample_poses
 from avs_planner.qsr.select import (
     Frustum,
@@ -17,6 +18,10 @@ from avs_planner.qsr.select import (
 )
 
 __all__ = [
+    "OPEN_SIDE_RADIUS",
+    "LandmarkTracker",
+    "landmarks_from",
+    "open_side",
     "Frustum",
     "ScoredPose",
     "SelectionStatus",

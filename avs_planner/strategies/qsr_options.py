@@ -15,7 +15,8 @@ OPTIONS: dict[str, Any] = {
     "confirm_frames": 2,  # frames to confirm a first detection (any one agreeing suffices)
     "uniform_floor": 0.02,  # qsr: share of uniform density mixed in (wrong QSRs stay findable)
     "max_poses": 40,  # view poses before giving up regardless of time
-    "survey_stops": 3,  # frontier stops of the survey (after looking round at the start)
+    "survey_stops": 12,  # frontier stops of the survey at most (after looking round at the
+    # start); it ends sooner when no frontier is left: the seed starts with complete maps
     "survey_headings": 8,  # directions looked at per survey stop
     "depth_columns": 64,  # depth frame size (columns x rows)
     "depth_rows": 48,

@@ -102,3 +102,47 @@ def test_default_robot_comes_from_the_world_file(tmp_path: Path) -> None:
     world.write_text(PR2_WORLD)
     spec = EpisodeSpec.from_dict({"target": "cup", "world": str(world), "robot": None})
     assert load_spec(spec.world, spec.robot).robot.model == "pr2"
+
+
+CUP_RIGHT = {"target": "cup", "relations": ["right", "close"], "of": "keyboard", "count": 2}
+
+
+@pytest.mark.parametrize(("qsr", "names"), [
+    ([{**CUP_RIGHT, "of": "sofa"}], "descriptions[0].of: unknown landmark label 'sofa'"),
+    ([CUP_RIGHT, {**CUP_RIGHT, "relations": ["up"]}], "descriptions[1].relations"),
+    ([{**CUP_RIGHT, "count": -1}], "descriptions[0].count: must be > 0"),
+    ([{"target": "cup", "of": "keyboard"}], "descriptions[0]: missing key(s) count"),
+    ([], "non-empty list"),
+    ({"descriptions": [{**CUP_RIGHT, "via": [{"relations": ["front"], "of": "lamp"}]}]},
+     "descriptions[0].via[0].of"),
+])
+def test_bad_qsr_descriptions_are_422_naming_the_entry(client: TestClient, qsr: Any,
+                                                       names: str) -> None:
+    response = client.post("/v1/tasks", json={**GOOD, "target": "cup", "strategy": "qsr",
+                                              "qsr": qsr})
+    assert response.status_code == 422, response.text
+    [error] = [e for e in response.json()["detail"] if e["loc"] == ["body", "qsr"]]
+    assert names in error["msg"]
+
+
+def test_a_qsr_field_of_the_wrong_shape_is_422_not_500(client: TestClient) -> None:
+    for qsr in ("cup right of keyboard", 3, [1, 2]):
+        response = client.post("/v1/tasks", json={**GOOD, "target": "cup", "qsr": qsr})
+        assert response.status_code == 422, response.text
+        assert all(e["loc"][:2] == ["body", "qsr"] for e in response.json()["detail"])
+
+
+def test_a_task_with_qsr_descriptions_is_accepted_and_reaches_the_episode(
+        client: TestClient) -> None:
+    from avs_planner.episode.runner import EpisodeSpec
+
+    for qsr in ([CUP_RIGHT], {"descriptions": [CUP_RIGHT]}):
+        accepted = client.post("/v1/tasks", json={"target": "cup", "world": "qsr_desks_a",
+                                                  "strategy": "qsr", "qsr": qsr})
+        assert accepted.status_code == 202, accepted.text
+        request = accepted.json()["request"]
+        assert request["qsr"] == qsr
+        spec = EpisodeSpec.from_dict({**request, "task_id": "t", "output_dir": None})
+        [description] = spec.qsr.descriptions_for("cup")
+        assert description.text() == "right(cup, keyboard) & close(cup, keyboard)"
+        assert description.count == 2

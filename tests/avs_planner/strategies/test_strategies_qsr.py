@@ -9,8 +9,9 @@ import pytest
 
 from avs_planner.episode import EpisodeError, run_episode
 from avs_planner.episode.runner import EpisodeSpec
+from avs_planner.qsr import LandmarkTracker, open_side
 from avs_planner.strategies import get_strategy
-from avs_planner.strategies.qsr import LandmarkTracker, forget_learnt, open_side
+from avs_planner.strategies.qsr import forget_learnt
 from conceptual_map.metric import OccupancyGrid
 from conceptual_map.qsr import load_qsr
 
