@@ -93,7 +93,7 @@ _SWITCHING_OPTIONS = {f.name: f.default for f in fields(LoopConfig)
 # the 3D map; avs_planner/strategies/flap_views.py)
 _SWITCHING_OPTIONS["views"] = "cones"
 # QSR-weighted cones when QSRs are known for the target: on|off|observe (strategies/switching.py)
-_SWITCHING_OPTIONS["qsr_cones"] = "on"
+_SWITCHING_OPTIONS["qsr_cones"] = "off"
 
 _FLAP_OPTIONS = {  # avs_planner/strategies/flap.py
     "greedy": False,  # next best view by p/t (the seed's baseline) instead of branch and bound
