@@ -22,11 +22,22 @@ explanation has: what was searched, what was seen, and why the search ended.
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Iterable, Mapping
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
+
+from avs_planner.episode.explain_terms import (
+    Assumption,
+    action_words,
+    describe,
+    destination,
+    distribution_text,
+    evidence,
+    is_virtual,
+    rounded,
+    why_refuted,
+)
 
 EXPLANATION_VERSION = 1
 FILE_NAME = "explanation.json"
@@ -34,143 +45,6 @@ FILE_NAME = "explanation.json"
 
 class ExplainError(ValueError):
     """A run folder or trace that cannot be explained (the message names the file)."""
-
-
-@dataclass
-class Assumption:
-    """One assumption's life in the ledger."""
-
-    id: str
-    action: str
-    meaning: str
-    kind: str
-    assumed_at: float
-    plan: int  # the plan that first used it (1-based)
-    p_first: float | None
-    history: list[dict[str, Any]] = field(default_factory=list)  # {t, p, source}
-    plans: list[int] = field(default_factory=list)
-    status: str = "open"  # open | confirmed | refuted | dropped | unresolved
-    ended_at: float | None = None
-    by: str | None = None  # the observation that settled it
-    reason: str | None = None
-    subject: str | None = None  # the room or placeholder it is about
-    category: str | None = None
-    label: str | None = None  # the object label it is about (obj-exists)
-
-    @property
-    def p_last(self) -> float | None:
-        return self.history[-1]["p"] if self.history else self.p_first
-
-
-def _strip(label: str) -> list[str]:
-    return label.strip().strip("()").split()
-
-
-def _virtual(name: str) -> bool:
-    return name.startswith("new-")
-
-
-def _a(noun: str) -> str:
-    return f"{'an' if noun[:1].lower() in 'aeiou' else 'a'} {noun}"
-
-
-def describe(action: str) -> tuple[str, dict[str, str | None]]:
-    """What an assumptive step assumes, in words, and its subject, category and label."""
-    name, *args = _strip(action) or [""]
-    if name == "assume-leads-to-room" and len(args) == 3:
-        return (f"{_a(args[1])} lies behind {args[0]} ({args[2]})",
-                {"subject": args[0], "category": args[1], "label": None})
-    if name == "assume-category" and len(args) == 2:
-        return f"{args[0]} is {_a(args[1])}", {"subject": args[0], "category": args[1],
-                                                "label": None}
-    if name == "assume-obj-exists-in" and len(args) == 4:
-        return (f"{_a(args[0])} is in {args[1]} (as {_a(args[2])}) ({args[3]})",
-                {"subject": args[1], "category": args[2], "label": args[0]})
-    if name == "assume-obj-exists-on" and len(args) == 6:
-        return (f"{_a(args[0])} is on {args[1]} ({_a(args[2])} in {args[4]}, as "
-                f"{_a(args[3])}) ({args[5]})",
-                {"subject": args[1], "category": args[3], "label": args[0]})
-    return f"{action} holds", {"subject": args[0] if args else None, "category": None,
-                               "label": None}
-
-
-def _evidence(event: Mapping[str, Any]) -> str | None:
-    """One event as evidence, in words (None for events that say nothing new)."""
-    kind = event.get("type")
-    if kind == "action" and event.get("status") not in (None, "start"):
-        detail = event.get("detail") or ""
-        text = f"{event.get('action')} {event.get('status')}" + (f": {detail}" if detail else "")
-        category = event.get("category")
-        if isinstance(category, Mapping) and category:
-            text += " (now " + _dist(category) + ")"
-        return text
-    if kind == "observation":
-        where = event.get("position")
-        at = f" at ({where[0]:.2f}, {where[1]:.2f})" if isinstance(where, list | tuple) and \
-            len(where) >= 2 else ""
-        seen = "confirmed" if event.get("detected") else "not confirmed"
-        if event.get("detected") is False and not at:
-            return None  # a look that saw nothing: the dt event sums these up
-        return f"{event.get('label')} {seen}{at}"
-    if kind == "dt":
-        return (f"DT search for {event.get('label')} {event.get('relation')} "
-                f"{event.get('location')}: {event.get('result')} after {event.get('steps')} "
-                f"steps (p {event.get('probability')})")
-    if kind == "belief":
-        if "blocked" in event:
-            return f"blocked: {event.get('detail')}"
-        if "doubt_categories" in event:
-            return (f"room categories believed below {event['doubt_categories']} doubted "
-                    f"again ({event.get('reason')})")
-        if "retry_blocked" in event:
-            return f"blocked spots tried again: {', '.join(event['retry_blocked'])}"
-        if "cut_off" in event:
-            return "cut off: " + "; ".join(event["cut_off"])
-        if "dropped_support" in event:
-            return f"support label {event['dropped_support']} dropped ({event.get('reason')})"
-        if "matched" in event:
-            return "matched " + ", ".join(f"{k} = {v}" for k, v in event["matched"].items())
-    return None
-
-
-def _destination(action: str) -> str | None:
-    """Where a move or explore step went."""
-    words = _strip(action)
-    if len(words) == 3 and words[0] == "move":
-        return words[2]
-    if len(words) == 2 and words[0] == "explore":
-        return words[1]
-    return None
-
-
-def _why_refuted(entry: Assumption, detail: str, went_to: Mapping[str, float]) -> str:
-    """The monitor's verdict on a contradicted assumption, read with where the robot went."""
-    if entry.kind == "assume-leads-to-room" and "no longer possible" in detail:
-        if went_to.get(entry.subject or "", -math.inf) >= float(entry.assumed_at or 0.0):
-            return (f"{entry.subject} was explored (the robot went there): it is no longer "
-                    f"a placeholder, so no unseen {entry.category} can be assumed behind it "
-                    f"(monitor: {detail})")
-        return (f"{entry.subject} is no longer a placeholder (the map grew over it), so no "
-                f"unseen {entry.category} can be assumed behind it (monitor: {detail})")
-    if entry.kind == "assume-category" and "no longer possible" in detail:
-        return (f"the planner no longer offers {entry.category} for {entry.subject}: its "
-                f"category belief is taken as settled, or the room changed as the map grew "
-                f"(monitor: {detail})")
-    if entry.kind.startswith("assume-obj-exists") and "defined-exists" in detail:
-        where = "in" if entry.kind == "assume-obj-exists-in" else "on"
-        return (f"{_a(entry.label or 'object')} may no longer be assumed {where} "
-                f"{entry.subject}: the searches there came back empty (or one was found "
-                f"there already) (monitor: {detail})")
-    return f"monitor: {detail}"
-
-
-def _dist(category: Mapping[str, Any], n: int = 2) -> str:
-    items = sorted(category.items(), key=lambda kv: -float(kv[1]))[:n]
-    return ", ".join(f"{k} {float(v):.2f}" for k, v in items)
-
-
-def _r(value: Any) -> float | None:
-    return None if value is None else round(float(value), 4)
 
 
 class Ledger:
@@ -204,7 +78,7 @@ class Ledger:
         self.events += 1
         kind = event.get("type")
         handler = getattr(self, f"_on_{kind}", None)
-        text = _evidence(event)
+        text = evidence(event)
         if text is not None:
             self.since.append(text)
             self.tail.append(f"t={float(event.get('t') or 0.0):.1f} s: {text}")
@@ -221,7 +95,7 @@ class Ledger:
                   "status": event.get("status"), "detail": event.get("detail") or ""}
         self.actions.append(record)
         self.last_done = record
-        where = _destination(str(record["action"]))
+        where = destination(str(record["action"]))
         if where is not None:
             self.went_to[where] = float(record["t"] or 0.0)
 
@@ -239,7 +113,7 @@ class Ledger:
         for key in ("cut_off", "doubt_categories", "retry_blocked", "dropped_support",
                     "most_likely"):
             if key in event:
-                text = _evidence(event)
+                text = evidence(event)
                 if text is None:  # most_likely: the baselines' next room or placeholder
                     text = (f"most likely {event.get('kind')}: {event['most_likely']} "
                             f"(p {event.get('probability')})")
@@ -301,15 +175,15 @@ class Ledger:
             entry = self.open.get(sig)
             if entry is None:
                 meaning, about = describe(step)
-                name = _strip(step)[0] if _strip(step) else step
+                name = action_words(step)[0] if action_words(step) else step
                 entry = Assumption(f"A{len(self.assumptions) + 1}", step, meaning, name,
-                                   event.get("t"), index, _r(p), plans=[index], **about)
+                                   event.get("t"), index, rounded(p), plans=[index], **about)
                 self.assumptions.append(entry)
                 self.open[sig] = entry
             else:
                 entry.plans.append(index)
                 if p is not None and (entry.p_last is None or abs(entry.p_last - p) > 1e-4):
-                    entry.history.append({"t": event.get("t"), "p": _r(p),
+                    entry.history.append({"t": event.get("t"), "p": rounded(p),
                                           "source": f"plan {index}"})
             self.current[step] = sig
 
@@ -321,8 +195,8 @@ class Ledger:
         introduced: dict[Any, tuple] = {}
         out: dict[str, tuple] = {}
         for step in steps:
-            name, *args = _strip(step) or [""]
-            uses: list[Any] = [n for n in args if _virtual(n)]
+            name, *args = action_words(step) or [""]
+            uses: list[Any] = [n for n in args if is_virtual(n)]
             if name == "assume-obj-exists-in" and len(args) == 4:
                 uses.append(("category", args[1], args[2]))
             elif name == "assume-obj-exists-on" and len(args) == 6:
@@ -333,7 +207,7 @@ class Ledger:
                     deps.append(introduced[key])
             sig = (step, tuple(deps))
             out[step] = sig
-            provides: list[Any] = [n for n in args if _virtual(n)]
+            provides: list[Any] = [n for n in args if is_virtual(n)]
             if name == "assume-category" and len(args) == 2:
                 provides.append(("category", args[0], args[1]))
             elif name == "assume-leads-to-room" and len(args) == 3:
@@ -348,13 +222,13 @@ class Ledger:
         evidence = "; ".join(self.since) if self.since else "a detection"
         for virtual, real in matched.items():
             for entry in list(self.open.values()):
-                names = _strip(entry.action)[1:]
+                names = action_words(entry.action)[1:]
                 if entry.kind.startswith("assume-obj-exists") and names[-1:] == [virtual]:
                     self._close(entry, "confirmed", t, f"{virtual} matched {real}: a "
                                 f"{entry.label} was found there", evidence)
         renamed: dict[str, tuple] = {}
         for label, sig in self.current.items():
-            words = _strip(label)
+            words = action_words(label)
             new = "(" + " ".join(matched.get(w, w) for w in words) + ")"
             renamed[label] = sig
             if new != label:
@@ -377,7 +251,7 @@ class Ledger:
             if entry is None:
                 continue
             if entry.p_last is None or abs(entry.p_last - float(p)) > 1e-4:
-                entry.history.append({"t": t, "p": _r(p), "source": "monitor"})
+                entry.history.append({"t": t, "p": rounded(p), "source": "monitor"})
         self._monitor_evidence = evidence
 
     def _evidence_now(self) -> str:
@@ -404,7 +278,7 @@ class Ledger:
             if verdict == "assumption_contradicted":
                 if entry.p_last != 0.0:
                     entry.history.append({"t": t, "p": 0.0, "source": "monitor"})
-                why = _why_refuted(entry, detail or verdict, self.went_to)
+                why = why_refuted(entry, detail or verdict, self.went_to)
                 self._close(entry, "refuted", t, why, evidence)
         self.replans.append(record)
         self._pending_replan = record
@@ -470,7 +344,7 @@ class Ledger:
         kinds: dict[str, int] = {}
         visited: dict[str, list[str]] = {}  # explore -> placeholders, sweep -> rooms, ...
         for a in self.actions:
-            words = _strip(a["action"]) or [a["action"]]
+            words = action_words(a["action"]) or [a["action"]]
             kinds[words[0]] = kinds.get(words[0], 0) + 1
             target = words[-1] if len(words) > 1 else None
             if target is not None and words[0] in ("explore", "sweep", "classify", "move"):
@@ -507,7 +381,7 @@ class Ledger:
             posterior = None
             if a.kind == "assume-category" and a.subject in rooms:
                 posterior = (rooms[a.subject].get("category") or {}).get(a.category)
-                h["final_note"] = f"{a.subject} believed " + _dist(
+                h["final_note"] = f"{a.subject} believed " + distribution_text(
                     rooms[a.subject].get("category") or {}, 3)
             elif a.kind == "assume-leads-to-room" and placeholders is not None:
                 if a.subject in placeholders:
@@ -515,7 +389,7 @@ class Ledger:
                 else:
                     h["final_note"] = f"{a.subject} was explored (no longer a placeholder)"
                     posterior = 0.0
-            h["p_final"] = _r(posterior) if posterior is not None else h["p_last"]
+            h["p_final"] = rounded(posterior) if posterior is not None else h["p_last"]
         searched = [f"{s['label']} {s['relation']} {s['location']}: {s['result']}"
                     for s in self.searches]
         if not self.plans:  # a strategy without plans: what it went through is the story
@@ -610,7 +484,7 @@ def final_beliefs(mind: Any, target: str) -> dict[str, Any]:
             p_target = cmap.p_object_at(target, rid)
         except Exception:  # noqa: BLE001 - a label the knowledge base does not know
             p_target = None
-        rooms[rid] = {"category": _top(category), "p_target": _r(p_target)}
+        rooms[rid] = {"category": _top(category), "p_target": rounded(p_target)}
     placeholders: dict[str, Any] = {}
     for pid in sorted(pm.placeholders):
         try:
@@ -626,126 +500,8 @@ def _top(dist: Mapping[str, float], n: int = 4) -> dict[str, float]:
     return {k: round(float(v), 4) for k, v in items}
 
 
-# ---- text ------------------------------------------------------------------------------------
-
-
-def _p(value: Any) -> str:
-    return "?" if value is None else f"{float(value):.3g}"
-
-
-def _t(value: Any) -> str:
-    return "?" if value is None else f"{float(value):.1f} s"
-
-
 def render(explanation: Mapping[str, Any]) -> str:
-    """The explanation as readable text (what `avs explain` prints)."""
-    e = explanation
-    out: list[str] = []
-    head = (f"Episode: find {e.get('target')} in {e.get('world')} ({e.get('strategy')}, "
-            f"{e.get('robot')}, seed {e.get('seed')})")
-    out += [head, f"Outcome: {e.get('outcome')} at t={_t(e.get('t'))}: {e.get('reason')}", ""]
-    plans = e.get("plans") or []
-    if plans:
-        out.append(f"Plans ({len(plans)}):")
-        for plan in plans:
-            steps = plan.get("steps") or []
-            marked = [("[assume] " if s.get("assumptive") else "") + s["action"]
-                      + (f" p={_p(s['p'])}" if s.get("assumptive") and s.get("p") is not None
-                         else "") for s in steps]
-            if marked:
-                body = "; ".join(marked)
-            elif plan.get("why") == "timeout":
-                body = (f"the planner stopped at its limit ({plan.get('status')}); planned again "
-                        f"with the fallback heuristic")
-            else:
-                body = f"no plan ({plan.get('status')})"
-            out.append(f"  #{plan['index']} t={_t(plan.get('t'))} {plan.get('why')}, "
-                       f"p={_p(plan.get('probability'))}: {body}")
-        out.append("")
-    assumptions = e.get("assumptions") or []
-    if assumptions:
-        out.append(f"Assumptions ({len(assumptions)}):")
-        for a in assumptions:
-            history = " -> ".join(_p(h["p"]) for h in a.get("history") or [])
-            trail = f"p {_p(a.get('p_first'))}" + (f" -> {history}" if history else "")
-            out.append(f"  {a['id']} {a['meaning']}: assumed at t={_t(a.get('assumed_at'))} "
-                       f"(plan {a.get('plan')}), {trail}")
-            line = f"     {a['status']} at t={_t(a.get('ended_at'))}: {a.get('reason')}"
-            out.append(line)
-            if a.get("by"):
-                out.append(f"     by: {a['by']}")
-        out.append("")
-    replans = e.get("replans") or []
-    if replans:
-        out.append(f"Replans ({len(replans)}):")
-        for r in replans:
-            after = f" after {r['after']}" if r.get("after") else ""
-            if r.get("after_detail"):
-                after += f" ({r['after_detail']})"
-            out.append(f"  t={_t(r.get('t'))}{after}: {r.get('summary')}")
-        out.append("")
-    give_up = e.get("give_up")
-    if give_up and plans:
-        hyps = give_up.get("hypotheses") or []
-        out.append(f"Gave up: {give_up.get('reason')}")
-        out.append(f"  Room hypotheses tried ({len(hyps)}):")
-        for h in hyps:
-            plans_ = ", ".join(str(p) for p in sorted(set(h.get("plans") or [])))
-            out.append(f"  - {h['hypothesis']}: p {_p(h.get('p_first'))} when first assumed, "
-                       f"final {_p(h.get('p_final'))} (plans {plans_})")
-            why = h.get("why_dropped")
-            out.append(f"      {h.get('status')} at t={_t(h.get('ended_at'))}: {why}")
-            if h.get("by"):
-                out.append(f"      by: {h['by']}")
-            if h.get("final_note"):
-                out.append(f"      at the end: {h['final_note']}")
-        if give_up.get("searched"):
-            out.append("  Searched: " + "; ".join(give_up["searched"]))
-        if give_up.get("then"):
-            out.append("  After the last plan:")
-            out += [f"    {line}" for line in give_up["then"]]
-        out.append("")
-    search = e.get("search") or {}
-    counts = search.get("action_counts") or {}
-    if plans and counts:
-        out.append("What it did:")
-    if not plans:
-        out.append(f"Search ({e.get('strategy')} does not plan with assumptions, so there is "
-                   f"no assumption ledger):")
-    if counts or not plans:
-        if counts:
-            out.append("  steps: " + ", ".join(f"{n}x {k}" for k, n in counts.items()))
-        for kind, targets in (search.get("visited") or {}).items():
-            if kind == "move":
-                continue
-            out.append(f"  {kind}: {', '.join(targets)} ({len(targets)})")
-        for s in search.get("dt_searches") or []:
-            out.append(f"  DT search t={_t(s.get('t'))}: {s.get('label')} {s.get('relation')} "
-                       f"{s.get('location')}: {s.get('result')} (p {_p(s.get('probability'))})")
-        flap = search.get("flap")
-        if flap:
-            regions = ", ".join(f"{r['name']} (p {_p(r['p'])})" for r in flap["regions"])
-            out.append(f"  FLAP: regions {regions or 'none'}; {flap['decisions']} decisions, "
-                       f"{flap['views']} views")
-            last = flap.get("last_decision")
-            if last:
-                out.append(f"    last decision (cycle {last['cycle']}): {last['status']}, "
-                           f"P(target still unseen in the regions) {_p(last['p_remaining'])}")
-        obs = search.get("observations") or {}
-        out.append(f"  detections: {obs.get('confirmed', 0)} confirmed, "
-                   f"{obs.get('not_confirmed', 0)} not confirmed")
-        if not plans:
-            out.append(f"  ended: {e.get('outcome')}: {e.get('reason')}")
-    final = e.get("final_beliefs") or {}
-    if final.get("rooms"):
-        out.append("")
-        out.append(f"Beliefs at the end (P({e.get('target')} in room), room category):")
-        for rid, room in final["rooms"].items():
-            out.append(f"  {rid}: P={_p(room.get('p_target'))}, "
-                       f"{_dist(room.get('category') or {}, 3)}")
-    notes = e.get("notes") or []
-    if notes:
-        out.append("")
-        out.append("Notes:")
-        out += [f"  {n}" for n in notes]
-    return "\n".join(out).rstrip() + "\n"
+    """The explanation as readable text (what `avs explain` prints; `explain_text.py`)."""
+    from avs_planner.episode.explain_text import render as render_text
+
+    return render_text(explanation)

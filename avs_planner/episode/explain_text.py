@@ -1,0 +1,130 @@
+"""Explanations as readable text: what `avs explain` prints (the data: `explain.py`)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from avs_planner.episode.explain import distribution_text
+
+
+def _p(value: Any) -> str:
+    return "?" if value is None else f"{float(value):.3g}"
+
+
+def _t(value: Any) -> str:
+    return "?" if value is None else f"{float(value):.1f} s"
+
+
+def render(explanation: Mapping[str, Any]) -> str:
+    """The explanation as readable text (what `avs explain` prints)."""
+    e = explanation
+    out: list[str] = []
+    head = (f"Episode: find {e.get('target')} in {e.get('world')} ({e.get('strategy')}, "
+            f"{e.get('robot')}, seed {e.get('seed')})")
+    out += [head, f"Outcome: {e.get('outcome')} at t={_t(e.get('t'))}: {e.get('reason')}", ""]
+    plans = e.get("plans") or []
+    if plans:
+        out.append(f"Plans ({len(plans)}):")
+        for plan in plans:
+            steps = plan.get("steps") or []
+            marked = [("[assume] " if s.get("assumptive") else "") + s["action"]
+                      + (f" p={_p(s['p'])}" if s.get("assumptive") and s.get("p") is not None
+                         else "") for s in steps]
+            if marked:
+                body = "; ".join(marked)
+            elif plan.get("why") == "timeout":
+                body = (f"the planner stopped at its limit ({plan.get('status')}); planned again "
+                        f"with the fallback heuristic")
+            else:
+                body = f"no plan ({plan.get('status')})"
+            out.append(f"  #{plan['index']} t={_t(plan.get('t'))} {plan.get('why')}, "
+                       f"p={_p(plan.get('probability'))}: {body}")
+        out.append("")
+    assumptions = e.get("assumptions") or []
+    if assumptions:
+        out.append(f"Assumptions ({len(assumptions)}):")
+        for a in assumptions:
+            history = " -> ".join(_p(h["p"]) for h in a.get("history") or [])
+            trail = f"p {_p(a.get('p_first'))}" + (f" -> {history}" if history else "")
+            out.append(f"  {a['id']} {a['meaning']}: assumed at t={_t(a.get('assumed_at'))} "
+                       f"(plan {a.get('plan')}), {trail}")
+            line = f"     {a['status']} at t={_t(a.get('ended_at'))}: {a.get('reason')}"
+            out.append(line)
+            if a.get("by"):
+                out.append(f"     by: {a['by']}")
+        out.append("")
+    replans = e.get("replans") or []
+    if replans:
+        out.append(f"Replans ({len(replans)}):")
+        for r in replans:
+            after = f" after {r['after']}" if r.get("after") else ""
+            if r.get("after_detail"):
+                after += f" ({r['after_detail']})"
+            out.append(f"  t={_t(r.get('t'))}{after}: {r.get('summary')}")
+        out.append("")
+    give_up = e.get("give_up")
+    if give_up and plans:
+        hyps = give_up.get("hypotheses") or []
+        out.append(f"Gave up: {give_up.get('reason')}")
+        out.append(f"  Room hypotheses tried ({len(hyps)}):")
+        for h in hyps:
+            plans_ = ", ".join(str(p) for p in sorted(set(h.get("plans") or [])))
+            out.append(f"  - {h['hypothesis']}: p {_p(h.get('p_first'))} when first assumed, "
+                       f"final {_p(h.get('p_final'))} (plans {plans_})")
+            why = h.get("why_dropped")
+            out.append(f"      {h.get('status')} at t={_t(h.get('ended_at'))}: {why}")
+            if h.get("by"):
+                out.append(f"      by: {h['by']}")
+            if h.get("final_note"):
+                out.append(f"      at the end: {h['final_note']}")
+        if give_up.get("searched"):
+            out.append("  Searched: " + "; ".join(give_up["searched"]))
+        if give_up.get("then"):
+            out.append("  After the last plan:")
+            out += [f"    {line}" for line in give_up["then"]]
+        out.append("")
+    search = e.get("search") or {}
+    counts = search.get("action_counts") or {}
+    if plans and counts:
+        out.append("What it did:")
+    if not plans:
+        out.append(f"Search ({e.get('strategy')} does not plan with assumptions, so there is "
+                   f"no assumption ledger):")
+    if counts or not plans:
+        if counts:
+            out.append("  steps: " + ", ".join(f"{n}x {k}" for k, n in counts.items()))
+        for kind, targets in (search.get("visited") or {}).items():
+            if kind == "move":
+                continue
+            out.append(f"  {kind}: {', '.join(targets)} ({len(targets)})")
+        for s in search.get("dt_searches") or []:
+            out.append(f"  DT search t={_t(s.get('t'))}: {s.get('label')} {s.get('relation')} "
+                       f"{s.get('location')}: {s.get('result')} (p {_p(s.get('probability'))})")
+        flap = search.get("flap")
+        if flap:
+            regions = ", ".join(f"{r['name']} (p {_p(r['p'])})" for r in flap["regions"])
+            out.append(f"  FLAP: regions {regions or 'none'}; {flap['decisions']} decisions, "
+                       f"{flap['views']} views")
+            last = flap.get("last_decision")
+            if last:
+                out.append(f"    last decision (cycle {last['cycle']}): {last['status']}, "
+                           f"P(target still unseen in the regions) {_p(last['p_remaining'])}")
+        obs = search.get("observations") or {}
+        out.append(f"  detections: {obs.get('confirmed', 0)} confirmed, "
+                   f"{obs.get('not_confirmed', 0)} not confirmed")
+        if not plans:
+            out.append(f"  ended: {e.get('outcome')}: {e.get('reason')}")
+    final = e.get("final_beliefs") or {}
+    if final.get("rooms"):
+        out.append("")
+        out.append(f"Beliefs at the end (P({e.get('target')} in room), room category):")
+        for rid, room in final["rooms"].items():
+            out.append(f"  {rid}: P={_p(room.get('p_target'))}, "
+                       f"{distribution_text(room.get('category') or {}, 3)}")
+    notes = e.get("notes") or []
+    if notes:
+        out.append("")
+        out.append("Notes:")
+        out += [f"  {n}" for n in notes]
+    return "\n".join(out).rstrip() + "\n"
