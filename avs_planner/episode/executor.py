@@ -147,20 +147,24 @@ class Executor:
         self._unplaced.append(seen)
         return self._place_seen()
 
-    def confirm(self, seen: SeenLike) -> bool:
-        """`confirm_needed` more frames (of up to `confirm_frames`) see the label again within
-        `agree` metres. Without the DT's belief, a report rests on this: a phantom (5% of
-        frames, anywhere in view) that repeats twice at the same spot is practically never
-        seen, while a real object missed in 1 frame of 5 still passes 9 times in 10."""
+    def confirm(self, seen: SeenLike, needed: int | None = None,
+                frames: int | None = None) -> bool:
+        """`needed` more frames (default `confirm_needed`) of up to `frames` (default
+        `confirm_frames`) see the label again within `agree` metres. Without the DT's belief,
+        a report rests on this: a phantom (5% of frames, anywhere in view) that repeats twice
+        at the same spot is practically never seen, while a real object missed in 1 frame of
+        5 still passes 9 times in 10."""
         agree, cfg = self.config.agree[0], self.config
+        needed = cfg.confirm_needed if needed is None else needed
+        frames = cfg.confirm_frames if frames is None else frames
         hits = 0
-        for k in range(cfg.confirm_frames):
+        for k in range(frames):
             if any(s.label == seen.label and math.dist(s.position, seen.position) <= agree
                    for s in self.robot.detect([seen.label])):
                 hits += 1
-            if hits >= cfg.confirm_needed:
+            if hits >= needed:
                 return True
-            if hits + cfg.confirm_frames - k - 1 < cfg.confirm_needed:
+            if hits + frames - k - 1 < needed:
                 return False
         return False
 
@@ -175,16 +179,10 @@ class Executor:
         self.robot.turn_to(math.atan2(dy, dx))
         self.robot.look(0.0, -math.atan2(self.camera.height - obj.position[2],
                                          max(math.hypot(dx, dy), 0.1)))
-        agree = self.config.agree[0]
-        for _ in range(frames):
-            if any(s.label == obj.label and math.dist(s.position, obj.position) <= agree
-                   for s in self.robot.detect([obj.label])):
-                self.emit("observation", label=obj.label, detected=True, verifying=True,
-                          position=[round(v, 2) for v in obj.position])
-                return True
-        self.emit("observation", label=obj.label, detected=False, verifying=True,
+        seen = self.confirm(obj, needed=1, frames=frames)
+        self.emit("observation", label=obj.label, detected=seen, verifying=True,
                   position=[round(v, 2) for v in obj.position])
-        return False
+        return seen
 
     def _place_seen(self) -> KnownObject | None:
         """Confirmed detections become known objects once the place map has a room for them
