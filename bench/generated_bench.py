@@ -1,7 +1,8 @@
 """Success on unseen buildings: generated worlds x (two present objects, one absent label).
 
 Run: `.venv/bin/python -m bench.generated_bench [--worlds N] [--style office] [--strategies
-switching,exhaustive,most-likely-room] [--workers W] [--jsonl FILE]` (default 50 office worlds,
+switching,exhaustive,most-likely-room] [--workers W] [--jsonl FILE] [--option K=V ...]`
+(options go to the switching strategy, e.g. `--option reward=1000`; default 50 office worlds,
 all three strategies, one process per core). Every strategy runs on the same worlds, targets
 and seeds. Per strategy: found rate for present objects, correct give-up rate for absent ones,
 false reports (a wrong object reported; must be 0), median and p90 simulated time and distance
@@ -28,16 +29,33 @@ STRATEGIES = ("switching", "exhaustive", "most-likely-room")
 
 
 def episodes(worlds: int, style: str, strategies: list[str], first: int = 0,
-             robot: str | None = None) -> list[dict]:
-    """One spec per (world, target, strategy); the targets come from the generator's record."""
+             robot: str | None = None, options: dict | None = None) -> list[dict]:
+    """One spec per (world, target, strategy); the targets come from the generator's record.
+    `options` are the switching strategy's (`--option K=V`)."""
     specs = []
     for seed in range(first, first + worlds):
         for label, present in generated_targets(seed, style):
             for strategy in strategies:
+                extra = {"strategy_options": options} if options and strategy == "switching" \
+                    else {}
                 specs.append({"generate": {"seed": seed, "style": style}, "target": label,
                               "seed": seed, "strategy": strategy, "present": present,
-                              **({"robot": robot} if robot else {})})
+                              **({"robot": robot} if robot else {}), **extra})
     return specs
+
+
+def _options(pairs: list[str]) -> dict:
+    """`K=V` pairs; V read as JSON when it parses (numbers, true/false), else a string."""
+    out = {}
+    for pair in pairs:
+        key, sep, value = pair.partition("=")
+        if not sep or not key:
+            raise SystemExit(f"--option wants KEY=VALUE, got {pair!r}")
+        try:
+            out[key] = json.loads(value)
+        except json.JSONDecodeError:
+            out[key] = value
+    return out
 
 
 def run_one(spec: dict) -> dict:
@@ -111,10 +129,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--jsonl", type=Path, help="write every episode's summary here")
     parser.add_argument("--robot", choices=("pioneer", "pr2"),
                         help="robot model (default: the world's, the pioneer)")
+    parser.add_argument("--option", action="append", default=[], metavar="K=V",
+                        help="a switching-strategy option (repeatable), e.g. reward=1000")
     args = parser.parse_args(argv)
     strategies = args.strategies.split(",")
     specs = episodes(3 if args.quick else args.worlds, args.style, strategies, args.first,
-                     args.robot)
+                     args.robot, _options(args.option))
     print(f"generated bench: {len(specs)} episodes ({args.style} worlds "
           f"{args.first}..{args.first + (3 if args.quick else args.worlds) - 1}, "
           f"strategies {', '.join(strategies)})", flush=True)

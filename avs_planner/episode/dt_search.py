@@ -1,8 +1,9 @@
 """SEARCHFOROBJECT: a closed-loop DT session over the view cones, against the robot's detector.
 
 MOVE actions drive to a cone's pose and point the head; PROCESSVIEWCONE looks twice (a
-detection counts when both frames agree); a confirmation becomes a known object, a rejection
-becomes failed-search evidence in the conceptual map (coverage of the cones looked through).
+detection counts when both frames agree); a confirmation becomes a known object, every search
+(confirmed or rejected) thins the conceptual map's unseen count there by the coverage of the
+cones looked through.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ class ViewConeSearch:
     def __init__(self, executor: Executor, label: str, relation: str, location: str):
         self.ex = executor
         self.label, self.relation, self.location = label, relation, location
+        self.head: tuple[float, float] = (0.0, 0.0)  # where the camera points (pan, tilt)
 
     def run(self) -> StepOutcome:
         label, relation, location = self.label, self.relation, self.location
@@ -48,6 +50,7 @@ class ViewConeSearch:
                 self.ex.drive_to(cone.pose[:2])
                 self.ex.robot.turn_to(cone.pose[2])
                 self.ex.robot.look(*(cone.head or (0.0, 0.0)))
+                self.head = cone.head or (0.0, 0.0)
                 if cone.torso is not None:
                     self.ex.robot.set_torso(cone.torso)
                 session.update(action)
@@ -69,6 +72,7 @@ class ViewConeSearch:
         match = self._detect_once(label, relation, location)
         if match is None:
             self.ex.emit("observation", label=label, detected=False)
+            self._glimpse_tops(label, relation, location)
             return None
         again = self._detect_once(label, relation, location)
         agree = self.ex.config.agree[0 if label == self.ex.builder.task.target else 1]
@@ -76,6 +80,18 @@ class ViewConeSearch:
         self.ex.emit("observation", label=label, detected=agreed,
                   position=[round(v, 2) for v in match.position])
         return match if agreed else None
+
+    def _glimpse_tops(self, label: str, relation: str, location: str) -> None:
+        """A look for the target that saw none also looked at the tops of other known
+        supports in view (`episode/glimpses.py`); the searched location itself is this
+        search's own evidence (`Mind.searched`)."""
+        glimpses = self.ex.glimpses
+        if glimpses is None or label != self.ex.builder.task.target:
+            return
+        supports = [o for o in self.ex._supports_of(label)
+                    if not (relation == "on" and o == location)]
+        glimpses.frame(self.ex.robot.pose, self.head[0], self.head[1], [], supports,
+                       tops_label=label)
 
     def _detect_once(self, label: str, relation: str, location: str) -> SeenLike | None:
         seen = [s for s in self.ex.robot.detect([label]) if s.label == label]
@@ -99,20 +115,25 @@ class ViewConeSearch:
 
     def _conclude(self, result, label: str, relation: str, location: str,  # noqa: ANN001
                   made: ConeSet) -> StepOutcome:
+        looked = {s.action.cone for s in result.trace if s.action.kind is not ActionKind.MOVE}
+        mass = sum(made.cones[i].probability for i in looked)
+        coverage = made.coverage * mass / made.probability if made.probability > 0 else 0.0
+        p_detect = 1.0 - self.ex.config.detector.false_negative
         if result.status is DTStatus.CONFIRMED and result.detection is not None:
             seen = result.detection
             support = location if relation == "on" else None
             obj = self.ex.mind.add_object(label, seen.position, support)
             self.ex.found_sids[obj.id] = seen.id
+            if coverage > 0.0:
+                # Poisson thinning: whatever was found, the cones looked through leave
+                # Poisson(lambda (1 - coverage p_detect)) of `label` unseen there, so a second
+                # desk stays as likely as before only in the part not looked at
+                self.ex.mind.searched(label, relation, location, coverage, p_detect)
             atoms = {("label-of", obj.id, label), ("detected", obj.id),
                      ("related", obj.id, relation, location)}
             return StepOutcome(StepStatus.DONE, f"confirmed {obj.id}", {obj.id: atoms})
-        looked = {s.action.cone for s in result.trace if s.action.kind is not ActionKind.MOVE}
-        mass = sum(made.cones[i].probability for i in looked)
-        coverage = made.coverage * mass / made.probability if made.probability > 0 else 0.0
         if coverage > 0.0:
-            p_detect = 1.0 - self.ex.config.detector.false_negative
-            self.ex.mind.failed_search(label, relation, location, coverage, p_detect)
+            self.ex.mind.searched(label, relation, location, coverage, p_detect)
         if relation == "on":
             key = (label, location)
             self.ex.builder.failed_on[key] = self.ex.builder.failed_on.get(key, 0) + 1

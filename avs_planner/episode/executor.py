@@ -18,12 +18,14 @@ from avs_planner.cp.search import PlanStep
 from avs_planner.cp.task import Atom
 from avs_planner.dt import DetectorModel
 from avs_planner.episode.dt_search import ViewConeSearch
+from avs_planner.episode.glimpses import Glimpses
 from avs_planner.episode.mind import KnownObject, Mind
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
 from avs_planner.episode.state_builder import AvsState, StateBuilder
 from avs_planner.episode.viewcones import CameraModel, ConeSet, room_cones, support_cones
 from conceptual_map.errors import MapError
 from conceptual_map.metric import distance_field, plan_path
+from conceptual_map.metric.path_planning import PathResult, PathStatus
 
 Event = Callable[..., None]
 
@@ -66,6 +68,11 @@ class ExecutorConfig:
     # a phantom that also repeats at that spot is practically never seen, while a real
     # object in view is missed by all three frames with the camera's 0.2 only 0.8% of times
     verify_frames: int = 3
+    # frames taken in passing (looking ahead while driving, both ways at a new place) that
+    # do not show the target lower P(ObjectAt) where they looked, and supports they show
+    # become known (`episode/glimpses.py`); the switching strategy turns this on
+    # (`Executor.enable_glimpses`), the other strategies keep their own evidence rules
+    glimpses: bool = False
 
 
 @dataclass
@@ -98,6 +105,14 @@ class Executor:
         self.dt_session: Any = None  # the last SEARCHFOROBJECT's DTSession (read by observers)
         self._unplaced: list[SeenLike] = []
         self.qsr_cones: Any = None  # QSR-weighted support cones (episode/qsr_cones.install)
+        self.glimpses: Glimpses | None = None
+        if self.config.glimpses:
+            self.enable_glimpses()
+
+    def enable_glimpses(self) -> None:
+        """Frames taken in passing become evidence (`episode/glimpses.py`)."""
+        self.glimpses = Glimpses(self.mind, self.camera,
+                                 1.0 - self.config.detector.false_negative)
 
     # ---- sensing along the way --------------------------------------------------------------
 
@@ -130,12 +145,19 @@ class Executor:
     def watch(self) -> KnownObject | None:
         """Keep the detector on while moving: look ahead for the target (a second frame must
         repeat a detection); a new confirmed target becomes a known object whose atoms reach
-        the monitor with the next step's outcome (it may match a virtual object)."""
+        the monitor with the next step's outcome (it may match a virtual object). The same
+        frame looks for the supports the problem knows of: a new one, confirmed, becomes a
+        known object too, and a frame that shows none of a label is evidence where it looked
+        (`episode/glimpses.py`)."""
         if not self.watching:
             return None
         label = self.builder.task.target
         self.robot.look(0.0, self._ahead_tilt)
-        first = [s for s in self.robot.detect([label]) if s.label == label]
+        labels = [label, *self.builder.supports] if self.glimpses is not None else [label]
+        frame = self.robot.detect(labels)
+        first = [s for s in frame if s.label == label]
+        if self.glimpses is not None:
+            self._glimpse(frame, labels)
         if not first or self.known_near(first[0]):
             return None
         seen = first[0]
@@ -147,14 +169,47 @@ class Executor:
         self._unplaced.append(seen)
         return self._place_seen()
 
+    def _glimpse(self, frame: list[SeenLike], labels: list[str]) -> None:
+        """What one frame taken in passing says: the labels it did not show are less likely
+        where it looked; supports it shows (seen again in a second frame) become known."""
+        assert self.glimpses is not None
+        target = self.builder.task.target
+        shown = {s.label for s in frame}
+        unseen = [lab for lab in labels if lab not in shown]
+        changed = self.glimpses.frame(self.robot.pose, 0.0, self._ahead_tilt, unseen,
+                                      self._supports_of(target) if target in unseen else (),
+                                      tops_label=target)
+        if changed:
+            self.emit("belief", glimpsed=changed)
+        for seen in frame:
+            if seen.label == target or self.known_near(seen):
+                continue
+            if self.mind.room_at(seen.position[:2]) is None:
+                continue
+            if not self.confirm(seen, needed=1, frames=1, agree=self.config.agree[1]):
+                continue
+            obj = self.mind.add_object(seen.label, seen.position)
+            self.seen_while_moving[obj.id] = {
+                ("label-of", obj.id, seen.label), ("detected", obj.id),
+                ("related", obj.id, "in", obj.room)}
+            self.emit("observation", label=seen.label, detected=True, watching=True,
+                      position=[round(v, 2) for v in seen.position], object=obj.id)
+
+    def _supports_of(self, label: str) -> list[str]:
+        """Known objects `label` may lie on (the knowledge lists the relation)."""
+        listed = self.mind.cmap.knowledge.relation_lambda
+        return [oid for oid, obj in self.mind.objects.items()
+                if (label, "on", obj.label) in listed]
+
     def confirm(self, seen: SeenLike, needed: int | None = None,
-                frames: int | None = None) -> bool:
+                frames: int | None = None, agree: float | None = None) -> bool:
         """`needed` more frames (default `confirm_needed`) of up to `frames` (default
         `confirm_frames`) see the label again within `agree` metres. Without the DT's belief,
         a report rests on this: a phantom (5% of frames, anywhere in view) that repeats twice
         at the same spot is practically never seen, while a real object missed in 1 frame of
         5 still passes 9 times in 10."""
-        agree, cfg = self.config.agree[0], self.config
+        cfg = self.config
+        agree = cfg.agree[0] if agree is None else agree
         needed = cfg.confirm_needed if needed is None else needed
         frames = cfg.confirm_frames if frames is None else frames
         hits = 0
@@ -435,7 +490,9 @@ class Executor:
                 continue
             if path.found:
                 return path
-        return plan_path(self.mind.grid, start, start, radius, allow_unknown=True)
+        # none found (the robot may stand closer to furniture than its margin: then even a
+        # query from where it stands is refused, which must not end the episode)
+        return PathResult(PathStatus.NO_PATH, (), math.inf, 0)
 
     def _free_near(self, goal: tuple[float, float], reach: float = 0.6
                    ) -> tuple[float, float] | None:
@@ -494,8 +551,13 @@ class Executor:
         return StepOutcome(StepStatus.DONE, f"{len(made.cones)} cones")
 
     def search(self, label: str, relation: str, location: str) -> StepOutcome:
-        """SEARCHFOROBJECT: a DT session over the cones CREATEVIEWCONES made."""
-        return ViewConeSearch(self, label, relation, location).run()
+        """SEARCHFOROBJECT: a DT session over the cones CREATEVIEWCONES made; its duration
+        prices later searches of its kind (`StateBuilder.observe_search_time`)."""
+        start = self.robot.clock
+        outcome = ViewConeSearch(self, label, relation, location).run()
+        if self.stats.dt_calls and self.robot.clock > start:
+            self.builder.observe_search_time(label, relation, self.robot.clock - start)
+        return outcome
 
 
 def _split_leg(waypoints: list[tuple[float, float]], step: float

@@ -54,6 +54,15 @@ class LoopConfig:
     watch: bool = True
     # blocked spots are tried again this many times when nothing else is left
     retry_blocked: int = 2
+    # a plan that searches only what is already mapped (no placeholder explored, no room
+    # assumed beyond one) is executed only if it is worth more than it costs: reward x
+    # P(success) > cost, the CP's own objective against giving up (see `_worth_it`)
+    worth_test: bool = True
+    # frames taken in passing are evidence, and supports they show become known objects
+    # (`Executor.enable_glimpses`, `episode/glimpses.py`)
+    glimpses: bool = True
+    # price moves and searches in the robot's own seconds (`BuilderConfig.seconds`)
+    seconds: bool = False
 
 
 class SwitchingLoop:
@@ -75,6 +84,10 @@ class SwitchingLoop:
 
     def run(self) -> SearchResult:
         self.executor.watching = self.config.watch
+        if self.config.glimpses and self.executor.glimpses is None:
+            self.executor.enable_glimpses()
+        if self.config.seconds != self.builder.config.seconds:
+            self.builder.config = replace(self.builder.config, seconds=self.config.seconds)
         self.executor.look_around()
         state = self.builder.build()
         self.planner = ContinualPlanner(state.skeleton(), self._options(),
@@ -85,7 +98,7 @@ class SwitchingLoop:
         if first is None:
             return self._end(Outcome.GAVE_UP, "planner timed out, nothing to explore")
         if not first.solved:
-            return self._end(Outcome.GAVE_UP, f"no plan: {first.status.value}")
+            return self._end(Outcome.GAVE_UP, self._no_plan(first))
         for _ in range(self.config.max_steps):
             stop = self._budget_spent()
             if stop:
@@ -106,20 +119,53 @@ class SwitchingLoop:
                 return self._end(Outcome.FOUND, outcome.detail)
             self.planner.plan = self.planner.plan[:index] + self.planner.plan[index + 1:]
             state = self.builder.build()
-            result = self._monitor(state, outcome)
+            settled = step.label if _search_rejected(step, outcome) else None
+            result = self._monitor(state, outcome, settled)
             if result is not None:
                 result = self._recover(result)
                 if result is None:
                     return self._end(Outcome.GAVE_UP, "planner timed out, nothing to explore")
                 state = self.builder.build()
             if result is not None and not result.solved:
-                return self._end(Outcome.GAVE_UP, f"no plan above the success threshold "
-                                 f"{self.config.min_success:g} ({result.status.value})")
+                return self._end(Outcome.GAVE_UP, self._no_plan(result))
         return self._end(Outcome.TIMEOUT, f"{self.config.max_steps} steps executed")
 
     def _fallback(self, result: PlanResult) -> PlanResult:
         """A search that ran out of time is retried with the fallback heuristic, greedier
         and with a larger expansion limit."""
+        return self._worth_it(self._retry(result))
+
+    def _worth_it(self, result: PlanResult) -> PlanResult:
+        """The CP minimises c(pi) + R (1 - p(pi)); giving up costs R. A plan with
+        R p(pi) < c(pi) is worse than giving up, by the planner's own objective, and is not
+        executed: the result becomes "no plan above the threshold" (the loop then tries what
+        it tries before giving up). Only plans that search what is already mapped are
+        judged: a plan that explores is one chain of assumptions about what lies beyond a
+        placeholder, while exploring also reveals every other room and object there, so its
+        p(pi) undervalues it."""
+        if not (self.config.worth_test and result.solved) or _explores(result.plan):
+            return result
+        value = self.config.reward * result.probability
+        if value >= result.cost:
+            return result
+        self.trace.emit("belief", not_worth=[s.label for s in result.plan if not s.assumptive],
+                        probability=round(result.probability, 5), cost=round(result.cost, 2),
+                        reward=self.config.reward)
+        return replace(result, status=PlanStatus.NO_PLAN_ABOVE_THRESHOLD, plan=(),
+                       extra={**result.extra, "not_worth": True,
+                              "best_probability": result.probability,
+                              "best_cost": result.cost})
+
+    def _no_plan(self, result: PlanResult) -> str:
+        """Why the episode gives up, in words."""
+        if result.extra.get("not_worth"):
+            return (f"no plan is worth its cost: the best left finds the target with "
+                    f"p={result.extra['best_probability']:.3g} at cost "
+                    f"{result.extra['best_cost']:.0f} (reward {self.config.reward:g} x p < cost)")
+        return (f"no plan above the success threshold {self.config.min_success:g} "
+                f"({result.status.value})")
+
+    def _retry(self, result: PlanResult) -> PlanResult:
         assert self.planner is not None
         if not _timed_out(result):
             return result
@@ -249,8 +295,16 @@ class SwitchingLoop:
                         detail=outcome.detail)
         return True
 
-    def _monitor(self, state: AvsState, outcome: StepOutcome) -> PlanResult | None:
-        """Hand the new belief state to the CP: None if the plan stands, else the new plan."""
+    def _monitor(self, state: AvsState, outcome: StepOutcome,
+                 settled: str | None = None) -> PlanResult | None:
+        """Hand the new belief state to the CP: None if the plan stands, else the new plan.
+
+        `settled`: the step (a search) the DT just rejected, if it was one. The plan was made
+        betting on that search (its success a probabilistic effect; the plan may even hold a
+        second search of the same location, planned as an independent try); now the DT has
+        looked through the cones and the map holds what it saw, so the rest of the plan is
+        re-decided on that evidence instead of kept while its probabilities move by less than
+        the monitor's threshold."""
         assert self.planner is not None
         update = self.planner.update(state.world_state(), state.skeleton(),
                                      observed=outcome.observed or None)
@@ -261,6 +315,13 @@ class SwitchingLoop:
                         confirmed=list(update.confirmed),
                         assumptions={a: round(p, 5) for a, p in report.assumptions}
                         if report else {})
+        if update.decision is Decision.CONTINUE and settled:
+            self.trace.emit("replan", status="search_settled", action=settled,
+                            detail="the DT rejected it: the plan is re-decided on what it saw")
+            self.result.replans += 1
+            result = self._fallback(self.planner.replan(state.world_state()))
+            self._record_plan(result, "replan")
+            return result
         if update.decision is Decision.CONTINUE:
             return None
         report = update.report
@@ -316,6 +377,18 @@ class SwitchingLoop:
 def _signature(state: AvsState) -> int:
     """The belief state as the CP sees it (atoms and numbers)."""
     return hash((state.atoms, frozenset(state.values.items())))
+
+
+def _explores(plan: tuple[PlanStep, ...]) -> bool:
+    """The plan drives to a placeholder or assumes what lies beyond one."""
+    return any(s.name == "assume-leads-to-room" or
+               (s.name == "move" and s.args[1].startswith("placeholder")) for s in plan)
+
+
+def _search_rejected(step: PlanStep, outcome: StepOutcome) -> bool:
+    """A SEARCHFOROBJECT that ran and whose DT session rejected the location."""
+    return step.name.startswith("searchforobject") and outcome.status is StepStatus.DONE \
+        and outcome.detail.startswith("rejected")
 
 
 def _timed_out(result: PlanResult) -> bool:

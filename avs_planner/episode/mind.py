@@ -201,9 +201,10 @@ class Mind:
         self.cmap.forget_object(oid)
         self.objects.pop(oid, None)
 
-    def failed_search(self, label: str, relation: str, location: str, coverage: float,
-                      p_detect: float) -> None:
-        """A DT search that rejected: lower P(ObjectAt) of the searched location."""
+    def searched(self, label: str, relation: str, location: str, coverage: float,
+                 p_detect: float) -> None:
+        """A DT search looked through `coverage` of a location: the `label` objects not seen
+        there are Poisson(lambda x remaining), whatever it found (Poisson thinning)."""
         where = RelatedSpace(relation, location) if relation == "on" else location
         self.cmap.observe_search(label, where, min(1.0, coverage), p_detect)
 

@@ -185,7 +185,8 @@ class Episode:
                            else None, emit)
         self.builder = StateBuilder(self.mind, SearchTask(spec.target, spec.category))
         camera = self.robot.robot.model.camera
-        self.camera = CameraModel(self.robot.camera_height, camera.hfov, camera.detect_range)
+        self.camera = CameraModel(self.robot.camera_height, camera.hfov, camera.detect_range,
+                                  vfov=camera.vfov)
         self.executor = Executor(self.robot, self.mind, self.builder, self.camera,
                                  self._emit, ExecutorConfig(dt_policy=spec.dt_policy),
                                  seed=spec.seed)

@@ -27,6 +27,7 @@ class CameraModel:
     detect_range: float
     look_distance: float = 2.0  # m: where an in-room view aims its tilt
     support_height: float = 0.7  # m: assumed top of a support before one is known
+    vfov: float | None = None  # rad; None: the vertical field of view is not checked
 
 
 @dataclass(frozen=True)
@@ -93,6 +94,14 @@ def support_cones(mind: Mind, support: KnownObject, p_total: float, camera: Came
 
 def _room_cells(mind: Mind, room: str, reach: float) -> np.ndarray:
     """World centres of occupied/unknown cells next to free space, nearest to this room."""
+    points, rooms = candidate_cells(mind, reach)
+    return points[rooms == room][::2]
+
+
+def candidate_cells(mind: Mind, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """Where objects (and their supports) may be: the centres of occupied/unknown cells next
+    to free space, within `reach` of a place, each with the room of its nearest place
+    (an object array of room ids, None where the place has no room)."""
     grid, pm = mind.grid, mind.place_map
     states = grid.state_grid()
     free = states == CellState.FREE
@@ -103,15 +112,15 @@ def _room_cells(mind: Mind, room: str, reach: float) -> np.ndarray:
     near_free[:, :-1] |= free[:, 1:]
     idx = np.argwhere(near_free & ~free)
     if len(idx) == 0 or not pm.places:
-        return np.zeros((0, 2))
+        return np.zeros((0, 2)), np.zeros(0, dtype=object)
     points = grid.to_world(idx)
     ids = sorted(pm.places)
     centres = np.array([pm.places[p].position for p in ids])
     dist = np.linalg.norm(points[:, None, :] - centres[None, :, :], axis=2)
     nearest = dist.argmin(axis=1)
-    mine = np.array([pm.room_of(p) == room for p in ids])
-    keep = mine[nearest] & (dist.min(axis=1) <= reach)
-    return points[keep][::2]
+    room_of = np.array([pm.room_of(p) for p in ids], dtype=object)
+    keep = dist.min(axis=1) <= reach
+    return points[keep], room_of[nearest[keep]]
 
 
 def _in_wedge(points: np.ndarray, pose: tuple[float, float, float],

@@ -71,6 +71,10 @@ class ObjectLedger:
         self.objects: dict[str, ObjectRecord] = {}
         self._counts: dict[Location, Counter[str]] = {}
         self._remaining: dict[tuple[Location, str], float] = {}
+        # share of `label` objects at a location that frames taken in passing would have
+        # seen (fraction of the location in view x detection probability); set, not
+        # multiplied, since those frames overlap: the latest share replaces the last
+        self._glimpsed: dict[tuple[Location, str], float] = {}
 
     def add(
         self,
@@ -141,7 +145,12 @@ class ObjectLedger:
     def record_search(
         self, label: str, location: Location, coverage: float, p_detect: float
     ) -> None:
-        """A search of `location` for `label` that found nothing."""
+        """A search of `location` for `label` looked through `coverage` of it.
+
+        Whether or not it found one, the `label` objects it did not see are Poisson with the
+        lambda thinned by (1 - coverage * p_detect): after a search that found a desk, a
+        second desk is only as likely as the unlooked part of the room allows.
+        """
         self.require_label(label)
         self.room_of(location)
         for name, value in (("coverage", coverage), ("p_detect", p_detect)):
@@ -152,12 +161,24 @@ class ObjectLedger:
         key = (location, label)
         self._remaining[key] = self._remaining.get(key, 1.0) * (1.0 - coverage * p_detect)
 
+    def record_glimpses(self, label: str, location: Location, share: float) -> None:
+        """Frames taken in passing (not a search) have looked at part of `location` and not
+        seen `label`: `share` = the part in view x the detection probability, in [0, 1]."""
+        self.require_label(label)
+        self.room_of(location)
+        if isinstance(share, bool) or not isinstance(share, int | float) \
+                or not 0.0 <= share <= 1.0:
+            raise ConceptualError(f"share must be a number in [0, 1], got {share!r}")
+        self._glimpsed[(location, label)] = float(share)
+
     def count(self, location: Location, label: str) -> int:
         return self._counts.get(location, Counter())[label]
 
     def remaining(self, location: Location, label: str) -> float:
-        """Fraction of `label` objects at `location` that searches so far would have missed."""
-        return self._remaining.get((location, label), 1.0)
+        """Fraction of `label` objects at `location` that searches so far would have missed
+        (and the frames taken in passing, as one more independent look)."""
+        key = (location, label)
+        return self._remaining.get(key, 1.0) * (1.0 - self._glimpsed.get(key, 0.0))
 
     def location_lambda(self, label: str, location: Location) -> np.ndarray:
         """Prior expected count of `label` at `location`, per category."""
@@ -204,12 +225,13 @@ class ObjectLedger:
 
     def _evidence_keys(self) -> set[tuple[Location, str]]:
         keys = {(loc, label) for loc, counts in self._counts.items() for label in counts}
-        return keys | set(self._remaining)
+        return keys | set(self._remaining) | set(self._glimpsed)
 
     def forget_room(self, room: str) -> None:
         """Drop room-level search records of a deleted room (it holds no objects)."""
-        for key in [k for k in self._remaining if k[0] == room]:
-            del self._remaining[key]
+        for records in (self._remaining, self._glimpsed):
+            for key in [k for k in records if k[0] == room]:
+                del records[key]
         self._counts.pop(room, None)
 
     def move_room(self, gone: str, keep: str) -> None:
@@ -228,4 +250,12 @@ class ObjectLedger:
         for (location, label), fraction in list(self._remaining.items()):
             if location == gone:
                 del self._remaining[(location, label)]
-                self._remaining[(keep, label)] = max(fraction, self.remaining(keep, label))
+                self._remaining[(keep, label)] = max(fraction,
+                                                     self._remaining.get((keep, label), 1.0))
+        # glimpses are shares of a room's area: the merged room's is not known until the
+        # next frame gives it, so keep the smaller (a room never glimpsed counts as 0)
+        for label in {k[1] for k in self._glimpsed if k[0] in (gone, keep)}:
+            share = min(self._glimpsed.pop((gone, label), 0.0),
+                        self._glimpsed.pop((keep, label), 0.0))
+            if share > 0.0:
+                self._glimpsed[(keep, label)] = share

@@ -170,9 +170,19 @@ class ConceptualMap:
     def observe_search(
         self, label: str, location: Location | tuple[str, str], coverage: float, p_detect: float
     ) -> None:
-        """A search for `label` at `location` found nothing (coverage x detection probability)."""
+        """A search for `label` looked through `coverage` of `location` (x detection
+        probability); if nothing was found it is also evidence about the room's category."""
         location = _as_location(location)
         self.objects.record_search(label, location, coverage, p_detect)
+        self._refresh_object_evidence(self._room_of(location))
+
+    def observe_glimpses(
+        self, label: str, location: Location | tuple[str, str], share: float
+    ) -> None:
+        """Frames taken in passing have looked at `share` of `location` (x detection
+        probability) without seeing `label`; replaces the last share given for it."""
+        location = _as_location(location)
+        self.objects.record_glimpses(label, location, share)
         self._refresh_object_evidence(self._room_of(location))
 
     def _refresh_object_evidence(self, room: str) -> None:

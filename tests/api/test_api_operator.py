@@ -148,7 +148,8 @@ def test_async_plan_job_polls_to_a_result_and_cancels(make_settings: Make) -> No
         accepted = client.post("/v1/plans?wait=false", json={"domain": DOMAIN, "problem": PROBLEM})
         assert accepted.status_code == 202 and accepted.headers["Location"].startswith("/v1/plans/")
         job_id = accepted.json()["id"]
-        deadline = time.monotonic() + 30
+        deadline = time.monotonic() + 240  # a hang guard, not a speed test (a loaded machine
+        # starts the plan worker slowly)
         while (job := client.get(f"/v1/plans/{job_id}").json())["state"] in ("queued", "running"):
             assert time.monotonic() < deadline
             time.sleep(0.1)

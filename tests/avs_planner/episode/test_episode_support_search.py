@@ -4,12 +4,16 @@ rooms of uncertain category visited again (and certain ones doubted) before givi
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import pytest
 
 from avs_planner.cp.continual import ContinualPlanner
 from avs_planner.cp.search import SearchOptions
+from avs_planner.dt import ViewCone
+from avs_planner.dt.domain import ActionKind, DTAction
+from avs_planner.dt.session import DTResult, DTStatus, DTStep
 from avs_planner.episode.dt_search import ViewConeSearch
 from avs_planner.episode.executor import _split_leg
 from avs_planner.episode.loop import LoopConfig, SwitchingLoop
@@ -17,6 +21,7 @@ from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import StepStatus
 from avs_planner.episode.robot import Seen
 from avs_planner.episode.trace import Trace
+from avs_planner.episode.viewcones import ConeSet
 
 OPTIONS = SearchOptions(weight=3.0, heuristic="hadd", node_limit=4000)
 
@@ -152,3 +157,34 @@ def test_the_target_is_looked_at_again_before_it_is_reported(corridor, monkeypat
     executor.config = replace(executor.config, verify_frames=0)
     frames[:] = []
     assert executor._run(step, builder.build()).status is StepStatus.FOUND
+
+
+def _p_in(state, label: str, room: str) -> float:
+    return max(v for k, v in state.values.items() if k[:3] == ("p-obj-in", label, room))
+
+
+@pytest.mark.parametrize("found", [True, False])
+def test_a_room_search_thins_the_unseen_count_whether_or_not_it_found_one(corridor,
+                                                                           found) -> None:
+    """Poisson thinning: the cones looked through leave lambda (1 - coverage p_detect) of
+    tables unseen in the room, also after a search that confirmed one (before this, a found
+    table left a second one exactly as likely as before the search, and the CP searched the
+    same room for tables again and again)."""
+    mind, builder, executor = corridor
+    room, (x, y) = _here(mind)
+    before = _p_in(builder.build(), "table", room)
+    left = mind.cmap.objects.remaining(room, "table")  # after the glimpses of the look round
+    cones = (ViewCone("c-0", (x, y, 0.0), 0.3), ViewCone("c-1", (x, y, math.pi), 0.3))
+    made = ConeSet(cones, coverage=0.8, probability=0.6)
+    looked = tuple(DTStep(DTAction(ActionKind.PROCESS_VIEW_CONE, i), None, 1.0, (), 0.0)
+                   for i in range(2))
+    status = DTStatus.CONFIRMED if found else DTStatus.REJECTED
+    seen = Seen(1, "table", (x + 1.0, y, 0.4), 0.9) if found else None
+    result = DTResult(status, 0.9, 2.0, looked, detection=seen)
+    outcome = ViewConeSearch(executor, "table", "in", room)._conclude(
+        result, "table", "in", room, made)
+    assert outcome.status is StepStatus.DONE
+    assert mind.cmap.objects.remaining(room, "table") == pytest.approx(
+        left * (1.0 - 0.8 * (1.0 - executor.config.detector.false_negative)))
+    after = _p_in(builder.build(), "table", room)
+    assert after < before

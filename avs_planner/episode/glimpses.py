@@ -1,0 +1,167 @@
+"""Frames taken in passing are evidence too: where they did not show the target, it is less
+likely to be.
+
+While driving, the detector looks ahead for the target, and at a new place the robot looks
+both ways (`Executor.watch`, `Executor.look_around`). Until now a frame that showed nothing
+was dropped: only the DT's searches lowered P(ObjectAt), so a room the robot had looked
+across on its way was searched from scratch, and on an absent target the budget ran out
+before the building's hypotheses did. Here every such frame counts:
+
+- **Rooms.** The cells a room search would cover (`viewcones.candidate_cells`: occupied or
+  unknown cells next to free space, nearest to one of the room's places) count as looked at
+  when a frame had them in view: inside the camera's horizontal field of view, between 0.5 m
+  and 0.9 x the recognition range (the room cones' own limits), an object at the assumed
+  support height inside the vertical field of view, and a free line of sight on the
+  occupancy grid (an unknown or occupied cell in between blocks it).
+- **Supports.** The top of a known support counts as looked at when it is in view by the
+  same tests (at twice its detected centre's height, the executor's rule for a top).
+
+A look is one chance for the detector (hit rate `p_detect`, the DT's own detector model), so
+a cell or top looked at from k different standpoints (camera positions 1 m apart; frames
+from the same standpoint see the same thing and count once) would have missed an object
+with probability (1 - p_detect)^k, and Poisson thinning leaves the mean of that over a
+room's cells (or the top's own value) of the label's count unseen. That share goes to the
+conceptual map as glimpses (`ConceptualMap.observe_glimpses`, replacing the last share
+given). The planner then sees the lowered P(ObjectAt) in its `p-obj-in` values, and a
+support whose P(target on it) falls below the planner's threshold is settled
+(`StateBuilder`). The DT's own searches are recorded apart (`Mind.searched`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+
+from avs_planner.episode.mind import Mind
+from avs_planner.episode.viewcones import CameraModel, candidate_cells
+from conceptual_map.conceptual import RelatedSpace
+from conceptual_map.metric import CellState
+
+STANDPOINT = 1.0  # m: camera positions nearer than this are one standpoint
+MAX_LOOKS = 4  # standpoints counted per cell (beyond, a miss is practically ruled out)
+
+
+class Glimpses:
+    """What frames taken in passing have seen of rooms and supports, per label."""
+
+    def __init__(self, mind: Mind, camera: CameraModel, p_detect: float,
+                 min_range: float = 0.5) -> None:
+        self.mind, self.camera, self.p_detect = mind, camera, p_detect
+        self.min_range = min_range
+        self.max_range = 0.9 * camera.detect_range
+        # label -> {world key of a candidate cell: standpoints it was looked at from}
+        self.cells: dict[str, dict[tuple[int, int], set[tuple[int, int]]]] = {}
+        # (label, support id) -> standpoints its top was looked at from
+        self.tops: dict[tuple[str, str], set[tuple[int, int]]] = {}
+        self.frames = 0
+
+    def frame(self, pose: tuple[float, float, float], pan: float, tilt: float,
+              labels: Iterable[str], supports: Iterable[str] = (),
+              tops_label: str | None = None) -> dict[str, dict[str, float]]:
+        """A frame from `pose` with the head at (`pan`, `tilt`) did not show `labels`; the
+        tops of the known objects `supports` are checked for `tops_label` (the target).
+        Returns, per label, the rooms whose share changed and the new share."""
+        labels = list(labels)
+        self.frames += 1
+        stand = (round(pose[0] / STANDPOINT), round(pose[1] / STANDPOINT))
+        changed: dict[str, dict[str, float]] = {}
+        points, rooms = (candidate_cells(self.mind, self.max_range + 1.0) if labels
+                         else (np.zeros((0, 2)), np.zeros(0, dtype=object)))
+        if len(points):
+            seen = self._in_view(points, pose, pan, tilt, self.camera.support_height)
+            keys = [tuple(k) for k in self._keys(points).tolist()]
+            touched = {r for r in rooms[seen] if r is not None}
+            for label in labels:
+                looks = self.cells.setdefault(label, {})
+                new = False
+                for i in np.flatnonzero(seen):
+                    where = looks.setdefault(keys[i], set())
+                    if stand not in where and len(where) < MAX_LOOKS:
+                        where.add(stand)
+                        new = True
+                if not new:
+                    continue
+                for room in touched:
+                    mine = [keys[i] for i in np.flatnonzero(rooms == room)]
+                    share = self._share([len(looks.get(k, ())) for k in mine])
+                    self._observe(label, room, share)
+                    changed.setdefault(label, {})[room] = round(share, 3)
+        if tops_label is not None:
+            self._tops(pose, pan, tilt, tops_label, supports, stand)
+        return changed
+
+    def _share(self, looks: list[int]) -> float:
+        """Share of a location's objects the looks would have seen: 1 - mean miss."""
+        if not looks:
+            return 0.0
+        miss = (1.0 - self.p_detect) ** np.asarray(looks, dtype=float)
+        return float(1.0 - miss.mean())
+
+    def _observe(self, label: str, location: str | RelatedSpace, share: float) -> None:
+        cmap = self.mind.cmap
+        if isinstance(location, str) and not cmap.graph.has_room(location):
+            return
+        cmap.observe_glimpses(label, location, min(1.0, share))
+
+    def _tops(self, pose: tuple[float, float, float], pan: float, tilt: float, label: str,
+              supports: Iterable[str], stand: tuple[int, int]) -> None:
+        for oid in supports:
+            obj = self.mind.objects.get(oid)
+            if obj is None:
+                continue
+            top = 2.0 * obj.position[2]  # the executor's rule: a support's centre is half-way
+            point = np.array([obj.position[:2]])
+            if not self._in_view(point, pose, pan, tilt, top)[0]:
+                continue
+            seen = self.tops.setdefault((label, oid), set())
+            if stand in seen or len(seen) >= MAX_LOOKS:
+                continue
+            seen.add(stand)
+            self._observe(label, RelatedSpace("on", oid), self._share([len(seen)]))
+
+    def _keys(self, points: np.ndarray) -> np.ndarray:
+        return np.round(points / self.mind.grid.resolution).astype(np.int64)
+
+    def _in_view(self, points: np.ndarray, pose: tuple[float, float, float], pan: float,
+                 tilt: float, height: float) -> np.ndarray:
+        """Points (at `height`) inside the frame's view with a free line of sight."""
+        cam = self.camera
+        d = points - np.asarray(pose[:2])
+        r = np.hypot(d[:, 0], d[:, 1])
+        yaw = pose[2] + pan
+        bearing = np.abs((np.arctan2(d[:, 1], d[:, 0]) - yaw + np.pi) % (2 * np.pi) - np.pi)
+        ok = (r >= self.min_range) & (r <= self.max_range) & (bearing <= cam.hfov / 2)
+        if cam.vfov is not None:
+            elevation = np.arctan2(height - cam.height, np.maximum(r, 1e-6))
+            ok &= np.abs(elevation - tilt) <= cam.vfov / 2
+        if not ok.any():
+            return ok
+        idx = np.flatnonzero(ok)
+        ok[idx] = self._line_of_sight(np.asarray(pose[:2]), points[idx])
+        return ok
+
+    def _line_of_sight(self, origin: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """True where every grid cell between `origin` and the point is known free, leaving
+        out the robot's own footprint (its laser never sees the cells under it) and the last
+        cell and a half (the point's own cell holds the object)."""
+        grid = self.mind.grid
+        res = grid.resolution
+        free = grid.state_grid() == CellState.FREE
+        d = points - origin
+        length = np.hypot(d[:, 0], d[:, 1])
+        steps = np.maximum(1, np.ceil(length / (0.5 * res)).astype(int))
+        n = int(steps.max())
+        t = np.arange(n)[None, :] / steps[:, None]  # fraction along each ray
+        along = t * length[:, None]
+        inside_ray = (along <= length[:, None] - 1.5 * res) & \
+            (along >= self.mind.config.robot_radius)
+        xs = origin[0] + d[:, 0:1] * t
+        ys = origin[1] + d[:, 1:2] * t
+        cells = grid.to_cell(np.stack([xs.ravel(), ys.ravel()], axis=1))
+        within = grid.inside(cells)
+        clear = np.zeros(len(cells), dtype=bool)
+        good = cells[within]
+        clear[within] = free[tuple(good.T)]
+        clear = clear.reshape(xs.shape)
+        return np.all(clear | ~inside_ray, axis=1)
