@@ -424,9 +424,9 @@ class Executor:
         through unknown cells (a laser mounted ahead of the base never sees the cells under
         and behind it); the simulator still refuses any motion that would collide."""
         radius = self.mind.config.robot_radius
-        slim = radius - self.config.squeeze
-        if self.mind.body is not None:  # never slimmer than the footprint less a grid cell
-            slim = max(slim, self.mind.body.footprint_radius - self.mind.grid.resolution)
+        slim = self.mind.config.squeeze_radius  # the mind's own (`mind.squeeze_radius`)
+        if slim is None:
+            slim = radius - self.config.squeeze
         tries = ((slim, False), (radius, True))
         for margin, unknown in tries:
             try:

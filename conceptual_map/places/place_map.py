@@ -300,7 +300,7 @@ class PlaceMap:
         points = np.vstack(probes)
         cells = grid.to_cell(points)
         standable = grid.inside(cells)
-        standable[standable] = grid.traversable(self.config.robot_radius)[
+        standable[standable] = grid.traversable(self.config.reach_radius)[
             cells[standable, 0], cells[standable, 1]
         ]
         points = points[standable]  # a robot could pass here, as through a door
