@@ -24,6 +24,7 @@ from avs_planner.episode.state_builder import AvsState, StateBuilder
 from avs_planner.episode.viewcones import CameraModel, ConeSet, room_cones, support_cones
 from conceptual_map.errors import MapError
 from conceptual_map.metric import distance_field, plan_path
+from conceptual_map.metric.path_planning import PathResult, PathStatus
 
 Event = Callable[..., None]
 
@@ -435,7 +436,9 @@ class Executor:
                 continue
             if path.found:
                 return path
-        return plan_path(self.mind.grid, start, start, radius, allow_unknown=True)
+        # no path (the robot may stand where only a squeeze fits: never plan from there
+        # with the full radius, which raises instead of saying "no path")
+        return PathResult(PathStatus.NO_PATH, (), math.inf, 0)
 
     def _free_near(self, goal: tuple[float, float], reach: float = 0.6
                    ) -> tuple[float, float] | None:
