@@ -72,6 +72,7 @@ class Mind:
     # (place, move target) -> the blockage evidence when that move failed from that place:
     # while the robot stands there with the same evidence, the move is not offered again
     failed_moves: dict[tuple[str, str], frozenset[str]] = field(default_factory=dict)
+    clock: float = 0.0  # s: the time of the last scan sensed
 
     def __post_init__(self) -> None:
         self.grid = OccupancyGrid(resolution=self.resolution)
@@ -109,10 +110,13 @@ class Mind:
         return gone
 
     def retry_blocked(self) -> list[Blockage]:
-        """Forget the active blockages now (nothing else is left to try)."""
+        """Forget the active blockages now (nothing else is left to try). The placeholders
+        are re-derived at once: space that only a kept-out spot cut off is a goal again
+        (else the planner would see none until the next scan, and give up)."""
         gone = self.blockages.clear()
         if gone:
             self.grid.set_keep_out([])
+            self._feed.apply(self.place_map.refresh(self.grid, self.clock))
         return gone
 
     def move_failed(self, target: str) -> None:
@@ -133,6 +137,7 @@ class Mind:
 
     def sense(self, scan: LaserScanLike, poses: list[Pose], time: float) -> list[MapEvent]:
         """Integrate a scan taken at the end of `poses` and grow the place map along them."""
+        self.clock = max(self.clock, time)
         self.forget_blockages(time)
         self.grid.integrate_scan(scan)
         events = self.place_map.follow(self.grid, poses, time)

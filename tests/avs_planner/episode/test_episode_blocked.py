@@ -239,3 +239,28 @@ def test_a_target_behind_a_gap_the_grid_under_measures_is_found(robot: str) -> N
                                   "seed": 1, "time_budget_s": 900.0})
     summary = Episode(spec).run()
     assert summary["outcome"] == "found" and summary["correct"], summary["reason"]
+
+
+def test_retrying_blocked_spots_brings_back_the_placeholders_they_cut_off() -> None:
+    """A blockage in the only door hides the room beyond; when the loop retries blocked spots
+    (nothing else left) the placeholder there is a goal again at once, not after the next
+    scan (the planner saw no goal and gave up: generated office world 4, pr2, keyboard)."""
+    from conceptual_map.metric.synthetic import rooms_world
+
+    world = rooms_world([(0.0, 0.0, 4.0, 4.0), (4.0, 0.0, 9.0, 4.0)], [(4.0, 2.0, 1.0)],
+                        wall=0.1)
+    mind = Mind()
+
+    def sense(pose: tuple[float, float, float], time: float) -> None:
+        mind.sense(world.laser(pose, beams=1440, fov=4.18, max_range=5.6), [pose], time)
+
+    sense((2.0, 2.0, 0.0), 0.0)
+    sense((2.0, 2.0, math.pi), 1.0)
+    beyond = [p for p in mind.place_map.placeholders.values() if p.position[0] > 4.2]
+    assert beyond
+    mind.block((4.0, 2.0), 5.0)
+    sense((2.0, 2.0, 0.0), 6.0)
+    assert not [p for p in mind.place_map.placeholders.values() if p.position[0] > 4.2]
+    assert mind.retry_blocked()
+    back = [p for p in mind.place_map.placeholders.values() if p.position[0] > 4.2]
+    assert back and all(p.id in mind.cmap.placeholders for p in back)
