@@ -6,8 +6,9 @@ planning radius plus a margin that grows with each touch nearby) that the grid's
 traversability (so every path, reachability and standpoint query) respects until
 `retry_after` simulated seconds have passed, and that cuts the place-graph edges through it.
 A blockage at a mapped door names the door. `narrow_openings` finds free space the robot can
-see but not reach because an opening on the way is narrower than its `passing_width`: the
-reason an episode gives when that is all that is left.
+see but not reach because an opening on the way is narrower than it squeezes through (at
+that route's bottleneck, on the widest route there): the reason an episode gives when that is
+all that is left.
 """
 
 from __future__ import annotations
