@@ -69,7 +69,8 @@ class RobotBody:
 
     @property
     def passing_width(self) -> float:
-        """The narrowest opening (door) the mind plans through."""
+        """The narrowest opening (door) the mind plans through with its full margin (where
+        its grid shows less, it may still squeeze: `avs_planner.episode.mind.squeeze_radius`)."""
         return 2.0 * self.planning_radius
 
     def drive_time(self, distance: float) -> float:

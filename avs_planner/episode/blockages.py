@@ -6,8 +6,9 @@ planning radius plus a margin that grows with each touch nearby) that the grid's
 traversability (so every path, reachability and standpoint query) respects until
 `retry_after` simulated seconds have passed, and that cuts the place-graph edges through it.
 A blockage at a mapped door names the door. `narrow_openings` finds free space the robot can
-see but not reach because an opening on the way is narrower than its `passing_width`: the
-reason an episode gives when that is all that is left.
+see but not reach because an opening on the way is narrower than it squeezes through (at
+that route's bottleneck, on the widest route there): the reason an episode gives when that is
+all that is left.
 """
 
 from __future__ import annotations
@@ -20,8 +21,6 @@ from scipy import ndimage
 
 from conceptual_map.metric import OccupancyGrid, plan_path
 from conceptual_map.metric.errors import PathQueryError
-from conceptual_map.places.config import PlaceMapConfig
-from conceptual_map.places.doors import openings_along
 from conceptual_map.places.frontiers import reachable_mask
 from conceptual_map.places.model import Door
 
@@ -126,10 +125,14 @@ class NarrowOpening:
 
 
 def narrow_openings(grid: OccupancyGrid, robot: Point, radius: float, doors: dict[str, Door],
-                    config: PlaceMapConfig | None = None, slim: float = 0.12,
-                    min_area: float = 0.5) -> list[NarrowOpening]:
-    """Free space a slim robot reaches but this one (`radius`) does not come near, with the
-    bottleneck on the way to it (the narrowest point of a slim path there)."""
+                    slim: float = 0.12, min_area: float = 0.5) -> list[NarrowOpening]:
+    """Free space a slim robot reaches but this one (`radius`: the slimmest disc it would
+    squeeze through with) does not come near, with the bottleneck of the widest route there.
+
+    The width is the grid's passing width of the best route (the largest disc that still gets
+    from the robot to the region's roomiest cell, plus the grid's half-cell under-estimate on
+    each side), found at the narrowest point of that route: not the narrowest point of the
+    shortest slim path, which may squeeze between two chairs beside a wide gap."""
     mine = reachable_mask(grid, robot, radius)
     thin = reachable_mask(grid, robot, slim)
     if not thin.any():
@@ -144,32 +147,67 @@ def narrow_openings(grid: OccupancyGrid, robot: Point, radius: float, doors: dic
         area = len(cells) * grid.resolution ** 2
         if area < min_area:
             continue
-        goal = grid.to_world(cells[len(cells) // 2][None, :])[0]
+        deep = cells[int(np.argmax(clearance[cells[:, 0], cells[:, 1]]))]
+        goal = grid.to_world(deep[None, :])[0]
+        goal_xy = (float(goal[0]), float(goal[1]))
+        best = _widest_radius(grid, robot, (int(deep[0]), int(deep[1])), slim,
+                              min(radius, float(clearance[deep[0], deep[1]])))
         try:
-            path = plan_path(grid, robot, (float(goal[0]), float(goal[1])), slim, smooth=False)
+            path = plan_path(grid, robot, goal_xy, best, smooth=False)
         except PathQueryError:
             continue
         if not path.found:
             continue
-        points = np.asarray(path.waypoints)
+        points = _densify(np.asarray(path.waypoints), grid.resolution)
         at = grid.to_cell(points)
         values = clearance[at[:, 0], at[:, 1]]
-        i = int(np.argmin(values))
+        i = _bottleneck(grid, robot, at, values, best, (int(deep[0]), int(deep[1])))
         centre = (float(points[i, 0]), float(points[i, 1]))
         width = 2.0 * (float(values[i]) + grid.resolution / math.sqrt(2.0))
-        near = points[np.linalg.norm(points - points[i], axis=1) <= 0.6]
-        chords = openings_along(grid, _densify(near), config) if config else []
-        if chords:  # the door detector's chord is a better width than the path's clearance
-            best = min(chords, key=lambda o: float(np.linalg.norm(o.centre - points[i])))
-            centre = (float(best.centre[0]), float(best.centre[1]))
-            width = best.width
         door = min(doors.values(), key=lambda d: math.dist(d.centre, centre), default=None)
         name = door.id if door is not None and math.dist(door.centre, centre) < 0.5 else None
         out.append(NarrowOpening(centre, round(width, 2), round(area, 1), name))
     return out
 
 
-def _densify(points: np.ndarray, step: float = 0.05) -> np.ndarray:
+def _widest_radius(grid: OccupancyGrid, robot: Point, cell: tuple[int, int], low: float,
+                   high: float, tolerance: float = 0.005) -> float:
+    """The largest disc radius in [low, high] (to `tolerance`) whose reachable space from the
+    robot holds `cell` (`low` is known to reach it)."""
+    if high <= low:
+        return low
+    if reachable_mask(grid, robot, high)[cell]:
+        return high
+    while high - low > tolerance:
+        mid = 0.5 * (low + high)
+        if reachable_mask(grid, robot, mid)[cell]:
+            low = mid
+        else:
+            high = mid
+    return low
+
+
+def _bottleneck(grid: OccupancyGrid, robot: Point, cells: np.ndarray, values: np.ndarray,
+                radius: float, goal: tuple[int, int], step: float = 0.02) -> int:
+    """The index of the route's narrowest point where a slightly larger disc (`radius` +
+    `step`) is cut off: between the last cell near the space such a disc reaches from the
+    robot and the first near the goal's part of it (the corners the route hugs elsewhere at
+    `radius` are not the bottleneck)."""
+    grow = int(math.ceil(step / grid.resolution)) + 1
+    robot_side = ndimage.binary_dilation(reachable_mask(grid, robot, radius + step),
+                                         iterations=grow)[cells[:, 0], cells[:, 1]]
+    labels, _ = ndimage.label(grid.traversable(radius + step))
+    theirs = int(labels[goal])
+    goal_side = (ndimage.binary_dilation(labels == theirs, iterations=grow)[cells[:, 0],
+                                                                           cells[:, 1]]
+                 if theirs else np.zeros(len(cells), dtype=bool))
+    leave = int(np.nonzero(robot_side)[0].max()) if robot_side.any() else 0
+    after = np.nonzero(goal_side[leave:])[0]
+    enter = leave + int(after[0]) if len(after) else len(cells) - 1
+    return leave + int(np.argmin(values[leave:enter + 1]))
+
+
+def _densify(points: np.ndarray, step: float) -> np.ndarray:
     """Points every `step` m along a polyline."""
     if len(points) < 2:
         return points

@@ -479,9 +479,9 @@ class Executor:
         through unknown cells (a laser mounted ahead of the base never sees the cells under
         and behind it); the simulator still refuses any motion that would collide."""
         radius = self.mind.config.robot_radius
-        slim = radius - self.config.squeeze
-        if self.mind.body is not None:  # never slimmer than the footprint less a grid cell
-            slim = max(slim, self.mind.body.footprint_radius - self.mind.grid.resolution)
+        slim = self.mind.config.squeeze_radius  # the mind's own (`mind.squeeze_radius`)
+        if slim is None:
+            slim = radius - self.config.squeeze
         tries = ((slim, False), (radius, True))
         for margin, unknown in tries:
             try:
@@ -490,8 +490,8 @@ class Executor:
                 continue
             if path.found:
                 return path
-        # none found (the robot may stand closer to furniture than its margin: then even a
-        # query from where it stands is refused, which must not end the episode)
+        # no path (the robot may stand where only a squeeze fits: a query from there with
+        # the full radius is refused, which must not end the episode)
         return PathResult(PathStatus.NO_PATH, (), math.inf, 0)
 
     def _free_near(self, goal: tuple[float, float], reach: float = 0.6

@@ -95,6 +95,9 @@ class SwitchingLoop:
         first = self._fallback(self.planner.replan(state.world_state()))
         self._record_plan(first, "initial")
         first = self._recover(first)
+        stop = self._budget_spent()
+        if stop:
+            return self._end(Outcome.TIMEOUT, stop)
         if first is None:
             return self._end(Outcome.GAVE_UP, "planner timed out, nothing to explore")
         if not first.solved:
@@ -123,6 +126,9 @@ class SwitchingLoop:
             result = self._monitor(state, outcome, settled)
             if result is not None:
                 result = self._recover(result)
+                stop = self._budget_spent()
+                if stop:
+                    return self._end(Outcome.TIMEOUT, stop)
                 if result is None:
                     return self._end(Outcome.GAVE_UP, "planner timed out, nothing to explore")
                 state = self.builder.build()
@@ -142,7 +148,8 @@ class SwitchingLoop:
         it tries before giving up). Only plans that search what is already mapped are
         judged: a plan that explores is one chain of assumptions about what lies beyond a
         placeholder, while exploring also reveals every other room and object there, so its
-        p(pi) undervalues it."""
+        p(pi) undervalues it. For the same reason, when no such plan is worth its cost the
+        robot explores the nearest placeholder left before it gives up (`_recover`)."""
         if not (self.config.worth_test and result.solved) or _explores(result.plan):
             return result
         value = self.config.reward * result.probability
@@ -209,13 +216,19 @@ class SwitchingLoop:
         plan reaches the threshold, first look again at rooms whose category is uncertain.
         None when the CP timed out and nothing is left to explore."""
         while True:
+            if self._budget_spent():
+                return result  # the main loop ends the episode on its next step
             while _timed_out(result):
-                if not self._explore_instead() and not self._shrink():
+                if self._budget_spent() or (not self._explore_instead() and not self._shrink()):
                     return None
                 result = self._plan_again("after exploring")
             if result.solved:
                 return result
-            if self._visit_uncertain_room():
+            if result.extra.get("not_worth") and self._explore_instead():
+                # nothing on the mapped part is worth searching, but exploring is worth
+                # more than the one chain of assumptions a plan puts on it (`_worth_it`)
+                result = self._plan_again("after exploring: nothing mapped was worth its cost")
+            elif self._visit_uncertain_room():
                 result = self._plan_again("after visiting an uncertain room")
             elif self._doubt_categories():
                 result = self._plan_again("doubting room categories believed certain")

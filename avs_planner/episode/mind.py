@@ -24,6 +24,17 @@ from conceptual_map.places import MapEvent, PlaceMap, PlaceMapConfig
 Pose = tuple[float, float, float]
 
 
+SQUEEZE = 0.08  # m: at most this much less than the planning radius when squeezing
+
+
+def squeeze_radius(body: RobotBody, resolution: float) -> float:
+    """The slimmest disc the mind plans a squeeze through a gap with: the planning radius
+    less `SQUEEZE`, never below the footprint less one grid cell (the grid's clearance
+    under-estimates the distance to a surface by up to about a cell: a gap the body passes
+    can look up to ~0.1 m narrower than it is). A squeeze the base refuses is a blockage."""
+    return round(max(body.planning_radius - SQUEEZE, body.footprint_radius - resolution), 3)
+
+
 @dataclass(frozen=True)
 class KnownObject:
     """An object the DT planner confirmed: `support` is the object it stands on, if any."""
@@ -61,6 +72,7 @@ class Mind:
     # (place, move target) -> the blockage evidence when that move failed from that place:
     # while the robot stands there with the same evidence, the move is not offered again
     failed_moves: dict[tuple[str, str], frozenset[str]] = field(default_factory=dict)
+    clock: float = 0.0  # s: the time of the last scan sensed
 
     def __post_init__(self) -> None:
         self.grid = OccupancyGrid(resolution=self.resolution)
@@ -71,13 +83,15 @@ class Mind:
     @classmethod
     def for_body(cls, body: RobotBody, knowledge: Knowledge | None = None) -> Mind:
         """A mind that plans for `body`'s footprint (from the robot model, never the world)."""
-        return cls(config=PlaceMapConfig(robot_radius=body.planning_radius),
+        return cls(config=PlaceMapConfig(robot_radius=body.planning_radius,
+                                         squeeze_radius=squeeze_radius(body, cls.resolution)),
                    body=body, knowledge=knowledge)
 
     @property
     def passing_width(self) -> float:
-        """The narrowest opening the mind plans through."""
-        return 2.0 * self.config.robot_radius
+        """The narrowest opening, as the grid measures it (`NarrowOpening.width`), the mind
+        tries to pass: its squeeze disc plus the grid's half-cell under-estimate each side."""
+        return 2.0 * (self.config.reach_radius + self.grid.resolution / math.sqrt(2.0))
 
     # ---- blocked moves ----------------------------------------------------------------------
 
@@ -96,10 +110,13 @@ class Mind:
         return gone
 
     def retry_blocked(self) -> list[Blockage]:
-        """Forget the active blockages now (nothing else is left to try)."""
+        """Forget the active blockages now (nothing else is left to try). The placeholders
+        are re-derived at once: space that only a kept-out spot cut off is a goal again
+        (else the planner would see none until the next scan, and give up)."""
         gone = self.blockages.clear()
         if gone:
             self.grid.set_keep_out([])
+            self._feed.apply(self.place_map.refresh(self.grid, self.clock))
         return gone
 
     def move_failed(self, target: str) -> None:
@@ -115,11 +132,12 @@ class Mind:
 
     def narrow_openings(self, robot: tuple[float, float]) -> list[NarrowOpening]:
         """Openings on the way to seen free space that are narrower than the robot passes."""
-        return narrow_openings(self.grid, robot, self.config.robot_radius, self.place_map.doors,
-                               self.config)
+        return narrow_openings(self.grid, robot, self.config.reach_radius,
+                               self.place_map.doors)
 
     def sense(self, scan: LaserScanLike, poses: list[Pose], time: float) -> list[MapEvent]:
         """Integrate a scan taken at the end of `poses` and grow the place map along them."""
+        self.clock = max(self.clock, time)
         self.forget_blockages(time)
         self.grid.integrate_scan(scan)
         events = self.place_map.follow(self.grid, poses, time)

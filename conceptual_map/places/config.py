@@ -11,6 +11,10 @@ from conceptual_map.errors import MapError
 class PlaceMapConfig:
     place_spacing: float = 1.0  # a new place once the robot is this far from every place
     robot_radius: float = 0.25  # for reachability and straight-line edges
+    # the slimmest disc the robot may try to squeeze through a gap with (its footprint less
+    # the grid's under-estimate of clearance); free space it reaches only this way still gets
+    # placeholders (the width is uncertain until tried: a touch says no). None: robot_radius
+    squeeze_radius: float | None = None
     edge_max_length: float = 1.6  # straight-line edges between places up to this long
     door_max_width: float = 1.5  # openings narrower than this are door hypotheses
     door_min_width: float = 0.5
@@ -31,7 +35,17 @@ class PlaceMapConfig:
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
+            if value is None and f.name == "squeeze_radius":
+                continue
             if not value > 0:
                 raise MapError(f"PlaceMapConfig.{f.name} must be positive, got {value!r}")
         if self.door_min_width >= self.door_max_width:
             raise MapError("PlaceMapConfig: door_min_width must be below door_max_width")
+        if self.squeeze_radius is not None and self.squeeze_radius > self.robot_radius:
+            raise MapError(f"PlaceMapConfig.squeeze_radius ({self.squeeze_radius}) must not "
+                           f"exceed robot_radius ({self.robot_radius})")
+
+    @property
+    def reach_radius(self) -> float:
+        """The disc whose reachable space gets placeholders: `squeeze_radius` if set."""
+        return self.robot_radius if self.squeeze_radius is None else self.squeeze_radius

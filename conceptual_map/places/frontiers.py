@@ -54,7 +54,7 @@ def frontier_regions(
     grid: OccupancyGrid, robot: tuple[float, float], config: PlaceMapConfig
 ) -> list[FrontierRegion]:
     """All reachable frontier regions with at least `min_open_space` unknown behind them."""
-    reachable = reachable_mask(grid, robot, config.robot_radius)
+    reachable = reachable_mask(grid, robot, config.reach_radius)
     if not reachable.any():
         return []
     reach = int(np.ceil(config.reach_tolerance / grid.resolution)) + 1
@@ -64,17 +64,27 @@ def frontier_regions(
     labels, _ = ndimage.label(frontier, structure=_EIGHT)
     sizes = np.bincount(labels.ravel())
     unknown_labels, _ = ndimage.label(grid.state_grid() == CellState.UNKNOWN)
-    roomy = reachable & (grid.clearance() >= config.robot_radius + STANDPOINT_MARGIN)
+    stand_masks = standpoint_masks(grid, reachable, config.robot_radius)
     offset = np.array([window[0].start, window[1].start])
     regions = []
     for k, box in enumerate(ndimage.find_objects(labels), start=1):
         if sizes[k] * grid.resolution < config.min_frontier_length:
             continue
         cells = np.argwhere(labels[box] == k) + [box[0].start, box[1].start] + offset
-        region = _describe(grid, cells, (roomy, reachable), unknown_labels, config)
+        region = _describe(grid, cells, stand_masks, unknown_labels, config)
         if region is not None and region.open_space >= config.min_open_space:
             regions.append(region)
     return regions
+
+
+def standpoint_masks(grid: OccupancyGrid, reachable: np.ndarray, radius: float
+                     ) -> tuple[np.ndarray, ...]:
+    """Where to stand near a goal, in order of preference: roomy (`radius` plus a margin from
+    obstacles), clear of obstacles by `radius`, then anywhere `reachable` (which may have been
+    reached only by squeezing through a gap narrower than `2 * radius`)."""
+    clearance = grid.clearance()
+    return (reachable & (clearance >= radius + STANDPOINT_MARGIN),
+            reachable & (clearance >= radius), reachable)
 
 
 def _bounding_window(mask: np.ndarray, margin: int, shape: tuple[int, ...]) -> tuple[slice, ...]:

@@ -75,6 +75,15 @@ class PlaceMap:
         events += self._refresh_rooms(grid, time)
         return events
 
+    def refresh(self, grid: OccupancyGrid, time: float = 0.0) -> list[MapEvent]:
+        """Re-derive placeholders and rooms from the grid where the robot last was (e.g. after
+        what the grid lets a robot traverse changed without a new scan: blocked spots are
+        forgotten). Nothing happens before the robot's first pose."""
+        if not self._path:
+            return []
+        here = (float(self._path[-1][0]), float(self._path[-1][1]))
+        return self._refresh_placeholders(grid, here, time) + self._refresh_rooms(grid, time)
+
     def room_of(self, place_id: str) -> str | None:
         """The room holding a place (or, for a placeholder, holding its attached place)."""
         if place_id in self.placeholders:
@@ -300,7 +309,7 @@ class PlaceMap:
         points = np.vstack(probes)
         cells = grid.to_cell(points)
         standable = grid.inside(cells)
-        standable[standable] = grid.traversable(self.config.robot_radius)[
+        standable[standable] = grid.traversable(self.config.reach_radius)[
             cells[standable, 0], cells[standable, 1]
         ]
         points = points[standable]  # a robot could pass here, as through a door

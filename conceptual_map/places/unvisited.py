@@ -36,7 +36,7 @@ def unvisited_regions(
     standpoint of a frontier placeholder already leading there)."""
     if not places:
         return []
-    reachable = reachable_mask(grid, robot, config.robot_radius)
+    reachable = reachable_mask(grid, robot, config.reach_radius)
     if not reachable.any():
         return []
     labels = free_regions(grid, doors)
@@ -52,12 +52,14 @@ def unvisited_regions(
     skip = _labels_at(grid, parts, covered)
     min_cells = config.min_unvisited_area / grid.resolution**2
     sizes = np.bincount(parts.ravel(), minlength=count + 1)
-    roomy = grid.clearance() >= config.robot_radius + STANDPOINT_MARGIN
+    clearance = grid.clearance()
+    prefer = (clearance >= config.robot_radius + STANDPOINT_MARGIN,
+              clearance >= config.robot_radius)
     regions = []
     for k, box in enumerate(ndimage.find_objects(parts), start=1):
         if sizes[k] < min_cells or k in skip:
             continue
-        region = _describe(grid, parts[box] == k, (box[0].start, box[1].start), roomy)
+        region = _describe(grid, parts[box] == k, (box[0].start, box[1].start), prefer)
         regions.append(region)
     return regions
 
@@ -72,14 +74,19 @@ def _labels_at(grid: OccupancyGrid, parts: np.ndarray, points: list[tuple[float,
 
 
 def _describe(grid: OccupancyGrid, mask: np.ndarray, offset: tuple[int, int],
-              roomy: np.ndarray) -> FrontierRegion:
-    """A standpoint (roomy if possible) nearest the region's medoid; its area as open space."""
+              prefer: tuple[np.ndarray, ...]) -> FrontierRegion:
+    """A standpoint nearest the region's medoid (in the first of the `prefer` masks that has
+    one in the region: roomy, then clear by the robot radius); its area as open space."""
     cells = np.argwhere(mask) + offset
     medoid = cells[np.argmin(np.linalg.norm(cells - cells.mean(axis=0), axis=1))]
     inside = np.zeros(grid.shape, dtype=bool)
     inside[cells[:, 0], cells[:, 1]] = True
     window = max(mask.shape)
-    stand = nearest_true(inside & roomy, medoid, window)
+    stand = None
+    for mask_ in prefer:
+        stand = nearest_true(inside & mask_, medoid, window)
+        if stand is not None:
+            break
     if stand is None:
         stand = medoid
     standpoint = grid.to_world(np.asarray([stand]))[0]

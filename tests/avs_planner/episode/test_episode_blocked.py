@@ -51,7 +51,11 @@ def test_the_mind_plans_with_the_robots_own_footprint() -> None:
 def test_a_door_narrower_than_the_pr2_is_never_planned_through_and_named() -> None:
     summary, episode = _episode(0.6, "pr2")
     assert summary["outcome"] == "gave_up"
-    assert "needs 0.72 m" in summary["reason"] and "wide at (4.9" in summary["reason"]
+    # the grid's width of the door (0.6 m) and what the PR2 squeezes through at the least
+    # (0.29 m disc + the grid's half-cell under-estimate each side: 0.65 m)
+    assert "needs 0.65 m" in summary["reason"] and "wide at (4.9" in summary["reason"]
+    width = float(summary["reason"].split("about ")[1].split(" m wide")[0])
+    assert 0.5 <= width <= 0.65
     assert all(x < 5.0 for x, *_ in episode.executor.stats.path)  # never went through
     assert not episode.mind.blockages.items  # never even tried (so never blocked)
 
@@ -178,3 +182,123 @@ def test_blocked_spots_are_retried_when_nothing_else_is_left_at_most_twice(corri
     assert len(mind.blockages.seen) == 3
     assert [round(b.radius, 2) for b in mind.blockages.seen.values()] == [0.35, 0.4, 0.45]
     assert "touched something unmapped" in loop._cut_off()
+
+
+def test_an_opening_is_measured_on_the_widest_route_not_the_shortest_slim_one() -> None:
+    """Room B is seen through a 0.4 m gap (on the short way) and a 0.8 m door (further): for a
+    robot that passes neither, the door is reported 0.8 m wide where it is. The narrowest
+    point of the shortest path a slim robot could take was reported before (0.42 m, off the
+    door), so a door a robot does pass looked too narrow from where it was seen."""
+    from avs_planner.episode.blockages import narrow_openings
+    from conceptual_map.metric import OccupancyGrid
+    from conceptual_map.metric.synthetic import rooms_world
+
+    world = rooms_world([(0, 0, 4, 4), (4, 0, 8, 4)], [(4.0, 0.8, 0.4), (4.0, 3.0, 0.8)],
+                        wall=0.1)
+    grid = OccupancyGrid()
+    for pose in [(2.0, 0.8, 0.0), (2.0, 3.0, 0.0), (3.2, 2.0, 0.0), (3.0, 0.8, 0.0)]:
+        grid.integrate_scan(world.laser(pose, beams=2880, max_range=8.0))
+    found = narrow_openings(grid, (2.0, 0.8), 0.45, {})
+    door = min(found, key=lambda o: math.dist(o.centre, (4.0, 3.0)))
+    assert math.dist(door.centre, (4.0, 3.0)) < 0.2 and door.width == pytest.approx(0.8, abs=0.05)
+    gap = min(found, key=lambda o: math.dist(o.centre, (4.0, 0.8)))
+    assert math.dist(gap.centre, (4.0, 0.8)) < 0.2 and gap.width == pytest.approx(0.4, abs=0.05)
+    # a robot that squeezes through 0.8 m reaches room B through the door: only the space
+    # seen through the 0.4 m gap alone is left unreachable
+    left = narrow_openings(grid, (2.0, 0.8), 0.36, {})
+    assert [math.dist(o.centre, (4.0, 0.8)) < 0.2 for o in left] == [True]
+
+
+_GAP_WORLD = """name: gap_{gap}
+size: [10.0, 5.0]
+wall_height: 2.0
+rooms:
+  - {{name: hall, category: office, rect: [0.0, 0.0, 5.0, 5.0]}}
+  - {{name: kitchen, category: kitchen, rect: [5.0, 0.0, 10.0, 5.0]}}
+doors:
+  - {{rooms: [hall, kitchen], at: [5.0, 1.0], width: 1.0}}
+furniture:
+  - {{name: fridge1, label: fridge, room: kitchen, pose: [6.8, {centre}, 0.0],
+     size: [0.4, {length}, 1.9]}}
+  - {{name: table1, label: table, room: kitchen, pose: [8.5, 1.5, 0.0], size: [1.0, 0.8, 0.75]}}
+objects:
+  - {{name: cereal1, label: cerealbox, on: table1, offset: [0.0, 0.0], size: [0.2, 0.07, 0.3]}}
+robot: {{model: pioneer, start: [2.5, 2.5, 0.0]}}
+"""
+
+
+@pytest.mark.parametrize("robot", ["pioneer", "pr2"])
+def test_a_target_behind_a_gap_the_grid_under_measures_is_found(robot: str) -> None:
+    """A tall fridge row leaves a 0.74 m gap to the wall, the only way to the table: the PR2
+    (0.68 m) passes it, but the grid (a lower bound on clearance) shows it narrower than the
+    0.72 m planning disc. The space behind it is a placeholder the robot squeezes to."""
+    gap, low = 0.74, 0.06
+    top = 4.95 - gap  # the wall's inner face is at 4.95
+    world = _GAP_WORLD.format(gap=gap, centre=round((top + low) / 2, 3),
+                              length=round(top - low, 3))
+    spec = EpisodeSpec.from_dict({"target": "cerealbox", "world_file": world, "robot": robot,
+                                  "seed": 1, "time_budget_s": 900.0})
+    summary = Episode(spec).run()
+    assert summary["outcome"] == "found" and summary["correct"], summary["reason"]
+
+
+def test_retrying_blocked_spots_brings_back_the_placeholders_they_cut_off() -> None:
+    """A blockage in the only door hides the room beyond; when the loop retries blocked spots
+    (nothing else left) the placeholder there is a goal again at once, not after the next
+    scan (the planner saw no goal and gave up: generated office world 4, pr2, keyboard)."""
+    from conceptual_map.metric.synthetic import rooms_world
+
+    world = rooms_world([(0.0, 0.0, 4.0, 4.0), (4.0, 0.0, 9.0, 4.0)], [(4.0, 2.0, 1.0)],
+                        wall=0.1)
+    mind = Mind()
+
+    def sense(pose: tuple[float, float, float], time: float) -> None:
+        mind.sense(world.laser(pose, beams=1440, fov=4.18, max_range=5.6), [pose], time)
+
+    sense((2.0, 2.0, 0.0), 0.0)
+    sense((2.0, 2.0, math.pi), 1.0)
+    beyond = [p for p in mind.place_map.placeholders.values() if p.position[0] > 4.2]
+    assert beyond
+    mind.block((4.0, 2.0), 5.0)
+    sense((2.0, 2.0, 0.0), 6.0)
+    assert not [p for p in mind.place_map.placeholders.values() if p.position[0] > 4.2]
+    assert mind.retry_blocked()
+    back = [p for p in mind.place_map.placeholders.values() if p.position[0] > 4.2]
+    assert back and all(p.id in mind.cmap.placeholders for p in back)
+
+
+_OBLIQUE_WORLD = """name: oblique
+size: [12.0, 6.0]
+wall_height: 2.0
+rooms:
+  - {name: corridor, category: corridor, rect: [0.0, 0.0, 12.0, 1.8]}
+  - {name: office, category: office, rect: [0.0, 1.8, 8.0, 6.0]}
+  - {name: kitchen, category: kitchen, rect: [8.0, 1.8, 12.0, 6.0]}
+doors:
+  - {rooms: [corridor, office], at: [1.2, 1.8], width: 0.9}
+  - {rooms: [corridor, kitchen], at: [10.8, 1.8], width: 0.75}
+furniture:
+  - {name: desk1, label: desk, room: office, pose: [4.0, 5.5, 0.0], size: [1.4, 0.7, 0.75]}
+  - {name: table1, label: table, room: kitchen, pose: [10.0, 5.0, 0.0], size: [1.0, 0.8, 0.75]}
+objects:
+  - {name: cereal1, label: cerealbox, on: table1, offset: [0.0, 0.0], size: [0.2, 0.07, 0.3]}
+robot: {model: pioneer, start: [1.0, 0.9, 0.0]}
+"""
+
+
+@pytest.mark.parametrize("robot", [
+    "pioneer",
+    pytest.param("pr2", marks=pytest.mark.xfail(strict=False, reason=(
+        "known, issue 26: with glimpses on (the switching default) the PR2 touches this "
+        "0.75 m door's jamb and keeps out of it: found in 1 of seeds 0-3 (3 of 4 with "
+        "strategy option glimpses=false)"))),
+])
+def test_a_target_behind_a_door_first_seen_obliquely_is_found(robot: str) -> None:
+    """The kitchen's 0.75 m door is first seen from 10 m down the corridor: the grid shows it
+    narrower than it is (0.70 m), below the PR2's 0.72 m planning disc (the PR2 gave up
+    there, 'the robot needs 0.79 m'); the space behind stays a goal and both robots find
+    the cereal box."""
+    spec = EpisodeSpec.from_dict({"target": "cerealbox", "world_file": _OBLIQUE_WORLD,
+                                  "robot": robot, "seed": 1, "time_budget_s": 900.0})
+    summary = Episode(spec).run()
+    assert summary["outcome"] == "found" and summary["correct"], summary["reason"]
