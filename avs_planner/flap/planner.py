@@ -6,13 +6,15 @@ views (eq. 7, flag xi), branches only up to depth psi and only on children whose
 least the best utility / phi, and stops a plan once it is complete (eq. 9, omega). Its first
 dive is the greedy sequence, so it is anytime. Set differences only: each node keeps, per view,
 the weight of the atoms it would still reveal, and subtracts what the chosen view covers.
+xi, psi and phi give up optimality for speed; an instance small enough to search without them
+within the node budget (`PlannerOptions.exact_nodes`) is searched exactly.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import Enum
 
 import numpy as np
@@ -43,6 +45,13 @@ class PlannerOptions:
     in a deep search only after the alternatives for the first views were compared. Without
     it a depth-first search cut short by a limit has only varied the last branching levels:
     its first view, the only one a continual planner executes, is then the greedy one.
+
+    exact_nodes: an instance whose tree of all view sequences has at most this many nodes
+    (those with a positive gain; 8 views: 109,600) is searched exactly, with xi, psi and phi
+    off. xi, psi and phi give up optimality to make big instances tractable (eq. 7 is
+    Sarmiento et al.'s heuristic, not a safe rule: it can drop the view on the way to the
+    others); a search that fits the default node budget (200,000) even without any pruning
+    needs none of them. 0 keeps the heuristics at every size.
     """
 
     xi: bool = True
@@ -52,16 +61,31 @@ class PlannerOptions:
     max_nodes: int | None = 200_000
     time_limit: float | None = None
     deepen: bool = True
+    exact_nodes: int = 200_000
 
     def check(self) -> None:
         if self.psi < 0 or self.phi < 1.0:
             raise FlapError(f"need psi >= 0 and phi >= 1, got {self.psi}, {self.phi}")
+        if self.exact_nodes < 0:
+            raise FlapError(f"exact_nodes must be >= 0, got {self.exact_nodes}")
         if not 0.0 < self.omega < 1.0:
             raise FlapError(f"omega must be in (0, 1), got {self.omega}")
 
 
 EXACT = PlannerOptions(xi=False, psi=10**9, phi=math.inf, max_nodes=None, deepen=False)
-GREEDY = PlannerOptions(psi=0)
+GREEDY = PlannerOptions(psi=0, exact_nodes=0)
+
+
+def sequence_tree_size(views: int, cap: int | None = None) -> int:
+    """Nodes of the tree of all sequences of distinct views (sum of n!/(n-k)!, k = 1..n),
+    counted up to `cap` (the count stops growing once it passes the cap)."""
+    total, level = 0, 1
+    for k in range(views):
+        level *= views - k
+        total += level
+        if cap is not None and total > cap:
+            break
+    return total
 
 
 @dataclass(frozen=True)
@@ -74,6 +98,7 @@ class PlanResult:
     nodes: int
     stop: StopReason
     seconds: float
+    exact: bool = False  # searched without xi, psi, phi (the instance fits exact_nodes)
 
     # An empty sequence with an infinite expected time: a limit struck before the first
     # complete plan (the first dive is the greedy one, so give it at least its length).
@@ -93,7 +118,7 @@ def plan_views(problem: SequencingProblem, options: PlannerOptions | None = None
 
 def plan_greedy(problem: SequencingProblem, omega: float = 0.05) -> PlanResult:
     """The greedy baseline: always the next best view by utility p/t until complete."""
-    return plan_views(problem, PlannerOptions(psi=0, omega=omega))
+    return plan_views(problem, PlannerOptions(psi=0, omega=omega, exact_nodes=0))
 
 
 class _Limit(Exception):
@@ -102,8 +127,13 @@ class _Limit(Exception):
 
 class _BranchAndBound:
     def __init__(self, problem: SequencingProblem, options: PlannerOptions):
-        self.p, self.o = problem, options
         self.members = problem.members.astype(np.float64)
+        useful = int(np.count_nonzero(self.members @ problem.weights > _EPS))
+        self.exact = options.exact_nodes > 0 and (
+            sequence_tree_size(useful, options.exact_nodes) <= options.exact_nodes)
+        if self.exact:  # small enough to search every sequence: no heuristic pruning
+            options = replace(options, xi=False, psi=max(useful, 1), phi=math.inf)
+        self.p, self.o = problem, options
         self.atoms = [np.flatnonzero(row) for row in problem.members]
         self.overlaps: dict[int, sparse.csr_matrix] = {}
         self.columns: sparse.csc_matrix | None = None
@@ -122,7 +152,8 @@ class _BranchAndBound:
         began = time.perf_counter()
         self.deadline = None if self.o.time_limit is None else began + self.o.time_limit
         if self.p.size == 0 or self.p.p_all() < self.o.omega:
-            return PlanResult((), 0.0, 0.0, 0, StopReason.DONE, time.perf_counter() - began)
+            return PlanResult((), 0.0, 0.0, 0, StopReason.DONE, time.perf_counter() - began,
+                              self.exact)  # fmt: skip
         gain = self.members @ self.p.weights
         stop = StopReason.SEARCHED
         depths = range(self.o.psi + 1) if self.o.deepen else (self.o.psi,)
@@ -137,7 +168,7 @@ class _BranchAndBound:
             stop = limit.args[0]
         cost, seq, survive = self.best
         return PlanResult(seq, cost, 1.0 - survive, self.nodes, stop,
-                          time.perf_counter() - began)  # fmt: skip
+                          time.perf_counter() - began, self.exact)  # fmt: skip
 
     def _visit(
         self, gain: np.ndarray, rest: np.ndarray, last: int, cost: float, survive: float
@@ -255,7 +286,7 @@ def plan_exhaustive(problem: SequencingProblem, omega: float = 0.05) -> PlanResu
     walk.extend([], np.zeros(problem.weights.size, dtype=bool), 0.0, 1.0)
     seq = walk.best_sequence
     return PlanResult(seq, walk.best_cost, problem.p_sequence(seq), walk.count,
-                      StopReason.SEARCHED, time.perf_counter() - began)  # fmt: skip
+                      StopReason.SEARCHED, time.perf_counter() - began, True)  # fmt: skip
 
 
 class _Enumeration:

@@ -18,7 +18,7 @@ from scipy.cluster.vq import kmeans2
 from avs_planner.body import RobotBody
 from avs_planner.flap.errors import FlapError
 from avs_planner.flap.sampling import ViewPose
-from conceptual_map.metric import OccupancyGrid, distance_fields, plan_path
+from conceptual_map.metric import OccupancyGrid, distances_at, plan_path
 
 
 @dataclass(frozen=True)
@@ -105,10 +105,8 @@ def build_table(
     rng = np.random.default_rng(seed)
     xy = np.array([(p.x, p.y) for p in poses])
     labels, reps = _cluster(xy, clusters, rng)
-    fields = distance_fields(grid, [(start.x, start.y)] + [tuple(xy[r]) for r in reps],
-                             body.footprint_radius)
-    cells = grid.to_cell(xy)
-    at_views = fields[:, cells[:, 0], cells[:, 1]]  # (1 + k, n) grid metres
+    at_views = distances_at(grid, [(start.x, start.y)] + [tuple(xy[r]) for r in reps],
+                            grid.to_cell(xy), body.footprint_radius)  # (1 + k, n) grid metres
     kept = np.nonzero(np.isfinite(at_views[0]))[0]
     if kept.size == 0:
         raise FlapError("no view is reachable from the robot's pose")

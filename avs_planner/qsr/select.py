@@ -22,6 +22,7 @@ from avs_planner.errors import AvsError
 from avs_planner.qsr.geometry import in_frustums, in_view_cones, line_of_sight
 from avs_planner.qsr.poses import sample_poses
 from conceptual_map.metric import OccupancyGrid
+from conceptual_map.metric.path_planning import distance_field
 
 
 class ViewSelectionError(AvsError):
@@ -153,6 +154,43 @@ def _select(
     frustums = rank_frustums(poses[k], points, weights, body, reach, options.torso,
                              None if visible is None else visible[k])
     return ViewSelection(SelectionStatus.SELECTED, method, scored[k], scored, frustums)
+
+
+def pose_times(
+    poses: tuple[ScoredPose, ...], grid: OccupancyGrid, start: tuple[float, float, float],
+    body: RobotBody,
+) -> np.ndarray:
+    """Seconds from the robot's pose `start` to each pose: grid-path distance at the body's
+    speed, turning onto the straight line and then to the pose's heading (a differential
+    base; an omni base only turns to the heading); inf where the grid has no path."""
+    x, y, yaw = start
+    field = distance_field(grid, (x, y), body.footprint_radius)
+    out = np.full(len(poses), np.inf)
+    for k, p in enumerate(poses):
+        cell = grid.cell_of((p.x, p.y))
+        if not grid.contains(cell) or not math.isfinite(dist := float(field[cell])):
+            continue
+        line = math.atan2(p.y - y, p.x - x)
+        turn = (body.turn_time(line - yaw) + body.turn_time(p.yaw - line)
+                if dist > 1e-6 and not body.holonomic else body.turn_time(p.yaw - yaw))
+        out[k] = body.drive_time(dist) + turn
+    return out
+
+
+def best_rate(
+    poses: tuple[ScoredPose, ...], grid: OccupancyGrid, start: tuple[float, float, float],
+    body: RobotBody, look_s: float,
+) -> ScoredPose | None:
+    """The pose with the most eq. 2 score per second of getting there and looking for
+    `look_s`: the utility p/t of Sarmiento et al. that FLAP (seed 000, eq. 6) plans with,
+    where p is the belief's mass in the pose's cone. None if no pose is reachable."""
+    if look_s <= 0.0:
+        raise ViewSelectionError(f"look_s must be > 0 s, got {look_s}")
+    times = pose_times(poses, grid, start, body) + look_s
+    if not len(poses) or not np.isfinite(times).any():
+        return None
+    rates = np.array([p.score for p in poses]) / times
+    return poses[int(np.argmax(np.where(np.isfinite(times), rates, -np.inf)))]
 
 
 def cone_half_angle(body: RobotBody, pan_sweep: float = 0.0) -> float:

@@ -344,6 +344,7 @@ def _search_region(ctx: SearchContext, result: SearchResult, volumes: list[Targe
                        expected_time=(round(plan.expected_time, 2) if plan and
                                       math.isfinite(plan.expected_time) else None),
                        stop=plan.stop.value if plan else None,
+                       exact=bool(plan and plan.exact),
                        seconds={**{n: round(s, 3) for n, s in decision.seconds.items()},
                                 "total": round(time.perf_counter() - began, 3)})
         if decision.status is not SearchStatus.GO:

@@ -37,8 +37,10 @@ from avs_planner.episode.mind import KnownObject
 from avs_planner.episode.outcome import Outcome, SearchResult, StepStatus
 from avs_planner.qsr import (
     LandmarkTracker,
+    ScoredPose,
     ViewMethod,
     ViewOptions,
+    best_rate,
     in_frustums,
     landmarks_from,
     line_of_sight,
@@ -165,7 +167,9 @@ class QsrSearch:
                                    start=pose[:2], occlusion=ctx.mind.voxels))  # fmt: skip
             if not view.selected:
                 return self._end(Outcome.GAVE_UP, f"view selection: {view.status.value}")
-            best = view.best
+            best = view.best  # eq. 2's argmax (random: a random one)
+            if self.opt["utility"] == "rate" and self.method is not ViewMethod.RANDOM:
+                best = self.choose(view.poses)
             ctx.trace.emit("action", action=f"(view-pose {self.method.value})", status="start",
                            pose=[round(best.x, 2), round(best.y, 2), round(best.yaw, 3)],
                            score=round(best.score, 4), plane_voxels=len(planes))
@@ -181,7 +185,7 @@ class QsrSearch:
             self.poses += 1
             found = known_target(ctx)  # seen while driving there (option watch)
             if found is None:
-                found = self.perceive(self.frustums_here(planes.points, density))
+                found = self.perceive(planes, density)
             ctx.trace.emit("action", action=f"(view-pose {self.method.value})", status="done",
                            poses=self.poses, search_time_s=round(self.search_time(), 2))
             if found is not None:
@@ -189,6 +193,13 @@ class QsrSearch:
                 self.result.found = found
                 where = ", ".join(f"{v:.2f}" for v in found.position)
                 return self._end(Outcome.FOUND, f"{found.label} at ({where}) in {found.room}")
+
+    def choose(self, poses: tuple[ScoredPose, ...]) -> ScoredPose:
+        """Option `utility: rate`: the pose with the most density per second of getting there
+        and looking (`avs_planner.qsr.best_rate`)."""
+        body = self.ctx.body
+        look = self.opt["frustums"] * (body.scan_time + body.sensing_time)
+        return best_rate(poses, self.ctx.mind.grid, self.ctx.robot.pose, body, look) or poses[0]
 
     def search_time(self) -> float:
         return self.ctx.robot.clock - self.search_start
@@ -252,25 +263,42 @@ class QsrSearch:
         size = (self.opt["depth_columns"], self.opt["depth_rows"])
         self.ctx.mind.integrate_depth(self.ctx.robot.depth(size))
 
-    def frustums_here(self, points: np.ndarray, density: np.ndarray):  # noqa: ANN201
+    def frustums_here(self, points: np.ndarray, density: np.ndarray,
+                      visible: np.ndarray | None = None):  # noqa: ANN201
         """The nine frustums ranked again where the robot really stands (the executor stops
         within its arrival distance of the pose), with line of sight from there."""
         body, mind = self.ctx.body, self.ctx.mind
         pose = np.asarray(self.ctx.robot.pose, dtype=float)
-        camera = np.array([[pose[0], pose[1], body.camera_height]])
-        visible = line_of_sight(mind.voxels, camera, points)[0]
+        if visible is None:
+            camera = np.array([[pose[0], pose[1], body.camera_height]])
+            visible = line_of_sight(mind.voxels, camera, points)[0]
         return rank_frustums(pose, points, density, body, body.detect_range, 0.0, visible)
 
-    def perceive(self, frustums) -> KnownObject | None:  # noqa: ANN001 - Frustum tuple
+    def perceive(self, planes: SupportingPlanes, density: np.ndarray) -> KnownObject | None:
         """Look with the best frustums (a depth frame each, for the 3D map), detect the
-        target and confirm it with a second frame."""
+        target and confirm it with a second frame. With `rerank`, after a look that found
+        nothing the frustums not yet used here are ranked again on the updated belief (the
+        look's voxels times `seen_weight`), as the next pose is."""
         ctx = self.ctx
         body = ctx.body
-        for i, f in enumerate(frustums[: self.opt["frustums"]]):
-            if i > 0 and f.score <= 0.0:
+        points = planes.points
+        pose = np.asarray(ctx.robot.pose, dtype=float)
+        camera = np.array([[pose[0], pose[1], body.camera_height]])
+        visible = line_of_sight(ctx.mind.voxels, camera, points)[0]
+        frustums = list(self.frustums_here(points, density, visible))
+        used: list[tuple[float, float]] = []
+        for i in range(self.opt["frustums"]):
+            if self.opt["rerank"] and i > 0:
+                fresh = self.frustums_here(points, self.density(planes), visible)
+                frustums = [f for f in fresh if (f.pan, f.tilt) not in used]
+            elif i > 0:
+                frustums = frustums[1:]
+            if not frustums or (i > 0 and frustums[0].score <= 0.0):
                 break
+            f = frustums[0]
             if self.search_time() >= self.opt["abort_s"]:
                 break
+            used.append((f.pan, f.tilt))
             ctx.robot.look(f.pan, f.tilt)
             ctx.trace.emit("action", action="(look)", pan=round(f.pan, 3), tilt=round(f.tilt, 3),
                            score=round(f.score, 4))

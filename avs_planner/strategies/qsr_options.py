@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from avs_planner.errors import AvsError
+
 OPTIONS: dict[str, Any] = {
     "abort_s": 120.0,  # the seed's search monitor: simulated seconds of search before abort
     "n_poses": 20,  # poses sampled per selection (Algorithm 1's n)
@@ -12,8 +14,12 @@ OPTIONS: dict[str, Any] = {
     "pan_sweep_deg": 0.0,  # widen the 2D cone by a head pan each way (the seed's Table IV: 60)
     "seen_weight": 0.25,  # density factor of a voxel per look that covered it: about the
     # chance that a look misses a cup in view (camera miss 0.2, + 0.8 x 0.2^2 unconfirmed)
+    "rerank": True,  # rank the frustums at a pose again after each look that found nothing
+    # (on the belief with that look's miss), instead of taking the first ranking's next one
     "confirm_frames": 2,  # frames to confirm a first detection (any one agreeing suffices)
     "uniform_floor": 0.02,  # qsr: share of uniform density mixed in (wrong QSRs stay findable)
+    "utility": "rate",  # pose choice: rate (eq. 2's score per second of getting there and
+    # looking, Sarmiento et al.'s p/t) or eq2 (the seed's argmax of eq. 2, travel ignored)
     "max_poses": 40,  # view poses before giving up regardless of time
     "survey_stops": 12,  # frontier stops of the survey at most (after looking round at the
     # start); it ends sooner when no frontier is left: the seed starts with complete maps
@@ -24,3 +30,12 @@ OPTIONS: dict[str, Any] = {
     "learn": True,  # after a found object, update the knowledge kept for the next search
     "learn_file": "",  # QSR YAML read at start (when it exists) and written after learning
 }
+
+UTILITIES = ("rate", "eq2")
+
+
+def check_options(options: dict[str, Any]) -> None:
+    """The registry's check of the QSR strategies' options beyond their types."""
+    if options["utility"] not in UTILITIES:
+        raise AvsError(f"option 'utility' must be one of {', '.join(UTILITIES)}, "
+                       f"got {options['utility']!r}")

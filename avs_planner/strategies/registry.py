@@ -14,6 +14,8 @@ from avs_planner.errors import AvsError
 from avs_planner.strategies.context import SearchContext
 from avs_planner.strategies.qsr_options import OPTIONS as _QSR_OPTIONS
 
+_QSR_CHECK = "avs_planner.strategies.qsr_options:check_options"
+
 Run = Callable[[SearchContext], SearchResult]
 
 
@@ -132,12 +134,15 @@ STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
     Strategy("qsr", "indirect search (Kunze et al.): survey landmarks and supporting planes, "
              "then views where the QSR mixture (target relative to landmarks) is densest; "
              "abort after 120 s of search",
-             "avs_planner.strategies.qsr:run_qsr", _QSR_OPTIONS),
+             "avs_planner.strategies.qsr:run_qsr", _QSR_OPTIONS,
+             check=_QSR_CHECK),
     Strategy("supporting-planes", "QSR baseline: as qsr, views scored by a uniform density "
              "over the supporting planes",
-             "avs_planner.strategies.qsr:run_supporting_planes", _QSR_OPTIONS),
+             "avs_planner.strategies.qsr:run_supporting_planes", _QSR_OPTIONS,
+             check=_QSR_CHECK),
     Strategy("random", "QSR baseline: as qsr, but a random one of the 20 sampled view poses",
-             "avs_planner.strategies.qsr:run_random", _QSR_OPTIONS),
+             "avs_planner.strategies.qsr:run_random", _QSR_OPTIONS,
+             check=_QSR_CHECK),
     Strategy("flap", "FLAP (seed 000): frontier view sampling in the 3D map and expected-time "
              "view sequencing over the target's known supports (greedy: true is its baseline)",
              "avs_planner.strategies.flap:run", _FLAP_OPTIONS,

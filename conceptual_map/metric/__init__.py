@@ -8,6 +8,7 @@ from conceptual_map.metric.path_planning import (
     PathStatus,
     distance_field,
     distance_fields,
+    distances_at,
     plan_path,
 )
 from conceptual_map.metric.sensors import DepthFrameLike, LaserScanLike, Rays
@@ -28,5 +29,6 @@ __all__ = [
     "VoxelMap",
     "distance_field",
     "distance_fields",
+    "distances_at",
     "plan_path",
 ]

@@ -228,6 +228,46 @@ def distance_fields(
     return dist.reshape((len(starts),) + grid.shape)
 
 
+def distances_at(
+    grid: OccupancyGrid,
+    starts: list[tuple[float, float]],
+    cells: np.ndarray,
+    robot_radius: float = 0.25,
+    allow_unknown: bool = False,
+) -> np.ndarray:
+    """`distance_fields` read at `cells` ((m, 2) grid cells) only: (k, m) metres, inf where
+    unreachable. Dijkstra runs on the traversable cells alone, so neither its graph nor its
+    result spans the whole map (k full fields of a building map are tens of MB)."""
+    cells = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
+    starts_cells = [grid.cell_of(s) for s in starts]
+    for s, cell in zip(starts, starts_cells, strict=True):
+        if not grid.contains(cell):
+            raise PathQueryError(f"start ({s[0]:.2f}, {s[1]:.2f}) is outside the map")
+    inside = np.all((cells >= 0) & (cells < np.asarray(grid.shape)), axis=1)
+    if not inside.all():
+        bad = cells[~inside][0]
+        raise PathQueryError(f"cell ({bad[0]}, {bad[1]}) is outside the map")
+    mask = grid.traversable(robot_radius, allow_unknown)
+    for cell in starts_cells:
+        if not mask[cell]:
+            mask = mask | _escape_zone(grid, cell, robot_radius)
+    nodes = np.flatnonzero(mask.ravel())
+    graph = (_grid_graph(mask) * grid.resolution).tocsr()[nodes][:, nodes]
+    index = np.full(mask.size, -1, dtype=np.int64)
+    index[nodes] = np.arange(nodes.size)
+    flat_starts = np.array([i * grid.shape[1] + j for i, j in starts_cells], dtype=np.int64)
+    flat_cells = cells[:, 0] * grid.shape[1] + cells[:, 1]
+    out = np.full((len(starts), cells.shape[0]), np.inf)
+    out[flat_starts[:, None] == flat_cells[None, :]] = 0.0  # a start's own cell, as a field
+    src = index[flat_starts]
+    at = index[flat_cells]
+    rows = np.flatnonzero(src >= 0)
+    if rows.size and (at >= 0).any():
+        dist = csgraph.dijkstra(graph, indices=src[rows])
+        out[np.ix_(rows, np.flatnonzero(at >= 0))] = dist[:, at[at >= 0]]
+    return out
+
+
 def _grid_graph(mask: np.ndarray) -> sparse.csr_matrix:
     rows, cols = mask.shape
     index = np.arange(rows * cols).reshape(rows, cols)

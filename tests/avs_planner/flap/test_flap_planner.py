@@ -14,6 +14,7 @@ from avs_planner.flap.planner import (
     plan_exhaustive,
     plan_greedy,
     plan_views,
+    sequence_tree_size,
 )
 from avs_planner.flap.problem import SequencingProblem
 from avs_planner.flap.sampling import ViewPose, ViewSampler
@@ -80,13 +81,42 @@ def test_default_planner_within_two_percent_on_room_instances(scene, belief) -> 
     full = SequencingProblem.build([views[k].cells for k in table.kept], belief.log_miss(),
                                    table.start, table.times)  # fmt: skip
     rng = np.random.default_rng(0)
-    gaps = []
-    for k in range(24):  # a single instance can be far off (xi prunes the view on the way)
+    gaps, heuristic_gaps = [], []
+    for k in range(24):
         problem = full.subset(rng.choice(full.size, 6 + k % 2, replace=False))
         best = plan_exhaustive(problem).expected_time
         assert plan_views(problem, EXACT).expected_time == pytest.approx(best, rel=1e-12)
-        gaps.append(plan_views(problem).expected_time / best - 1.0)
-    assert min(gaps) >= -1e-12 and np.mean(gaps) <= 0.02, gaps
+        default = plan_views(problem)
+        assert default.exact  # 6 or 7 views: the whole sequence tree fits exact_nodes
+        gaps.append(default.expected_time / best - 1.0)
+        heuristic = plan_views(problem, PlannerOptions(exact_nodes=0))
+        heuristic_gaps.append(heuristic.expected_time / best - 1.0)
+    assert max(abs(g) for g in gaps) <= 1e-12, gaps
+    # xi, psi, phi at this size: near on average, but single instances are far off (xi
+    # prunes the view on the way to the others), which is why small instances go exact
+    assert min(heuristic_gaps) >= -1e-12 and np.mean(heuristic_gaps) <= 0.02
+    assert max(heuristic_gaps) > 0.01, heuristic_gaps
+
+
+def test_sequence_tree_size_and_the_exact_switch() -> None:
+    assert [sequence_tree_size(n) for n in range(4)] == [0, 1, 4, 15]
+    assert sequence_tree_size(8) == 109_600 and sequence_tree_size(9) == 986_409
+    assert sequence_tree_size(30, cap=1000) <= 1000 * 30  # counting stops past the cap
+    rng = np.random.default_rng(3)
+    assert plan_views(random_problem(8, rng)).exact
+    assert not plan_views(random_problem(9, rng)).exact  # 986,409 > 200,000
+    assert not plan_views(random_problem(8, rng), PlannerOptions(exact_nodes=0)).exact
+    # views that see nothing left do not count: 9 views, one of them useless, is exact
+    members = np.zeros((9, 8), dtype=bool)
+    members[np.arange(8), np.arange(8)] = True
+    problem = problem_from(members, np.full(8, 0.1), np.arange(1.0, 10.0), np.ones((9, 9)))
+    assert plan_views(problem).exact
+    # the greedy baseline stays greedy on small instances
+    small = random_problem(6, np.random.default_rng(4))
+    greedy = plan_greedy(small)
+    assert not greedy.exact and greedy.nodes == len(greedy.sequence) + 1
+    with pytest.raises(FlapError):
+        plan_views(small, PlannerOptions(exact_nodes=-1))
 
 
 def test_greedy_is_one_dive_by_utility() -> None:

@@ -8,13 +8,16 @@ import pytest
 from avs_planner.body import JointRange, RobotBody
 from avs_planner.errors import AvsError
 from avs_planner.qsr import (
+    ScoredPose,
     SelectionStatus,
     ViewMethod,
     ViewOptions,
     ViewSelectionError,
+    best_rate,
     cone_half_angle,
     in_frustums,
     in_view_cones,
+    pose_times,
     rank_frustums,
     sample_poses,
     score_cones,
@@ -209,3 +212,37 @@ def test_pan_sweep_widens_the_cone_within_the_head_limits():
     assert [p.x for p in wide.poses] == [p.x for p in narrow.poses]
     assert all(w.score >= n.score for w, n in zip(wide.poses, narrow.poses, strict=True))
     assert sum(w.score for w in wide.poses) > sum(n.score for n in narrow.poses)
+
+
+def test_pose_times_by_hand_and_around_a_wall():
+    grid = _open_grid()
+    start = (2.0, 2.0, 0.0)
+    poses = (ScoredPose(4.0, 2.0, 0.0, 0.1), ScoredPose(2.0, 4.0, math.pi / 2, 0.1),
+             ScoredPose(2.0, 2.0, math.pi, 0.1))  # fmt: skip
+    times = pose_times(poses, grid, start, BODY)
+    # 2 m straight ahead at 0.5 m/s; 2 m after a quarter turn; a half turn on the spot
+    assert times[0] == pytest.approx(4.0, abs=0.1)
+    assert times[1] == pytest.approx(4.0 + math.pi / 2, abs=0.1)
+    assert times[2] == pytest.approx(math.pi)
+    # a wall from y = 0 to 8 at x = 5: the way to the far side goes round its end
+    walled = _open_grid()
+    walled.logodds[int(4.95 / 0.05):int(5.05 / 0.05) + 1, : int(8.0 / 0.05)] = \
+        walled.model.clamp_max
+    walled._touch()
+    far = (ScoredPose(7.0, 2.0, 0.0, 0.1),)
+    assert pose_times(far, walled, start, BODY)[0] > pose_times(far, grid, start, BODY)[0] + 10
+
+
+def test_best_rate_trades_density_against_time():
+    grid = _open_grid()
+    start = (2.0, 2.0, 0.0)
+    near = ScoredPose(3.0, 2.0, 0.0, 0.3)  # 2 s away
+    far = ScoredPose(8.0, 2.0, 0.0, 0.4)  # 12 s away: more density, less per second
+    assert best_rate((far, near), grid, start, BODY, 1.0) is near
+    assert best_rate((far, near), grid, start, BODY, 100.0) is far  # long looks: density wins
+    boxed = _open_grid()
+    boxed.logodds[int(6.0 / 0.05):int(6.1 / 0.05) + 1, :] = boxed.model.clamp_max
+    boxed._touch()
+    assert best_rate((far,), boxed, start, BODY, 1.0) is None  # behind a wall: no path
+    with pytest.raises(ViewSelectionError):
+        best_rate((near,), grid, start, BODY, 0.0)

@@ -127,3 +127,14 @@ def test_simulate_qsr_file_errors_exit_1_before_the_run(tmp_path, capsys):
     assert main([*base, "--qsr", str(tmp_path / "missing.yaml")]) == 1
     assert "cannot read" in capsys.readouterr().err
     assert not (tmp_path / "out" / "summary.json").exists()
+
+
+def test_pose_utility_option_is_checked():
+    from avs_planner.strategies.registry import StrategyError
+
+    for name in ("qsr", "supporting-planes", "random"):
+        options = get_strategy(name).check_options({"utility": "eq2", "rerank": "false"})
+        assert options["utility"] == "eq2" and options["rerank"] is False
+        assert get_strategy(name).options["utility"] == "rate"
+        with pytest.raises(StrategyError, match="'utility' must be one of rate, eq2"):
+            get_strategy(name).check_options({"utility": "fastest"})

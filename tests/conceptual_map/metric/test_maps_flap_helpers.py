@@ -9,6 +9,7 @@ from conceptual_map.metric import (
     VoxelMap,
     distance_field,
     distance_fields,
+    distances_at,
 )
 from conceptual_map.metric.synthetic import rooms_world
 
@@ -24,6 +25,15 @@ def test_distance_fields_match_one_at_a_time() -> None:
     assert np.isfinite(fields[0][grid.cell_of((3.2, 2.3))])
     for k, start in enumerate(starts):
         np.testing.assert_array_equal(fields[k], distance_field(grid, start, 0.3))
+    # read at some cells only (every cell, walls and unknown ones included): the same values
+    cells = np.argwhere(np.ones(grid.shape, dtype=bool))
+    at = distances_at(grid, starts, cells, robot_radius=0.3)
+    np.testing.assert_allclose(at, fields[:, cells[:, 0], cells[:, 1]], rtol=1e-12)
+    assert np.isinf(at).any() and np.isfinite(at).any()
+    # a start inside an obstacle's inflation zone escapes as distance_fields does
+    inside = [(1.45, 1.5)]
+    np.testing.assert_allclose(distances_at(grid, inside, cells, 0.3),
+                               distance_fields(grid, inside, 0.3)[:, cells[:, 0], cells[:, 1]])
 
 
 def test_cells_in_box_and_states_at() -> None:
