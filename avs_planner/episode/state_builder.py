@@ -226,14 +226,21 @@ class StateBuilder:
 
     def _placeholders(self, places: set[str]) -> set[str]:
         """Placeholders worth planning with: not given up on, and one per spot (the frontier
-        with the most unknown space behind it wins), at most `max_placeholders`."""
+        with the most unknown space behind it wins), at most `max_placeholders`. A
+        placeholder on free space seen but never visited (a room looked into through its
+        door: `conceptual_map/places/unvisited.py`) has no frontier (length 0); it counts
+        as one of the shortest frontiers kept, so the planner can go and search that room."""
         pm, tries, cfg = self.mind.place_map, self.mind.tried_placeholders, self.config
+
+        def length(ph) -> float:  # noqa: ANN001 - a Placeholder
+            return ph.frontier_length if ph.frontier_length > 0 else cfg.min_frontier_length
+
         candidates = sorted(
             (ph for pid, ph in pm.placeholders.items()
              if ph.place in places and tries.get(pid, 0) < cfg.max_placeholder_tries
              and pid in self.mind.cmap.placeholders
-             and ph.frontier_length >= cfg.min_frontier_length),
-            key=lambda ph: (-ph.open_space * ph.frontier_length, ph.id),
+             and length(ph) >= cfg.min_frontier_length),
+            key=lambda ph: (-ph.open_space * length(ph), ph.id),
         )
         kept: list = []
         for ph in candidates:

@@ -192,3 +192,20 @@ def test_searches_priced_in_the_robots_seconds_learn_from_timed_searches(corrido
     metres = [v for k, v in builder.build().values.items() if k[0] == "move-cost" and v > 0]
     assert moves and sorted(moves) == pytest.approx(
         sorted(m / body.linear_speed for m in metres), abs=1e-2)
+
+
+def test_a_placeholder_on_space_seen_but_not_visited_is_a_goal(corridor) -> None:
+    """Unvisited free space (a room looked into through its door) gets a placeholder with no
+    frontier (length 0): the planner must still be offered it."""
+    from dataclasses import replace
+
+    mind, builder, _ = corridor
+    pm = mind.place_map
+    before = builder.build().objects.get("placeholder", [])
+    assert before, "the corridor's look round leaves placeholders"
+    pid = before[0]
+    for other in pm.placeholders:  # the others were given up on: only this one is left
+        if other != pid:
+            mind.tried_placeholders[other] = builder.config.max_placeholder_tries
+    pm.placeholders[pid] = replace(pm.placeholders[pid], frontier_length=0.0)
+    assert builder.build().objects.get("placeholder", []) == [pid]
