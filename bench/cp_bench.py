@@ -105,6 +105,8 @@ def ipc_cases(quick: bool, full: bool = False) -> list[Case]:
                            key=lambda p: int(p.stem.split("-")[1]))
         for problem in instances if full else instances[:2] if quick else instances[::2]:
             cases.append(Case(f"{domain.parent.name}/{problem.stem}", domain, problem, False))
+    if full:  # instance 1 of every domain first, then 2, ...: a run stopped early is a sample
+        cases.sort(key=lambda c: int(c.problem.stem.split("-")[1]))  # stable: by domain within
     return cases
 
 
