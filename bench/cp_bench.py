@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import gc
+import json
 import math
 import os
 import statistics
@@ -104,6 +105,8 @@ def ipc_cases(quick: bool, full: bool = False) -> list[Case]:
                            key=lambda p: int(p.stem.split("-")[1]))
         for problem in instances if full else instances[:2] if quick else instances[::2]:
             cases.append(Case(f"{domain.parent.name}/{problem.stem}", domain, problem, False))
+    if full:  # instance 1 of every domain first, then 2, ...: a run stopped early is a sample
+        cases.sort(key=lambda c: int(c.problem.stem.split("-")[1]))  # stable: by domain within
     return cases
 
 
@@ -281,7 +284,16 @@ def main() -> None:
                         help="seconds per run; a failure counts as this")
     parser.add_argument("--only", choices=("avs", "ipc"), default=None)
     parser.add_argument("--grounding", action="store_true", help="compare the grounders too")
+    parser.add_argument("--jsonl", type=Path, default=None,
+                        help="append each instance's row to this file as it finishes (a long "
+                             "run stopped early still leaves its rows; `--summarize FILE` "
+                             "prints their tables)")
+    parser.add_argument("--summarize", type=Path, default=None,
+                        help="print the tables of the rows a --jsonl file holds, and stop")
     args = parser.parse_args()
+    if args.summarize is not None:
+        summarize(args.summarize)
+        return
     get_environment().credits_stream = None
     require_ipc()
     if args.grounding:
@@ -290,15 +302,36 @@ def main() -> None:
           f"counts as the limit); ours: R={OPTIONS.reward} w={OPTIONS.weight} "
           f"h={OPTIONS.heuristic} on AVS, the anytime greedy phase on IPC; FD: lama-first")
     with tempfile.TemporaryDirectory(prefix="cp-bench-") as scratch:
+        def rows_of(cases: list[Case], kind: str) -> list[dict]:
+            rows = []
+            for case in cases:
+                row = bench_case(case, args.runs, args.limit, Path(scratch))
+                rows.append(row)
+                if args.jsonl is not None:
+                    with args.jsonl.open("a") as out:
+                        out.write(json.dumps({"kind": kind, **row}) + "\n")
+            return rows
+
         if args.only != "ipc":
-            rows = [bench_case(c, args.runs, args.limit, Path(scratch))
-                    for c in avs_cases(args.quick, args.building, Path(scratch))]
-            report(rows, "AVS problems (probabilistic; FD on -ln p costs)", True)
+            rows = rows_of(avs_cases(args.quick, args.building, Path(scratch)), "avs")
+            report(rows, AVS_TITLE, True)
         if args.only != "avs":
-            rows = [bench_case(c, args.runs, args.limit, Path(scratch))
-                    for c in ipc_cases(args.quick, args.full)]
-            report(rows, "IPC instances (deterministic)", False)
+            rows = rows_of(ipc_cases(args.quick, args.full), "ipc")
+            report(rows, IPC_TITLE, False)
     sys.stdout.flush()
+
+
+AVS_TITLE = "AVS problems (probabilistic; FD on -ln p costs)"
+IPC_TITLE = "IPC instances (deterministic)"
+
+
+def summarize(path: Path) -> None:
+    """The tables of the rows a --jsonl file holds (those that finished)."""
+    rows = [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+    for kind, title, probabilistic in (("avs", AVS_TITLE, True), ("ipc", IPC_TITLE, False)):
+        picked = [r for r in rows if r.get("kind") == kind]
+        if picked:
+            report(picked, f"{title}: {len(picked)} rows from {path}", probabilistic)
 
 
 if __name__ == "__main__":

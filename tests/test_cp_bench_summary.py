@@ -46,3 +46,23 @@ def test_building_scale_against_its_targets():
     line = building_scale(rows)
     assert "80 places 40.0 ms (target <= 50: met)" in line
     assert "160 places 300.0 ms (target <= 200: MISSED)" in line
+
+
+def test_rows_saved_as_json_lines_are_summarized(tmp_path, capsys):
+    """`--jsonl` keeps the rows of a long run that is stopped; `--summarize` prints them."""
+    import json
+    import math
+
+    from bench.cp_bench import summarize
+
+    rows = [_row("blocks/instance-1", 10, 100), _row("tetris/instance-5", 60000, 200,
+                                                     status="timeout")]
+    rows[0].update(ours_cost=6.0, fd_cost=6.0, ours_valid=True)
+    rows[1].update(warm_s=math.nan)
+    path = tmp_path / "rows.jsonl"
+    path.write_text("".join(json.dumps({"kind": "ipc", **r}) + "\n" for r in rows))
+    summarize(path)
+    out = capsys.readouterr().out
+    assert "IPC instances (deterministic): 2 rows from" in out
+    assert "-- coverage: ours 1/2, FD 2/2; FD solved and we did not: tetris/instance-5" in out
+    assert "plan cost, ours/FD, median over the 1 both solved: 1.000" in out

@@ -94,6 +94,8 @@ typedef struct {
     Py_ssize_t n_unit, n_pairs;
     int32_t *unit_off;            /* per action, CSR into unit_* */
     int32_t *unit_fact, *unit_clause, *unit_pair;
+    int32_t *unit_neg_off, *unit_neg; /* per unit clause, its negative facts (CSR): what
+                                       * clause_variant tests, one bit each, not W words */
     int32_t *pair_action;
     /* precondition classes (derive_classes) and their pre_of lists */
     int32_t n_cls;
@@ -112,6 +114,7 @@ static void task_free_arrays(TaskObject *t)
     void *ptrs[] = {t->pre, t->pre_neg, t->add, t->del, t->reads, t->cost, t->prob, t->neglog,
                     t->pre_off, t->pre_facts, t->add_off, t->add_facts, t->cl_off, t->cl_pos,
                     t->cl_neg, t->unit_off, t->unit_fact, t->unit_clause, t->unit_pair,
+                    t->unit_neg_off, t->unit_neg,
                     t->pair_action, t->cls_of, t->cls_off, t->cls_members, t->cls_len,
                     t->cof_off, t->cof, t->xcof_off, t->xcof_cls, t->xcof_pair, t->no_pre,
                     t->n_pairs_of, t->pre_len, t->kind, t->link, t->member_off, t->members};
@@ -380,6 +383,28 @@ static int task_derive(TaskObject *t)
     t->unit_off[A] = (int32_t)nu;
     t->n_unit = nu;
     t->n_pairs = np;
+    /* the negative facts of each unit clause, listed (usually one: a state is tested with
+     * one bit per clause instead of a scan of its W-word mask; 160-place AVS problems have
+     * 8,704 unit clauses of 40 words each) */
+    t->unit_neg_off = xcalloc((size_t)nu + 1, sizeof(int32_t));
+    if (!t->unit_neg_off)
+        goto nomem;
+    Py_ssize_t n_neg = 0;
+    for (Py_ssize_t k = 0; k < nu; k++) {
+        const word *neg = t->cl_neg + (Py_ssize_t)t->unit_clause[k] * W;
+        for (Py_ssize_t i = 0; i < W; i++)
+            n_neg += __builtin_popcountll(neg[i]);
+        t->unit_neg_off[k + 1] = (int32_t)n_neg;
+    }
+    t->unit_neg = xcalloc((size_t)n_neg, sizeof(int32_t));
+    if (!t->unit_neg)
+        goto nomem;
+    for (Py_ssize_t k = 0, j = 0; k < nu; k++) {
+        const word *neg = t->cl_neg + (Py_ssize_t)t->unit_clause[k] * W;
+        for (Py_ssize_t i = 0; i < W; i++)
+            for (word x = neg[i]; x; x &= x - 1)
+                t->unit_neg[j++] = (int32_t)(i * 64 + __builtin_ctzll(x));
+    }
 
     if (derive_classes(t, pair_fact))
         goto nomem;
@@ -666,6 +691,14 @@ typedef struct {
     int oom;
 } Eval;
 
+/* Search.lazy: every successor evaluated when generated (eager), every one when popped
+ * (deferred evaluation), or only those reached by a helpful action when generated and the
+ * others when popped (search.py's _lazy says when each is used) */
+enum { LAZY_NONE = 0, LAZY_ALL = 1, LAZY_UNHELPFUL = 2 };
+#ifndef STALL
+#define STALL 64 /* search.py's STALL */
+#endif
+
 #define MAX_EVAL 2 /* evaluating threads: the search's own and at most one worker */
 
 /* A batch of states to evaluate: each state k is claimed by one thread (owner[k]), whose
@@ -709,6 +742,13 @@ typedef struct {
     Queue heap, pref;
     int64_t priority[2];
     double best_h;
+    /* LAZY_UNHELPFUL defers only while h improves: expansions so far, the expansion count
+     * when best_h last dropped, and whether the node being expanded defers (STALL) */
+    int64_t n_expanded, progress_at;
+    int defer_now;
+    int32_t *waiting; /* nodes deferred since the last flush_deferred */
+    int64_t n_waiting, cap_waiting;
+    double popped_h;  /* h of the queue entry pop_node took */
     int from_pref, pruned_threshold;
     /* helpful pool: StateRec.help_off/help_n index it */
     int32_t *help;
@@ -858,13 +898,11 @@ static inline void dclear(Eval *e)
 static void clause_variant(const Search *s, Eval *e, const word *state)
 {
     const TaskObject *t = s->t;
-    Py_ssize_t W = s->W;
     memset(e->pair_eff, 0, (size_t)t->n_pairs);
     for (Py_ssize_t k = 0; k < t->n_unit; k++) {
-        const word *neg = t->cl_neg + (Py_ssize_t)t->unit_clause[k] * W;
         int on = 1;
-        for (Py_ssize_t i = 0; i < W; i++)
-            if ((neg[i] & state[i]) != neg[i]) {
+        for (int32_t j = t->unit_neg_off[k]; j < t->unit_neg_off[k + 1]; j++)
+            if (!BIT(state, t->unit_neg[j])) {
                 on = 0;
                 break;
             }
@@ -1339,6 +1377,7 @@ static int queue_node(Search *s, double f, double h, int32_t node, int preferred
         return -1;
     if (h < s->best_h && s->n_eval[node]) {
         s->best_h = h;
+        s->progress_at = s->n_expanded;
         s->priority[1] -= 1000;
     }
     return 0;
@@ -1371,7 +1410,7 @@ static int push_node(Search *s, const word *state, double c, double p, int32_t p
         return added;
     double g = objective(c, p, s->reward);
     double hv;
-    int deferred = s->lazy && parent >= 0;
+    int deferred = parent >= 0 && (s->lazy == LAZY_ALL || (s->defer_now && !preferred));
     if (deferred)
         hv = s->n_h[parent];
     else
@@ -1389,6 +1428,9 @@ static int push_node(Search *s, const word *state, double c, double p, int32_t p
     s->n_alive[node] = hv != INFINITY;
     s->n_h[node] = hv;
     s->n_eval[node] = !deferred;
+    if (deferred && s->lazy == LAZY_UNHELPFUL &&
+        list_push(&s->waiting, &s->n_waiting, &s->cap_waiting, node, &s->oom))
+        return -1;
     if (hv != INFINITY)
         return queue_node(s, g + hv, hv, node, preferred);
     return 0;
@@ -1399,7 +1441,36 @@ static int32_t pop_node(Search *s)
     int use_pref = s->pref.n && (s->priority[1] <= s->priority[0] || !s->heap.n);
     s->from_pref = use_pref;
     s->priority[use_pref ? 1 : 0] += 1;
-    return qpop(use_pref ? &s->pref : &s->heap).node;
+    QEntry e = qpop(use_pref ? &s->pref : &s->heap);
+    s->popped_h = e.h;
+    return e.node;
+}
+
+/* LAZY_UNHELPFUL after STALL expansions without a lower h: every node still waiting for its
+ * estimate gets it now and is queued again by it (n_eval 2: the entry it was queued with,
+ * its parent's h, is stale), as if it had been evaluated when generated. */
+static int flush_deferred(Search *s)
+{
+    for (int64_t i = 0; i < s->n_waiting; i++) {
+        int32_t node = s->waiting[i];
+        if (!s->n_alive[node] || s->n_eval[node])
+            continue;
+        s->n_eval[node] = 2;
+        double c = s->n_c[node], p = s->n_p[node];
+        double f = f_value(s, s->n_state[node], c, p);
+        if (s->oom)
+            return -1;
+        if (f == INFINITY) {
+            s->n_alive[node] = 0;
+            continue;
+        }
+        double h = f - objective(c, p, s->reward);
+        s->n_h[node] = h;
+        if (queue_node(s, f, h, node, 0))
+            return -1;
+    }
+    s->n_waiting = 0;
+    return 0;
 }
 
 /* _Search.evaluate: 1 if the node may be expanded now, 0 if dropped or re-queued, -1 error */
@@ -1426,6 +1497,7 @@ static int evaluate_node(Search *s, int32_t node)
     }
     if (h < s->best_h) {
         s->best_h = h;
+        s->progress_at = s->n_expanded;
         s->priority[1] -= 1000;
     }
     return 1;
@@ -1510,6 +1582,8 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
         int32_t node = pop_node(s);
         if (!s->n_alive[node])
             continue;
+        if (s->n_eval[node] == 2 && s->popped_h != s->n_h[node])
+            continue; /* queued by its parent's h before flush_deferred queued it by its own */
         int ev = evaluate_node(s, node);
         if (ev < 0)
             return -1;
@@ -1540,6 +1614,10 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
         }
         expanded += 1;
         *expanded_out = expanded;
+        s->n_expanded = expanded;
+        s->defer_now = s->lazy == LAZY_UNHELPFUL && expanded - s->progress_at <= STALL;
+        if (s->lazy == LAZY_UNHELPFUL && !s->defer_now && s->n_waiting && flush_deferred(s))
+            return -1;
         if (best >= 0 && s->patience >= 0 && expanded - best_at > s->patience)
             return stop_at(s, best, goal_node, STOP_PATIENCE, ST_SOLVED);
         if (s->node_limit >= 0 && expanded > s->node_limit)
@@ -1569,7 +1647,7 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
          * would evaluate those one by one: here they are evaluated as a batch), then
          * push_node on each in order, as a search evaluating one at a time would */
         int32_t n_kids = 0, n_todo = 0;
-        int batching = !s->lazy && s->heuristic != H_BLIND;
+        int batching = s->lazy != LAZY_ALL && s->heuristic != H_BLIND;
         for (Py_ssize_t a = 0; a < A; a++) {
             const word *pre = t->pre + a * W, *neg = t->pre_neg + a * W;
             int ok = 1;
@@ -1598,6 +1676,8 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
             s->kid_p[n_kids] = kp;
             s->kid_pref[n_kids] = (int8_t)(s->preferred && s->help_stamp[a] == mark);
             n_kids++;
+            if (s->defer_now && !s->kid_pref[n_kids - 1])
+                continue; /* deferred: evaluated when popped */
             if (batching && !below_threshold(s, kp)) { /* else push_node drops it */
                 uint64_t h = hash_state(succ, W);
                 size_t slot = 0;
@@ -1673,7 +1753,7 @@ static void search_free(Search *s)
                     s->n_alive, s->n_eval, s->heap.v, s->pref.v, s->help, s->combined,
                     s->help_stamp, s->parent, s->kids, s->kid_act, s->todo, s->kid_c,
                     s->kid_p, s->todo_hc, s->todo_hl, s->todo_at, s->todo_n, s->kid_pref,
-                    s->todo_owner};
+                    s->todo_owner, s->waiting};
     for (size_t i = 0; i < sizeof(ptrs) / sizeof(ptrs[0]); i++)
         free(ptrs[i]);
     for (int i = 0; i < MAX_EVAL; i++)
@@ -1897,7 +1977,7 @@ static void run_batch(Search *s) { (void)s; }
 
 static int use_worker(const Search *s)
 {
-    if (s->heuristic == H_BLIND || s->lazy)
+    if (s->heuristic == H_BLIND || s->lazy == LAZY_ALL)
         return 0; /* nothing evaluated in batches */
     if (s->threads == 1)
         return 0;
@@ -2006,7 +2086,7 @@ static PyObject *native_search(PyObject *self, PyObject *args)
     Search s;
     memset(&s, 0, sizeof(s));
     long long node_limit, patience;
-    if (!PyArg_ParseTuple(args, "O!y*y*y*iddddLLppy*y*y*y*i:search", &TaskType, &t, &b[0],
+    if (!PyArg_ParseTuple(args, "O!y*y*y*iddddLLipy*y*y*y*i:search", &TaskType, &t, &b[0],
                           &b[1], &b[2], &s.heuristic, &s.reward, &s.weight, &s.min_success,
                           &s.timeout, &node_limit, &patience, &s.lazy, &s.preferred, &b[3],
                           &b[4], &b[5], &b[6], &s.threads))
@@ -2030,6 +2110,12 @@ static PyObject *native_search(PyObject *self, PyObject *args)
         goto done;
     }
     s.preferred = s.preferred && s.heuristic == H_FF;
+    if (s.lazy < LAZY_NONE || s.lazy > LAZY_UNHELPFUL) {
+        PyErr_SetString(PyExc_ValueError, "native search: lazy must be 0, 1 or 2");
+        goto done;
+    }
+    if (s.lazy == LAZY_UNHELPFUL && !s.preferred)
+        s.lazy = LAZY_NONE; /* no helpful actions: every successor evaluated when generated */
     memcpy(s.goal, b[1].buf, 8 * (size_t)W);
     memcpy(s.goal_neg, b[2].buf, 8 * (size_t)W);
     for (Py_ssize_t f = 0; f < F; f++)

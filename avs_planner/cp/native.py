@@ -321,7 +321,7 @@ def run(
     timeout_s: float | None,
     node_limit: int | None,
     patience: float,
-    lazy: bool,
+    lazy: int,
     preferred: bool,
     symmetries: Symmetries,
     start: float,
@@ -329,7 +329,8 @@ def run(
 ) -> tuple[str, tuple[int, ...], int, int, str | None]:
     """Run the C search: (status name, action indices of the plan, expanded, generated, why
     the best plan so far was returned: one of STOP_NAMES). `threads`: 1 or 2 evaluating
-    threads, None for the core's choice (two for large tasks on a multi-CPU machine)."""
+    threads, None for the core's choice (two for large tasks on a multi-CPU machine).
+    `lazy`: one of search.py's EAGER, DEFERRED, DEFERRED_UNHELPFUL."""
     packed = pack_task(task)
     n_facts = len(task.facts)
     n_bytes = 8 * words(n_facts)
@@ -343,7 +344,7 @@ def run(
         _bits(task.goal, n_bytes, n_facts, "the goal"),
         _bits(task.goal_neg, n_bytes, n_facts, "the goal"),
         HEURISTIC_CODES[heuristic], float(reward), float(weight), float(min_success),
-        remaining, _c_limit(node_limit), _c_limit(patience), lazy, preferred, *sym,
+        remaining, _c_limit(node_limit), _c_limit(patience), int(lazy), preferred, *sym,
         0 if threads is None else threads,
     )
     return STATUS_NAMES[status], path, expanded, generated, STOP_NAMES[stopped]

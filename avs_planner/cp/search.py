@@ -48,7 +48,11 @@ class SearchOptions:
     node_limit: int | None = None
     min_success: float = 0.0
     symmetry: bool = True
-    lazy: bool | None = None  # deferred evaluation; None: only on deterministic tasks
+    lazy: bool | None = None
+    """Deferred evaluation: True evaluates every successor when it is popped (it inherits its
+    parent's estimate until then), False every one when it is generated. None: deferred on
+    deterministic tasks; on probabilistic ones, successors by a helpful action are evaluated
+    when generated and the others when popped (FF with helpful actions only; else eager)."""
     preferred: bool = True  # helpful actions first (dual queue) when h is inadmissible and has them
     engine: str = "auto"  # "native" (C core, same results), "python", or auto: native if built
     threads: int | None = None
@@ -217,16 +221,34 @@ def search(
     return _Search(task, options, start, symmetries).run()
 
 
-def _lazy(task: GroundTask, options: SearchOptions) -> bool:
-    """Deferred evaluation: as asked, or by default only on deterministic tasks (it helps on
-    classical tasks, hurts where R(1 - p) jumps dominate g); never with admissible h."""
-    lazy = options.lazy
-    if lazy is None:
-        if task.arrays is not None:
-            lazy = bool((task.arrays.probability == 1.0).all())
-        else:
-            lazy = all(a.probability == 1.0 for a in task.actions)
-    return lazy and not get_heuristic(options.heuristic).admissible
+EAGER, DEFERRED, DEFERRED_UNHELPFUL = 0, 1, 2  # _lazy's modes (the C core's LAZY_*)
+STALL = 64  # DEFERRED_UNHELPFUL: expansions without a lower h after which all are evaluated
+
+
+def _lazy(task: GroundTask, options: SearchOptions) -> int:
+    """When successors are evaluated: as asked, or by default deferred on deterministic tasks
+    and, on probabilistic ones, deferred unless reached by a helpful action; never deferred
+    with admissible h.
+
+    Deferring all of them on probabilistic tasks hurts: a successor inherits its parent's
+    estimate, so a move that brings the goal closer looks no better than a cheaper useless
+    step (a view cone for a label nobody looks for), and the search exhausts the plateau of
+    such steps first (a 20-place AVS problem: 200,000 expansions without a plan, 14 eager).
+    Helpful actions are the relaxed plan's first steps: evaluating their successors at once
+    puts the moves the estimate wants first in the queue with their own estimate, and the
+    rest (most of a large task's successors: 341 of 346 at the start of a 160-place
+    problem) wait to be popped. When h stalls, see STALL and `_Search.flush`."""
+    if get_heuristic(options.heuristic).admissible:
+        return EAGER
+    if options.lazy is not None:
+        return DEFERRED if options.lazy else EAGER
+    if task.arrays is not None:
+        deterministic = bool((task.arrays.probability == 1.0).all())
+    else:
+        deterministic = all(a.probability == 1.0 for a in task.actions)
+    if deterministic:
+        return DEFERRED
+    return DEFERRED_UNHELPFUL if _preferred(options) and options.heuristic == "ff" else EAGER
 
 
 def _preferred(options: SearchOptions) -> bool:
@@ -274,6 +296,7 @@ class _Search:
         self.priority = [0, 0]
         self.best_h = math.inf
         self.from_pref = False
+        self.popped_h = 0.0  # h of the queue entry pop() took
         self.pruned_threshold = False
         self.lazy = _lazy(task, options)
         self.h_of_node: list[float] = []
@@ -281,6 +304,10 @@ class _Search:
         self.commutes: dict[tuple[int, int], bool] = {}
         self.patience = options.patience_used
         self.best: tuple[float, int, int] | None = None  # incumbent: (objective, node, expanded)
+        self.expanded = self.progress_at = 0  # expansions; when best_h last dropped
+        self.defer_now = False  # DEFERRED_UNHELPFUL and h dropped in the last STALL expansions
+        self.waiting: list[int] = []  # nodes deferred since the last flush
+        self.flushed: set[int] = set()  # evaluated by a flush: their first queue entry is stale
 
     def f(self, state: int, c: float, p: float) -> float:
         """c + w*hc + R(1 - p exp(-hl)): the weight inflates the remaining cost only; weighting
@@ -304,8 +331,9 @@ class _Search:
         if not self.labels.add(state, c, p, node, self.alive):
             return
         g = objective(c, p, self.reward)
-        if self.lazy and parent >= 0:
-            h = self.h_of_node[parent]  # deferred: evaluated when popped
+        deferred = self.deferred(parent, preferred)
+        if deferred:
+            h = self.h_of_node[parent]  # evaluated when popped
         else:
             h = self.f(state, c, p) - g
         self.states.append(state)
@@ -315,9 +343,17 @@ class _Search:
         self.via.append(action)
         self.alive.append(h != math.inf)
         self.h_of_node.append(h)
-        self.evaluated.append(not (self.lazy and parent >= 0))
+        self.evaluated.append(not deferred)
+        if deferred and self.lazy == DEFERRED_UNHELPFUL:
+            self.waiting.append(node)
         if h != math.inf:
             self.queue(g + h, h, node, preferred)
+
+    def deferred(self, parent: int, preferred: bool) -> bool:
+        """Whether a successor of `parent` is evaluated only when popped (see _lazy)."""
+        if parent < 0:
+            return False
+        return self.lazy == DEFERRED or (self.defer_now and not preferred)
 
     def queue(self, f: float, h: float, node: int, preferred: bool) -> None:
         heapq.heappush(self.heap, (f, h, node))
@@ -325,6 +361,7 @@ class _Search:
             heapq.heappush(self.pref_heap, (f, h, node))
         if h < self.best_h and self.evaluated[node]:
             self.best_h = h
+            self.progress_at = self.expanded
             self.priority[1] -= 1000  # progress: trust the helpful actions for a while
 
     def pop(self) -> int:
@@ -332,7 +369,27 @@ class _Search:
         use_pref = bool(self.pref_heap) and (self.priority[1] <= self.priority[0] or not self.heap)
         self.from_pref = use_pref
         self.priority[1 if use_pref else 0] += 1
-        return heapq.heappop(self.pref_heap if use_pref else self.heap)[2]
+        _, self.popped_h, node = heapq.heappop(self.pref_heap if use_pref else self.heap)
+        return node
+
+    def flush(self) -> None:
+        """DEFERRED_UNHELPFUL after STALL expansions without a lower h: every node still
+        waiting for its estimate gets it now and is queued again by it, as if it had been
+        evaluated when generated (the entry it was queued with, its parent's h, is stale)."""
+        for node in self.waiting:
+            if not self.alive[node] or self.evaluated[node]:
+                continue
+            self.evaluated[node] = True
+            self.flushed.add(node)
+            c, p = self.costs[node], self.probs[node]
+            f = self.f(self.states[node], c, p)
+            if f == math.inf:
+                self.alive[node] = False
+                continue
+            h = f - objective(c, p, self.reward)
+            self.h_of_node[node] = h
+            self.queue(f, h, node, False)
+        self.waiting = []
 
     def commute(self, i: int, j: int) -> bool:
         key = (i, j)
@@ -359,6 +416,7 @@ class _Search:
             return False
         if h < self.best_h:
             self.best_h = h
+            self.progress_at = self.expanded
             self.priority[1] -= 1000
         return True
 
@@ -370,7 +428,11 @@ class _Search:
         symmetries = self.symmetries
         while self.heap or self.pref_heap:
             node = self.pop()
-            if not self.alive[node] or not self.evaluate(node):
+            if not self.alive[node]:
+                continue
+            if node in self.flushed and self.popped_h != self.h_of_node[node]:
+                continue  # queued by its parent's h before the flush queued it by its own
+            if not self.evaluate(node):
                 continue
             self.alive[node] = False
             state, c, p = self.states[node], self.costs[node], self.probs[node]
@@ -385,6 +447,11 @@ class _Search:
                     continue
                 return self.finish(PlanStatus.SOLVED, node, expanded)
             expanded += 1
+            self.expanded = expanded
+            self.defer_now = (self.lazy == DEFERRED_UNHELPFUL
+                              and expanded - self.progress_at <= STALL)
+            if self.lazy == DEFERRED_UNHELPFUL and not self.defer_now and self.waiting:
+                self.flush()
             if self.best is not None and expanded - self.best[2] > self.patience:
                 return self.stop("patience", PlanStatus.SOLVED, expanded)
             if options.node_limit is not None and expanded > options.node_limit:
