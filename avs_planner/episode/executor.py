@@ -557,6 +557,11 @@ class Executor:
         outcome = ViewConeSearch(self, label, relation, location).run()
         if self.stats.dt_calls and self.robot.clock > start:
             self.builder.observe_search_time(label, relation, self.robot.clock - start)
+        if outcome.status is StepStatus.FAILED:
+            # no view cone of this location is one this body can stand at: searching it is
+            # not something this robot can do, so it is settled for the planner (else the
+            # same search is offered again from the same state, and the loop gives up)
+            self.builder.cannot_search(label, relation, location)
         return outcome
 
 

@@ -399,6 +399,14 @@ class StateBuilder:
         body = self.mind.body
         return body.linear_speed if self.config.seconds and body is not None else 1.0
 
+    def cannot_search(self, label: str, relation: str, location: str) -> None:
+        """The robot has no view of `location` to search it for `label` from: counted as
+        searched as often as it takes to settle it (`max_failed_*_searches`)."""
+        if relation == "on":
+            self.failed_on[(label, location)] = self.config.max_failed_support_searches
+        else:
+            self.failed_in[(label, location)] = self.config.max_failed_room_searches
+
     def observe_search_time(self, label: str, relation: str, seconds: float) -> None:
         """A SEARCHFOROBJECT took `seconds` of simulated time (driving to its cones, turning,
         looking): later problems price that kind of search by what it costs this robot."""

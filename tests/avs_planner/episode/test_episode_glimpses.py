@@ -209,3 +209,16 @@ def test_a_placeholder_on_space_seen_but_not_visited_is_a_goal(corridor) -> None
             mind.tried_placeholders[other] = builder.config.max_placeholder_tries
     pm.placeholders[pid] = replace(pm.placeholders[pid], frontier_length=0.0)
     assert builder.build().objects.get("placeholder", []) == [pid]
+
+
+def test_a_search_the_robot_cannot_stand_for_is_settled_not_offered_again(corridor) -> None:
+    """No view cone for a support (none this body can stand at): the search fails, and the
+    location is settled, so the same search is not offered again from the same state (the
+    loop would give up: 'failed from this very state before')."""
+    mind, builder, executor = corridor
+    _, (x, y) = _room_and_pose(mind)
+    table = mind.add_object("table", (x + 1.0, y, 0.375))
+    assert ("defined-exists", "cerealbox", "on", table.id) not in builder.build().atoms
+    outcome = executor.search("cerealbox", "on", table.id)  # no CREATEVIEWCONES was run
+    assert outcome.status is StepStatus.FAILED
+    assert ("defined-exists", "cerealbox", "on", table.id) in builder.build().atoms
