@@ -1446,6 +1446,24 @@ static int32_t pop_node(Search *s)
     return e.node;
 }
 
+/* Evaluate `node` now (n_eval set to `mark`): its f and h (h stored in n_h). 1 if alive,
+ * 0 if the heuristic proved it dead (dropped), -1 on an allocation error. */
+static int evaluate_now(Search *s, int32_t node, int8_t mark, double *f, double *h)
+{
+    s->n_eval[node] = mark;
+    double c = s->n_c[node], p = s->n_p[node];
+    *f = f_value(s, s->n_state[node], c, p);
+    if (s->oom)
+        return -1;
+    if (*f == INFINITY) {
+        s->n_alive[node] = 0;
+        return 0;
+    }
+    *h = *f - objective(c, p, s->reward);
+    s->n_h[node] = *h;
+    return 1;
+}
+
 /* LAZY_UNHELPFUL after STALL expansions without a lower h: every node still waiting for its
  * estimate gets it now and is queued again by it (n_eval 2: the entry it was queued with,
  * its parent's h, is stale), as if it had been evaluated when generated. */
@@ -1455,17 +1473,12 @@ static int flush_deferred(Search *s)
         int32_t node = s->waiting[i];
         if (!s->n_alive[node] || s->n_eval[node])
             continue;
-        s->n_eval[node] = 2;
-        double c = s->n_c[node], p = s->n_p[node];
-        double f = f_value(s, s->n_state[node], c, p);
-        if (s->oom)
+        double f, h;
+        int ok = evaluate_now(s, node, 2, &f, &h);
+        if (ok < 0)
             return -1;
-        if (f == INFINITY) {
-            s->n_alive[node] = 0;
+        if (!ok)
             continue;
-        }
-        double h = f - objective(c, p, s->reward);
-        s->n_h[node] = h;
         if (queue_node(s, f, h, node, 0))
             return -1;
     }
@@ -1478,17 +1491,10 @@ static int evaluate_node(Search *s, int32_t node)
 {
     if (s->n_eval[node])
         return 1;
-    s->n_eval[node] = 1;
-    double c = s->n_c[node], p = s->n_p[node];
-    double f = f_value(s, s->n_state[node], c, p);
-    if (s->oom)
-        return -1;
-    if (f == INFINITY) {
-        s->n_alive[node] = 0;
-        return 0;
-    }
-    double h = f - objective(c, p, s->reward);
-    s->n_h[node] = h;
+    double f, h;
+    int ok = evaluate_now(s, node, 1, &f, &h);
+    if (ok <= 0)
+        return ok;
     Queue *q = s->from_pref ? &s->pref : &s->heap;
     if (q->n && f > q->v[0].f) {
         if (queue_node(s, f, h, node, s->from_pref))
