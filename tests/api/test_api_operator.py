@@ -108,12 +108,12 @@ def test_short_plan_is_not_blocked_by_a_long_one(make_settings: Make) -> None:
     with TestClient(create_app(_plan_settings(make_settings))) as client:
         _warm(client, 2)
         long = threading.Thread(target=client.post, args=("/v1/plans",),
-                                kwargs={"json": {"domain": DOMAIN, "problem": "sleep 20"}})
+                                kwargs={"json": {"domain": DOMAIN, "problem": "sleep 120"}})
         long.start()
         time.sleep(0.5)
         short = client.post("/v1/plans", json={"domain": DOMAIN, "problem": PROBLEM})
         assert short.status_code == 200 and short.json()["status"] == "solved"
-        # answered while the 20 s job still runs: it did not wait behind it (no wall-clock
+        # answered while the 120 s job still runs: it did not wait behind it (no wall-clock
         # threshold, which a loaded machine would break)
         assert long.is_alive()
         client.app.state.manager.jobs.stop()  # end the long one now
