@@ -73,6 +73,7 @@ def generate(size: AvsSize, seed: int = 0) -> str:
         connect(anchor, h)
         init.append(f"(in-room {h} {room_of[anchor]})")
     values = _values(rng, size, rooms, vrooms, holders, labels, init)
+    values += _find_on(values, labels, vobjs)
     values += [f"(= (move-cost {a} {b}) {d})" for (a, b), d in sorted(costs.items())]
     init += [f"(virtual {v})" for v in vrooms + vobjs]
     return _text(size, seed, places, holders, rooms, vrooms, vobjs, labels, init, values)
@@ -108,6 +109,17 @@ def _values(rng, size, rooms, vrooms, holders, labels, init) -> list[str]:
             values.append(f"(= (search-cost {label} {rel}) {cost})")
             values.append(f"(= (p-detect {label} {rel}) {round(rng.uniform(0.5, 0.9), 2)})")
     return values
+
+
+def _find_on(values: list[str], labels: list[str], vobjs: list[str]) -> list[str]:
+    """`p-find-on L S`: nothing has looked at any support yet, so each is L's detection rate
+    on a support (no random draw: the other values stay what they were for a seed)."""
+    rate = {}
+    for v in values:
+        if v.startswith("(= (p-detect ") and " on) " in v:
+            label = v.split()[2]
+            rate[label] = v.rsplit(" ", 1)[1].rstrip(")")
+    return [f"(= (p-find-on {label} {o}) {rate[label]})" for label in labels for o in vobjs]
 
 
 def _text(size, seed, places, holders, rooms, vrooms, vobjs, labels, init, values) -> str:

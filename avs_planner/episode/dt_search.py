@@ -30,7 +30,7 @@ class ViewConeSearch:
 
     def run(self) -> StepOutcome:
         label, relation, location = self.label, self.relation, self.location
-        made = self.ex.cones.get((label, relation, location))
+        made = self.ex.cones_now(label, relation, location)
         if made is None or not made.cones:
             return StepOutcome(StepStatus.FAILED, "no view cones for this search")
         self.ex.stats.dt_calls += 1
@@ -115,10 +115,16 @@ class ViewConeSearch:
 
     def _conclude(self, result, label: str, relation: str, location: str,  # noqa: ANN001
                   made: ConeSet) -> StepOutcome:
-        looked = {s.action.cone for s in result.trace if s.action.kind is not ActionKind.MOVE}
-        mass = sum(made.cones[i].probability for i in looked)
-        coverage = made.coverage * mass / made.probability if made.probability > 0 else 0.0
+        looks: dict[int, int] = {}
+        for step in result.trace:
+            if step.action.kind is not ActionKind.MOVE:
+                looks[step.action.cone] = looks.get(step.action.cone, 0) + 1
         p_detect = 1.0 - self.ex.config.detector.false_negative
+        # the share of the location's objects these looks would have seen: a cone's share
+        # of the location (its mass) seen with 1 - (1 - p_detect)^k after k looks into it
+        coverage = (sum(made.cones[i].probability * (1.0 - (1.0 - p_detect) ** k)
+                        for i, k in looks.items()) * made.coverage / made.probability
+                    if made.probability > 0 else 0.0)
         if result.status is DTStatus.CONFIRMED and result.detection is not None:
             seen = result.detection
             support = location if relation == "on" else None
@@ -126,14 +132,14 @@ class ViewConeSearch:
             self.ex.found_sids[obj.id] = seen.id
             if coverage > 0.0:
                 # Poisson thinning: whatever was found, the cones looked through leave
-                # Poisson(lambda (1 - coverage p_detect)) of `label` unseen there, so a second
+                # Poisson(lambda (1 - share seen)) of `label` unseen there, so a second
                 # desk stays as likely as before only in the part not looked at
-                self.ex.mind.searched(label, relation, location, coverage, p_detect)
+                self.ex.mind.searched(label, relation, location, coverage, 1.0)
             atoms = {("label-of", obj.id, label), ("detected", obj.id),
                      ("related", obj.id, relation, location)}
             return StepOutcome(StepStatus.DONE, f"confirmed {obj.id}", {obj.id: atoms})
         if coverage > 0.0:
-            self.ex.mind.searched(label, relation, location, coverage, p_detect)
+            self.ex.mind.searched(label, relation, location, coverage, 1.0)
         if relation == "on":
             key = (label, location)
             self.ex.builder.failed_on[key] = self.ex.builder.failed_on.get(key, 0) + 1

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -23,6 +23,7 @@ from avs_planner.episode.mind import KnownObject, Mind
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
 from avs_planner.episode.state_builder import AvsState, StateBuilder
 from avs_planner.episode.viewcones import CameraModel, ConeSet, room_cones, support_cones
+from conceptual_map.conceptual.errors import ConceptualError
 from conceptual_map.errors import MapError
 from conceptual_map.metric import distance_field, plan_path
 from conceptual_map.metric.path_planning import PathResult, PathStatus
@@ -73,6 +74,9 @@ class ExecutorConfig:
     # become known (`episode/glimpses.py`); the switching strategy turns this on
     # (`Executor.enable_glimpses`), the other strategies keep their own evidence rules
     glimpses: bool = False
+    # directions the detector looks in at a new place (`look_around`): 2 is ahead and behind;
+    # 6 covers the whole turn with the camera's 60 degree field of view
+    look_headings: int = 2
 
 
 @dataclass
@@ -105,6 +109,9 @@ class Executor:
         self.dt_session: Any = None  # the last SEARCHFOROBJECT's DTSession (read by observers)
         self._unplaced: list[SeenLike] = []
         self.qsr_cones: Any = None  # QSR-weighted support cones (episode/qsr_cones.install)
+        # the map's P(ObjectAt) of each cone set's location when it was made: a later
+        # search of it starts from what looks since then have left (`cones_now`)
+        self.cone_basis: dict[tuple[str, str, str], float] = {}
         self.glimpses: Glimpses | None = None
         if self.config.glimpses:
             self.enable_glimpses()
@@ -118,20 +125,34 @@ class Executor:
 
     def look_around(self) -> None:
         """Scan, turn half round, scan again: the first view of a place (the place map is
-        updated once, after both scans); the detector watches both ways."""
+        updated once, after both scans). The detector watches in `look_headings` directions
+        spread evenly over the turn (2: ahead and behind)."""
+        headings = max(2, self.config.look_headings)
+        yaw = self.robot.pose[2]
         self.mind.integrate(self.robot.scan())
-        self.watch()
-        self.robot.turn_to(self.robot.pose[2] + math.pi)
-        self._sense([self.robot.pose], watch=True)
+        found = self.watch()
+        half = headings // 2
+        for k in range(1, headings):
+            if found is not None and k > half:  # the target is here: the map is done
+                break
+            self.robot.turn_to(yaw + 2.0 * math.pi * k / headings)
+            if k == half:
+                found = self._sense([self.robot.pose], watch=True) or found
+            elif found is None:
+                found = self.watch()
 
-    def _sense(self, poses: list[tuple[float, float, float]], watch: bool = False) -> None:
+    def _sense(self, poses: list[tuple[float, float, float]], watch: bool = False
+               ) -> KnownObject | None:
+        """Integrate a scan from `poses`; the detector watches when asked or at a new place.
+        Returns the target the watch confirmed, if any."""
         before = self.mind.place_map.current_place
         events = self.mind.sense(self.robot.scan(), poses, self.robot.clock)
         place = self.mind.place_map.current_place
         if place is not None and (place != before or place not in self.mind.classified):
             self._classify()
+        seen = None
         if watch or (place is not None and place != before):
-            self.watch()
+            seen = self.watch()
         if self._unplaced:
             self._place_seen()
         if events:
@@ -141,6 +162,7 @@ class Executor:
                 kinds[key] = kinds.get(key, 0) + 1
             self.emit("belief", map_events=kinds)
         self._record_pose()
+        return seen
 
     def watch(self) -> KnownObject | None:
         """Keep the detector on while moving: look ahead for the target (a second frame must
@@ -543,12 +565,36 @@ class Executor:
             made = (self.qsr_cones and self.qsr_cones.room_cones(label, location, p, key)) or \
                 room_cones(self.mind, location, label, p, self.camera, key)
         self.cones[(label, relation, location)] = made
+        self.cone_basis[(label, relation, location)] = self.location_belief(
+            label, relation, location)
         self.mind.cones_made.add((label, relation, location))
         self.emit("action", action="createviewcones", cones=len(made.cones),
                   coverage=round(made.coverage, 3), probability=round(p, 4))
         if not made.cones:
             return StepOutcome(StepStatus.FAILED, "no view cone reachable")
         return StepOutcome(StepStatus.DONE, f"{len(made.cones)} cones")
+
+    def location_belief(self, label: str, relation: str, location: str) -> float:
+        """The map's P(ObjectAt) of the location itself (not its supports)."""
+        where = ("on", location) if relation == "on" else location
+        try:
+            return self.mind.cmap.p_object_at(label, where, include_sublocations=False)
+        except ConceptualError:  # a location the map no longer has: no rescaling
+            return 0.0
+
+    def cones_now(self, label: str, relation: str, location: str) -> ConeSet | None:
+        """The cone set of a location, its probabilities scaled by what looks since it was
+        made (searches, glimpses) left of the map's P(ObjectAt) there: a desk searched once
+        is not searched again from its prior."""
+        made = self.cones.get((label, relation, location))
+        then = self.cone_basis.get((label, relation, location), 0.0)
+        if made is None or then <= 0.0:
+            return made
+        scale = min(1.0, self.location_belief(label, relation, location) / then)
+        if scale >= 1.0:
+            return made
+        cones = tuple(replace(c, probability=c.probability * scale) for c in made.cones)
+        return replace(made, cones=cones, probability=made.probability * scale)
 
     def search(self, label: str, relation: str, location: str) -> StepOutcome:
         """SEARCHFOROBJECT: a DT session over the cones CREATEVIEWCONES made; its duration

@@ -61,6 +61,8 @@ class LoopConfig:
     # frames taken in passing are evidence, and supports they show become known objects
     # (`Executor.enable_glimpses`, `episode/glimpses.py`)
     glimpses: bool = True
+    # directions the detector looks in at each new place (`Executor.look_around`)
+    look_headings: int = 6
     # price moves and searches in the robot's own seconds (`BuilderConfig.seconds`)
     seconds: bool = False
 
@@ -86,6 +88,9 @@ class SwitchingLoop:
         self.executor.watching = self.config.watch
         if self.config.glimpses and self.executor.glimpses is None:
             self.executor.enable_glimpses()
+        if self.config.look_headings != self.executor.config.look_headings:
+            self.executor.config = replace(self.executor.config,
+                                           look_headings=self.config.look_headings)
         if self.config.seconds != self.builder.config.seconds:
             self.builder.config = replace(self.builder.config, seconds=self.config.seconds)
         self.executor.look_around()

@@ -187,6 +187,7 @@ class StateBuilder:
         self._rooms(rooms, placeholders, atoms, values)
         self._objects(objects, rooms, atoms, values)
         self._statics(values)
+        self._find_on(objects, values)
         names = {
             "place": sorted(places), "placeholder": sorted(placeholders),
             "room": [*rooms, *self._virtual("new-room", self.config.virtual_rooms)],
@@ -394,6 +395,35 @@ class StateBuilder:
             return False
         p = cmap.p_object_at(label, where, include_sublocations=False)
         return p < self.config.min_probability
+
+    def _find_on(self, objects: list[str], values: dict[Atom, float]) -> None:
+        """`p-find-on L S`: the chance a search on S finds the L the plan assumed there. The
+        assumption's `p-obj-on` is the prior for any support of S's label in a room of the
+        category; this object's own looks (searches, glimpses) are in the share of L on it
+        still unseen, so a desk searched once is not planned as if it never had been."""
+        virtual = self._virtual("new-object", self.config.virtual_objects)
+        for label in self.labels:
+            rate = values[("p-detect", label, "on")]
+            for oid in [*objects, *virtual]:
+                share = self._unseen_share(label, oid) if oid in self.mind.objects else 1.0
+                values[("p-find-on", label, oid)] = round(rate * share, 6)
+
+    def _unseen_share(self, label: str, oid: str) -> float:
+        """P(L on `oid` now) over its prior: Poisson thinning by the looks at it so far,
+        averaged over the room's category belief (1 when nothing has looked at it)."""
+        cmap = self.mind.cmap
+        obj = self.mind.objects[oid]
+        if (label, "on", obj.label) not in cmap.knowledge.relation_lambda:
+            return 1.0
+        where = RelatedSpace("on", oid)
+        if cmap.objects.remaining(where, label) >= 1.0 or not cmap.graph.has_room(obj.room):
+            return 1.0
+        lam = cmap.knowledge.relation_lambda_of(label, "on", obj.label)
+        prior = float(cmap.room_marginal(obj.room) @ p_at_least_one(lam))
+        if prior <= 0.0:
+            return 1.0
+        now = cmap.p_object_at(label, where, include_sublocations=False)
+        return min(1.0, now / prior)
 
     def _speed(self) -> float:
         body = self.mind.body

@@ -46,7 +46,10 @@
     (p-placeholder-category ?p - placeholder ?c - category) - number  ; P_category(placeholder)
     (p-obj-in ?l - label ?r - room ?c - category) - number  ; P(ObjectAt L), L = in room ?r
     (p-obj-on ?l - label ?s - label ?c - category) - number ; P(ObjectAt L^C), on an ?s in a ?c
-    (p-detect ?l - label ?rel - relation) - number)         ; 1 - false-negative rate
+    (p-detect ?l - label ?rel - relation) - number          ; 1 - false-negative rate
+    ;; P(a search on ?s finds the ?l assumed on it): the detection rate times the share of
+    ;; ?l on this very ?s that earlier looks at it would have missed (1 before any look)
+    (p-find-on ?l - label ?s - visualobject) - number)
 
   ;; ---- assumptive actions: never executed, only monitored -------------------------------
 
@@ -115,7 +118,7 @@
     :parameters (?l - label ?s - visualobject ?o - visualobject ?r - room ?p - place)
     :precondition (and (viewcones ?l on ?s) (label-of ?o ?l) (related ?o on ?s)
                        (not (detected ?o)) (related ?s in ?r) (at ?p) (in-room ?p ?r))
-    :effect (and (probabilistic (p-detect ?l on) (detected ?o))
+    :effect (and (probabilistic (p-find-on ?l ?s) (detected ?o))
                  (increase (total-cost) (search-cost ?l on))))
 
   (:action reportposition

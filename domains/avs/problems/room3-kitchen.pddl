@@ -41,6 +41,8 @@
     (= (search-cost cerealbox in) 120) (= (search-cost cerealbox on) 10)
     (= (p-detect table in) 0.8) (= (p-detect table on) 0.8)
     (= (p-detect cerealbox in) 0.5) (= (p-detect cerealbox on) 0.8)
+    (= (p-find-on table new-object1) 0.8) (= (p-find-on table new-object2) 0.8) (= (p-find-on table new-object3) 0.8)
+    (= (p-find-on cerealbox new-object1) 0.8) (= (p-find-on cerealbox new-object2) 0.8) (= (p-find-on cerealbox new-object3) 0.8)
     ;; P_category(room)
     (= (p-room-category room1 kitchen) 0) (= (p-room-category room1 office) 0) (= (p-room-category room1 corridor) 1)
     (= (p-room-category room2 kitchen) 0) (= (p-room-category room2 office) 1) (= (p-room-category room2 corridor) 0)

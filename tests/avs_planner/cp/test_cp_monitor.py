@@ -122,6 +122,9 @@ def test_a_confirmed_assumption_is_dropped_instead_of_replanning(corridor_text):
     domain, problem = corridor_text
     problem = problem.replace("new-object1 new-object2 new-object3 - visualobject",
                               "table1 new-object1 new-object2 new-object3 - visualobject")
+    problem = problem.replace("(= (total-cost) 0)", "(= (total-cost) 0) "
+                              "(= (p-find-on table table1) 0.8) "
+                              "(= (p-find-on cerealbox table1) 0.8)")
     pproblem = read_text(domain, problem, "domain.pddl", "corridor.pddl")
     planner = ContinualPlanner(pproblem, OPTIONS)
     assert planner.replan().solved

@@ -1,0 +1,114 @@
+"""Evidence about one support instance reaches the planner and the DT: a desk searched once is
+not planned, nor searched, as if it never had been; every look of a DT search counts; and a
+new place is looked at all round."""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from avs_planner.dt import ViewCone
+from avs_planner.dt.domain import ActionKind, DTAction
+from avs_planner.dt.session import DTResult, DTStatus, DTStep
+from avs_planner.episode.dt_search import ViewConeSearch
+from avs_planner.episode.viewcones import ConeSet
+from conceptual_map.conceptual import RelatedSpace
+
+
+def _here(mind):
+    place = mind.place_map.current_place
+    return mind.place_map.room_of(place), mind.place_map.places[place].position
+
+
+def _looks(*cones: int) -> tuple[DTStep, ...]:
+    return tuple(DTStep(DTAction(ActionKind.PROCESS_VIEW_CONE, i), None, 1.0, (), 0.0)
+                 for i in cones)
+
+
+def test_every_look_of_a_dt_search_into_a_cone_counts(corridor) -> None:
+    """Two looks into one cone are two chances for the detector: that cone's share of the
+    location is left unseen with (1 - p_detect)^2, not (1 - p_detect)."""
+    mind, _, executor = corridor
+    room, (x, y) = _here(mind)
+    left = mind.cmap.objects.remaining(room, "table")
+    cones = (ViewCone("c-0", (x, y, 0.0), 0.3), ViewCone("c-1", (x, y, math.pi), 0.3))
+    made = ConeSet(cones, coverage=0.8, probability=0.6)
+    result = DTResult(DTStatus.REJECTED, 0.05, 2.0, _looks(0, 0, 1))
+    ViewConeSearch(executor, "table", "in", room)._conclude(result, "table", "in", room, made)
+    d = 1.0 - executor.config.detector.false_negative
+    seen = 0.8 * (0.5 * (1.0 - (1.0 - d) ** 2) + 0.5 * d)
+    assert mind.cmap.objects.remaining(room, "table") == pytest.approx(left * (1.0 - seen))
+
+
+def _support(mind, builder):
+    room, (x, y) = _here(mind)
+    table = mind.add_object("table", (x + 2.0, y, 0.375))
+    return table, RelatedSpace("on", table.id)
+
+
+def test_a_searched_support_is_planned_with_what_is_left_on_it(corridor) -> None:
+    """`p-find-on` is the detection rate on a support untouched by looks, and that rate times
+    P(on it now) / P(on it before any look) after a search of it: the CP's second search of
+    the same desk is worth what the first left, not the prior again."""
+    mind, builder, _ = corridor
+    table, where = _support(mind, builder)
+    state = builder.build()
+    rate = state.values[("p-detect", "cerealbox", "on")]
+    assert state.values[("p-find-on", "cerealbox", table.id)] == pytest.approx(rate)
+    assert state.values[("p-find-on", "cerealbox", "new-object1")] == pytest.approx(rate)
+    before = mind.cmap.p_object_at("cerealbox", where, include_sublocations=False)
+    mind.searched("cerealbox", "on", table.id, coverage=0.9, p_detect=0.64)
+    after = mind.cmap.p_object_at("cerealbox", where, include_sublocations=False)
+    assert 0.0 < after < before
+    # over the prior under the room's category belief now (the failed search moved it too)
+    lam = mind.cmap.knowledge.relation_lambda_of("cerealbox", "on", "table")
+    prior = float(mind.cmap.room_marginal(table.room) @ (1.0 - np.exp(-lam)))
+    found = builder.build().values[("p-find-on", "cerealbox", table.id)]
+    assert found == pytest.approx(rate * after / prior, rel=1e-3)
+    assert found < rate
+    # the problem as PDDL carries it, and the domain's search on a support reads it
+    text = builder.build().to_pddl()
+    match = re.search(rf"\(= \(p-find-on cerealbox {table.id}\) ([0-9.]+)\)", text)
+    assert match is not None and float(match.group(1)) == pytest.approx(found, abs=1e-6)
+    problem = builder.build().problem()
+    assert "p-find-on" in str(problem.success["searchforobject-on"])
+
+
+def test_a_second_dt_search_starts_from_what_the_first_left(corridor) -> None:
+    """The cones made for a location keep their shape; a later search scales their
+    probabilities by the map's P(ObjectAt) now over when they were made."""
+    mind, builder, executor = corridor
+    table, where = _support(mind, builder)
+    (x, y) = table.position[:2]
+    cones = (ViewCone("c-0", (x - 1.0, y, 0.0), 0.2), ViewCone("c-1", (x + 1.0, y, math.pi), 0.2))
+    key = ("cerealbox", "on", table.id)
+    executor.cones[key] = ConeSet(cones, coverage=0.9, probability=0.4)
+    executor.cone_basis[key] = executor.location_belief(*key)
+    assert executor.cones_now(*key) is executor.cones[key]
+    before = executor.cone_basis[key]
+    mind.searched("cerealbox", "on", table.id, coverage=0.9, p_detect=0.64)
+    scale = executor.location_belief(*key) / before
+    now = executor.cones_now(*key)
+    assert 0.0 < scale < 1.0
+    assert now.probability == pytest.approx(0.4 * scale)
+    assert [c.probability for c in now.cones] == pytest.approx([0.2 * scale] * 2)
+    assert [c.pose for c in now.cones] == [c.pose for c in cones]
+
+
+@pytest.mark.parametrize("headings", [2, 6])
+def test_a_new_place_is_looked_at_in_every_direction(corridor, headings) -> None:
+    """`look_headings` spreads the detector's frames evenly over a full turn."""
+    _, _, executor = corridor
+    executor.config = replace(executor.config, look_headings=headings)
+    yaws: list[float] = []
+    executor.watch = lambda: yaws.append(executor.robot.pose[2])  # type: ignore[method-assign]
+    start = executor.robot.pose[2]
+    executor.look_around()
+    assert len(yaws) == headings
+    offsets = sorted(round(((y - start) % (2 * math.pi)) / (2 * math.pi / headings)) % headings
+                     for y in yaws)
+    assert offsets == list(range(headings))
