@@ -119,7 +119,8 @@ class Executor:
     def enable_glimpses(self) -> None:
         """Frames taken in passing become evidence (`episode/glimpses.py`)."""
         self.glimpses = Glimpses(self.mind, self.camera,
-                                 1.0 - self.config.detector.false_negative)
+                                 1.0 - self.config.detector.false_negative,
+                                 support_body=self.config.support_radius)
 
     # ---- sensing along the way --------------------------------------------------------------
 
@@ -357,15 +358,17 @@ class Executor:
         best, best_cost = None, math.inf
         for pid, ph in mind.place_map.placeholders.items():
             cell = mind.grid.cell_of(ph.position)
-            if mind.tried_placeholders.get(pid, 0) >= 2 or not mind.grid.contains(cell):
+            if mind.tried_placeholders.get(pid, 0) >= self.builder.config.max_placeholder_tries \
+                    or not mind.grid.contains(cell):
                 continue
             if field_[cell] < best_cost:
                 best, best_cost = pid, float(field_[cell])
         return best
 
-    def uncertain_room(self, certain: float, skip: set[str]) -> str | None:
+    def uncertain_room(self, certain: float, skip: set[str],
+                       worth: Callable[[str], bool] = lambda room: True) -> str | None:
         """The known room nearest by grid path whose most likely category is below
-        `certain`, not in `skip`."""
+        `certain`, not in `skip`, for which `worth` holds."""
         mind = self.mind
         pm, cmap = mind.place_map, mind.cmap
         field_ = distance_field(mind.grid, self.robot.pose[:2], mind.config.robot_radius)
@@ -373,7 +376,7 @@ class Executor:
         for rid, room in pm.rooms.items():
             if rid in skip or not cmap.graph.has_room(rid):
                 continue
-            if max(cmap.room_category(rid).values()) >= certain:
+            if max(cmap.room_category(rid).values()) >= certain or not worth(rid):
                 continue
             for pid in room.places & set(pm.places):
                 cell = mind.grid.cell_of(pm.places[pid].position)

@@ -46,9 +46,12 @@ class Glimpses:
     """What frames taken in passing have seen of rooms and supports, per label."""
 
     def __init__(self, mind: Mind, camera: CameraModel, p_detect: float,
-                 min_range: float = 0.5) -> None:
+                 min_range: float = 0.5, support_body: float = 0.9) -> None:
         self.mind, self.camera, self.p_detect = mind, camera, p_detect
         self.min_range = min_range
+        # m from a support's centre that may be its own body on the way to its top (the
+        # executor's `support_radius`: a detection this near a support is on it)
+        self.support_body = support_body
         self.max_range = 0.9 * camera.detect_range
         # label -> {world key of a candidate cell: standpoints it was looked at from}
         self.cells: dict[str, dict[tuple[int, int], set[tuple[int, int]]]] = {}
@@ -112,7 +115,7 @@ class Glimpses:
                 continue
             top = 2.0 * obj.position[2]  # the executor's rule: a support's centre is half-way
             point = np.array([obj.position[:2]])
-            if not self._in_view(point, pose, pan, tilt, top)[0]:
+            if not self._in_view(point, pose, pan, tilt, top, self.support_body)[0]:
                 continue
             seen = self.tops.setdefault((label, oid), set())
             if stand in seen or len(seen) >= MAX_LOOKS:
@@ -124,8 +127,9 @@ class Glimpses:
         return np.round(points / self.mind.grid.resolution).astype(np.int64)
 
     def _in_view(self, points: np.ndarray, pose: tuple[float, float, float], pan: float,
-                 tilt: float, height: float) -> np.ndarray:
-        """Points (at `height`) inside the frame's view with a free line of sight."""
+                 tilt: float, height: float, body: float = 0.0) -> np.ndarray:
+        """Points (at `height`) inside the frame's view with a free line of sight (up to a
+        support's own `body`, see `_line_of_sight`)."""
         cam = self.camera
         d = points - np.asarray(pose[:2])
         r = np.hypot(d[:, 0], d[:, 1])
@@ -138,13 +142,18 @@ class Glimpses:
         if not ok.any():
             return ok
         idx = np.flatnonzero(ok)
-        ok[idx] = self._line_of_sight(np.asarray(pose[:2]), points[idx])
+        ok[idx] = self._line_of_sight(np.asarray(pose[:2]), points[idx], body)
         return ok
 
-    def _line_of_sight(self, origin: np.ndarray, points: np.ndarray) -> np.ndarray:
+    def _line_of_sight(self, origin: np.ndarray, points: np.ndarray, body: float = 0.0
+                       ) -> np.ndarray:
         """True where every grid cell between `origin` and the point is known free, leaving
         out the robot's own footprint (its laser never sees the cells under it) and the last
-        cell and a half (the point's own cell holds the object)."""
+        cell and a half (the point's own cell holds the object). With `body` > 0 the point
+        is the centre of a support whose top is looked at: the ray may end in the support's
+        own body (its occupied outline, the unknown inside it), one run of cells that are
+        not free within `body` m of the centre with no free cell after it; before that run
+        every cell must be free."""
         grid = self.mind.grid
         res = grid.resolution
         free = grid.state_grid() == CellState.FREE
@@ -164,4 +173,11 @@ class Glimpses:
         good = cells[within]
         clear[within] = free[tuple(good.T)]
         clear = clear.reshape(xs.shape)
-        return np.all(clear | ~inside_ray, axis=1)
+        if body <= 0.0:
+            return np.all(clear | ~inside_ray, axis=1)
+        on_ray = (along <= length[:, None]) & (along >= self.mind.config.robot_radius)
+        tail = on_ray & (along >= length[:, None] - body)
+        before = on_ray & ~tail
+        blocked = ~clear & tail
+        after_block = np.maximum.accumulate(blocked, axis=1)
+        return np.all(clear | ~before, axis=1) & ~np.any(after_block & clear & tail, axis=1)

@@ -254,9 +254,11 @@ class SwitchingLoop:
     def _visit_uncertain_room(self) -> bool:
         """No plan is good enough: the place classifier may have misled the room category
         beliefs (an elongated office reads as a corridor). Visit the places of the nearest
-        room whose category is uncertain, once per room, so it is classified again."""
+        room whose category is uncertain, once per room, so it is classified again; only
+        rooms that could still hold the target under some category (`could_hold`)."""
         certain = self.builder.config.certain_category
-        room = self.executor.uncertain_room(certain, self.visited_rooms)
+        room = self.executor.uncertain_room(certain, self.visited_rooms,
+                                            self.builder.could_hold)
         if room is None:
             return False
         self.visited_rooms.add(room)

@@ -425,6 +425,23 @@ class StateBuilder:
         now = cmap.p_object_at(label, where, include_sublocations=False)
         return min(1.0, now / prior)
 
+    def could_hold(self, room: str) -> bool:
+        """Under some category, the target may still be in `room` (on its known supports
+        included) with at least the planner's `min_probability`, after the looks there so
+        far. A room where it may not, whatever its category, cannot enter a plan: reading
+        its category again is not worth a visit."""
+        cmap = self.mind.cmap
+        if not cmap.graph.has_room(room):
+            return False
+        label = self.task.target
+        ledger = cmap.objects
+        places = [room, *ledger.sublocations(room, label)]
+        if any(ledger.count(place, label) for place in places):
+            return True
+        residual = sum(ledger.location_lambda(label, place) * ledger.remaining(place, label)
+                       for place in places)
+        return float(np.max(p_at_least_one(residual))) >= self.config.min_probability
+
     def _speed(self) -> float:
         body = self.mind.body
         return body.linear_speed if self.config.seconds and body is not None else 1.0
