@@ -15,8 +15,12 @@ from avs_planner.dt import ViewCone
 from avs_planner.dt.domain import ActionKind, DTAction
 from avs_planner.dt.session import DTResult, DTStatus, DTStep
 from avs_planner.episode.dt_search import ViewConeSearch
-from avs_planner.episode.viewcones import ConeSet
+from avs_planner.episode.glimpses import Glimpses
+from avs_planner.episode.mind import Mind
+from avs_planner.episode.viewcones import CameraModel, ConeSet
 from conceptual_map.conceptual import RelatedSpace
+from conceptual_map.metric import CellState
+from conceptual_map.metric.synthetic import rooms_world
 
 
 def _here(mind):
@@ -112,3 +116,54 @@ def test_a_new_place_is_looked_at_in_every_direction(corridor, headings) -> None
     offsets = sorted(round(((y - start) % (2 * math.pi)) / (2 * math.pi / headings)) % headings
                      for y in yaws)
     assert offsets == list(range(headings))
+
+
+# ---- a support's top is seen over its own body, not through a wall -------------------------
+
+def _box_room(desk: tuple[float, float, float, float], wall_x: float | None = None):
+    """A 8 x 5 m room with a desk-sized box (seen by the laser as its outline, unknown
+    inside), optionally a wall across the room at x = `wall_x` with a door at its end."""
+    world = rooms_world([(0.0, 0.0, 8.0, 5.0)], [], wall=0.1)
+    world.add_box(*desk, 0.0, 0.75)
+    if wall_x is not None:
+        world.add_box(wall_x - 0.05, 0.0, wall_x + 0.05, 4.0, 0.0, 2.0)
+    mind = Mind()
+    for pose in [(1.0, 2.5, 0.0), (1.0, 2.5, math.pi)]:
+        mind.sense(world.laser(pose, beams=1440, fov=4.18, max_range=5.6), [pose], 0.0)
+    return mind
+
+
+def _top_seen(mind, desk_centre, body: float = 0.9) -> bool:
+    glimpses = Glimpses(mind, CameraModel(1.2, math.radians(60), 4.0), p_detect=0.64,
+                        support_body=body)
+    table = mind.add_object("table", (*desk_centre, 0.375))
+    glimpses.frame((1.0, 2.5, 0.0), 0.0, -0.2, [], [table.id], tops_label="cerealbox")
+    return mind.cmap.objects.remaining(RelatedSpace("on", table.id), "cerealbox") < 1.0
+
+
+def test_a_support_top_is_seen_over_its_own_body() -> None:
+    """The laser maps a desk as its outline with unknown cells inside: a ray to its centre
+    crosses them, and that must not hide the top (before, no top in view ever counted)."""
+    mind = _box_room((3.0, 2.0, 4.2, 3.0))
+    assert mind.grid.state_grid()[mind.grid.cell_of((3.6, 2.5))] != CellState.FREE
+    assert not _top_seen(_box_room((3.0, 2.0, 4.2, 3.0)), (3.6, 2.5), body=0.0)
+    assert _top_seen(mind, (3.6, 2.5))
+
+
+def test_a_support_top_behind_a_wall_is_not_seen() -> None:
+    mind = _box_room((3.0, 2.0, 4.2, 3.0), wall_x=2.5)
+    assert not _top_seen(mind, (3.6, 2.5))
+
+
+def test_a_room_searched_through_is_not_worth_reading_again(corridor) -> None:
+    """`could_hold`: under its most favourable category, the target's unseen probability in
+    the room (its known supports included) against the planner's threshold."""
+    mind, builder, _ = corridor
+    room, _ = _here(mind)
+    table = mind.add_object("table", (*_here(mind)[1], 0.375))
+    assert builder.could_hold(room)
+    mind.searched("cerealbox", "in", room, coverage=1.0, p_detect=0.99)
+    assert builder.could_hold(room)  # still possible on the table
+    mind.searched("cerealbox", "on", table.id, coverage=1.0, p_detect=0.99)
+    assert not builder.could_hold(room)
+    assert not builder.could_hold("no-such-room")
