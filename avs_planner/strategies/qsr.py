@@ -174,7 +174,7 @@ class QsrSearch:
             if self.relooks():
                 best = self.choose(view.poses, self.stay_pose(planes, density))
                 if best is self.here:
-                    if self.look_again(planes):
+                    if self.look_again(planes, density):
                         return self._found(self.result.found)
                     continue
             elif self.opt["utility"] == "rate" and self.method is not ViewMethod.RANDOM:
@@ -249,13 +249,13 @@ class QsrSearch:
             return stay
         return poses[k]
 
-    def look_again(self, planes: SupportingPlanes) -> bool:
+    def look_again(self, planes: SupportingPlanes, density: np.ndarray) -> bool:
         """One more look from where the robot stands: the best of the nine frustums on the
         belief after its misses here (the frustum just used included). True when it found
         the target (in `self.result.found`); with no density left in view here, the robot
         will not consider staying again."""
         before = self.looks_here
-        found = self.perceive(planes, self.density(planes), 1, again=True)
+        found = self.perceive(planes, density, 1, again=True)
         if found is not None:
             self.result.found = found
             return True
