@@ -13,9 +13,11 @@ from avs_planner.qsr.select import (
     ViewSelectionError,
     best_rate,
     cone_half_angle,
+    pose_rates,
     pose_times,
     rank_frustums,
     score_cones,
+    score_poses,
     select_view,
 )
 
@@ -37,10 +39,12 @@ __all__ = [
     "in_frustums",
     "in_view_cones",
     "line_of_sight",
+    "pose_rates",
     "pose_times",
     "rank_frustums",
     "reachable",
     "sample_poses",
     "score_cones",
+    "score_poses",
     "select_view",
 ]

@@ -140,20 +140,47 @@ def _select(
                          options.start)  # fmt: skip
     if poses.shape[0] == 0:
         return ViewSelection(SelectionStatus.NO_POSES, method, None, (), ())
-    visible = None
-    if options.occlusion is not None:
-        camera_z = body.camera_height + body.torso.clip(options.torso)
-        cameras = np.column_stack([poses[:, :2], np.full(len(poses), camera_z)])
-        cones = in_view_cones(poses, points, half, reach)
-        visible = line_of_sight(options.occlusion, cameras, points, cones)
-        scores = (cones & visible).astype(float) @ weights
-    else:
-        scores = score_cones(poses, points, weights, half, reach)
+    scores, visible = _scores(poses, points, weights, body, options, half, reach)
     k = int(rng.integers(len(poses))) if method is ViewMethod.RANDOM else int(np.argmax(scores))
     scored = tuple(ScoredPose(*map(float, p), float(s)) for p, s in zip(poses, scores, strict=True))
     frustums = rank_frustums(poses[k], points, weights, body, reach, options.torso,
                              None if visible is None else visible[k])
     return ViewSelection(SelectionStatus.SELECTED, method, scored[k], scored, frustums)
+
+
+def _scores(
+    poses: np.ndarray, points: np.ndarray, weights: np.ndarray, body: RobotBody,
+    options: ViewOptions, half: float, reach: float,
+) -> tuple[np.ndarray, np.ndarray | None]:  # fmt: skip
+    """Eq. 2 per pose, with line of sight through `options.occlusion` when it is given (then
+    also the (n, m) visibility mask)."""
+    if options.occlusion is None:
+        return score_cones(poses, points, weights, half, reach), None
+    camera_z = body.camera_height + body.torso.clip(options.torso)
+    cameras = np.column_stack([poses[:, :2], np.full(len(poses), camera_z)])
+    cones = in_view_cones(poses, points, half, reach)
+    visible = line_of_sight(options.occlusion, cameras, points, cones)
+    return (cones & visible).astype(float) @ weights, visible
+
+
+def score_poses(
+    poses: np.ndarray, points: np.ndarray, density: np.ndarray, body: RobotBody,
+    options: ViewOptions | None = None,
+) -> np.ndarray:  # fmt: skip
+    """Eq. 2's score of given poses (n, 3), e.g. where the robot stands, as `select_view`
+    scores its samples (same cone, range and occlusion options)."""
+    options = options or ViewOptions()
+    poses = np.asarray(poses, dtype=float).reshape(-1, 3)
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    density = np.asarray(density, dtype=float).reshape(-1)
+    if density.shape[0] != points.shape[0]:
+        raise ViewSelectionError(f"density has {density.shape[0]} values for "
+                                 f"{points.shape[0]} plane voxels")  # fmt: skip
+    if poses.shape[0] == 0 or points.shape[0] == 0:
+        return np.zeros(poses.shape[0])
+    half = options.cone_half_angle or cone_half_angle(body, options.pan_sweep)
+    reach = options.max_range or body.detect_range
+    return _scores(poses, points, density, body, options, half, reach)[0]
 
 
 def pose_times(
@@ -184,13 +211,25 @@ def best_rate(
     """The pose with the most eq. 2 score per second of getting there and looking for
     `look_s`: the utility p/t of Sarmiento et al. that FLAP (seed 000, eq. 6) plans with,
     where p is the belief's mass in the pose's cone. None if no pose is reachable."""
+    rates = pose_rates(poses, grid, start, body, look_s)
+    if not len(poses) or not np.isfinite(rates).any():
+        return None
+    return poses[int(np.argmax(rates))]
+
+
+def pose_rates(
+    poses: tuple[ScoredPose, ...], grid: OccupancyGrid, start: tuple[float, float, float],
+    body: RobotBody, look_s: float,
+) -> np.ndarray:  # fmt: skip
+    """`best_rate`'s utility of every pose: eq. 2 score / (seconds to get there + `look_s`);
+    -inf where the grid has no path."""
     if look_s <= 0.0:
         raise ViewSelectionError(f"look_s must be > 0 s, got {look_s}")
+    if not len(poses):
+        return np.zeros(0)
     times = pose_times(poses, grid, start, body) + look_s
-    if not len(poses) or not np.isfinite(times).any():
-        return None
     rates = np.array([p.score for p in poses]) / times
-    return poses[int(np.argmax(np.where(np.isfinite(times), rates, -np.inf)))]
+    return np.where(np.isfinite(times), rates, -np.inf)
 
 
 def cone_half_angle(body: RobotBody, pan_sweep: float = 0.0) -> float:

@@ -40,11 +40,12 @@ from avs_planner.qsr import (
     ScoredPose,
     ViewMethod,
     ViewOptions,
-    best_rate,
     in_frustums,
     landmarks_from,
     line_of_sight,
+    pose_rates,
     rank_frustums,
+    score_poses,
     select_view,
 )
 from avs_planner.strategies.baselines import explore
@@ -109,6 +110,8 @@ class QsrSearch:
         self.rng = np.random.default_rng(ctx.executor.seed)
         self.looks: list[_Look] = []
         self.poses = 0
+        self.here: ScoredPose | None = None  # where the robot looked last, if it has not moved
+        self.looks_here = 0  # looks made from the current pose
         self.survey_s = 0.0
         self.search_start = 0.0
         self.landmarks: list[Landmark] = []
@@ -168,11 +171,18 @@ class QsrSearch:
             if not view.selected:
                 return self._end(Outcome.GAVE_UP, f"view selection: {view.status.value}")
             best = view.best  # eq. 2's argmax (random: a random one)
-            if self.opt["utility"] == "rate" and self.method is not ViewMethod.RANDOM:
+            if self.relooks():
+                best = self.choose(view.poses, self.stay_pose(planes, density))
+                if best is self.here:
+                    if self.look_again(planes, density):
+                        return self._found(self.result.found)
+                    continue
+            elif self.opt["utility"] == "rate" and self.method is not ViewMethod.RANDOM:
                 best = self.choose(view.poses)
             ctx.trace.emit("action", action=f"(view-pose {self.method.value})", status="start",
                            pose=[round(best.x, 2), round(best.y, 2), round(best.yaw, 3)],
                            score=round(best.score, 4), plane_voxels=len(planes))
+            self.here, self.looks_here = None, 0
             outcome = ctx.executor.drive_to((best.x, best.y))
             if outcome.status is not StepStatus.DONE:
                 failures += 1
@@ -185,21 +195,73 @@ class QsrSearch:
             self.poses += 1
             found = known_target(ctx)  # seen while driving there (option watch)
             if found is None:
-                found = self.perceive(planes, density)
+                found = self.perceive(planes, density, 1 if self.relooks() else None)
             ctx.trace.emit("action", action=f"(view-pose {self.method.value})", status="done",
                            poses=self.poses, search_time_s=round(self.search_time(), 2))
             if found is not None:
-                self.learn(found)
-                self.result.found = found
-                where = ", ".join(f"{v:.2f}" for v in found.position)
-                return self._end(Outcome.FOUND, f"{found.label} at ({where}) in {found.room}")
+                return self._found(found)
+            if self.relooks():
+                x, y, yaw = ctx.robot.pose
+                self.here = ScoredPose(x, y, yaw, 0.0)
 
-    def choose(self, poses: tuple[ScoredPose, ...]) -> ScoredPose:
-        """Option `utility: rate`: the pose with the most density per second of getting there
-        and looking (`avs_planner.qsr.best_rate`)."""
+    def _found(self, found: KnownObject) -> SearchResult:
+        self.learn(found)
+        self.result.found = found
+        where = ", ".join(f"{v:.2f}" for v in found.position)
+        return self._end(Outcome.FOUND, f"{found.label} at ({where}) in {found.room}")
+
+    def relooks(self) -> bool:
+        """Option `relook` with `utility: rate` (not `random`): after each look that found
+        nothing, staying for another look here competes with the sampled poses."""
+        return (self.opt["relook"] and self.opt["utility"] == "rate"
+                and self.method is not ViewMethod.RANDOM)
+
+    def look_s(self) -> float:
+        """Seconds of looking a pose is rated for: `frustums` x (depth frame + detection)."""
         body = self.ctx.body
-        look = self.opt["frustums"] * (body.scan_time + body.sensing_time)
-        return best_rate(poses, self.ctx.mind.grid, self.ctx.robot.pose, body, look) or poses[0]
+        return self.opt["frustums"] * (body.scan_time + body.sensing_time)
+
+    def stay_pose(self, planes: SupportingPlanes, density: np.ndarray) -> ScoredPose | None:
+        """Where the robot stands, scored by eq. 2 on the updated belief like the samples, if
+        it looked from here last and may look again (`max_looks` per pose, a safety bound)."""
+        if self.here is None or self.looks_here >= self.opt["max_looks"]:
+            return None
+        ctx = self.ctx
+        score = score_poses(np.array([ctx.robot.pose]), planes.points, density, ctx.body,
+                            ViewOptions(pan_sweep=math.radians(self.opt["pan_sweep_deg"]),
+                                        occlusion=ctx.mind.voxels))[0]  # fmt: skip
+        self.here = ScoredPose(self.here.x, self.here.y, self.here.yaw, float(score))
+        return self.here
+
+    def choose(self, poses: tuple[ScoredPose, ...], stay: ScoredPose | None = None
+               ) -> ScoredPose:  # fmt: skip
+        """Option `utility: rate`: the pose with the most density per second of getting there
+        and looking (`avs_planner.qsr.best_rate`); `stay`, the robot's own pose, needs no
+        driving (its rate is its score per `look_s`) and wins when it is at least as good."""
+        ctx = self.ctx
+        look = self.look_s()
+        rates = pose_rates(poses, ctx.mind.grid, ctx.robot.pose, ctx.body, look)
+        k = int(np.argmax(rates)) if len(rates) and np.isfinite(rates).any() else 0
+        if stay is not None and stay.score > 0.0 and (
+                not len(rates) or stay.score / look >= rates[k]):
+            ctx.trace.emit("belief", stay_rate=round(stay.score / look, 5),
+                           move_rate=round(float(rates[k]), 5) if len(rates) else None)
+            return stay
+        return poses[k]
+
+    def look_again(self, planes: SupportingPlanes, density: np.ndarray) -> bool:
+        """One more look from where the robot stands: the best of the nine frustums on the
+        belief after its misses here (the frustum just used included). True when it found
+        the target (in `self.result.found`); with no density left in view here, the robot
+        will not consider staying again."""
+        before = self.looks_here
+        found = self.perceive(planes, density, 1, again=True)
+        if found is not None:
+            self.result.found = found
+            return True
+        if self.looks_here == before:  # rated as staying, but no frustum here sees density
+            self.here = None
+        return False
 
     def search_time(self) -> float:
         return self.ctx.robot.clock - self.search_start
@@ -274,11 +336,13 @@ class QsrSearch:
             visible = line_of_sight(mind.voxels, camera, points)[0]
         return rank_frustums(pose, points, density, body, body.detect_range, 0.0, visible)
 
-    def perceive(self, planes: SupportingPlanes, density: np.ndarray) -> KnownObject | None:
-        """Look with the best frustums (a depth frame each, for the 3D map), detect the
-        target and confirm it with a second frame. With `rerank`, after a look that found
-        nothing the frustums not yet used here are ranked again on the updated belief (the
-        look's voxels times `seen_weight`), as the next pose is."""
+    def perceive(self, planes: SupportingPlanes, density: np.ndarray, looks: int | None = None,
+                 again: bool = False) -> KnownObject | None:
+        """Look with the best frustums (a depth frame each, for the 3D map), `looks` of
+        them (default `frustums`), detect the target and confirm it with a second frame. With
+        `rerank`, after a look that found nothing the frustums not yet used here are ranked
+        again on the updated belief (the look's voxels times `seen_weight`), as the next pose
+        is. `again`: a look after staying (any frustum, the ones used here included)."""
         ctx = self.ctx
         body = ctx.body
         points = planes.points
@@ -286,8 +350,10 @@ class QsrSearch:
         camera = np.array([[pose[0], pose[1], body.camera_height]])
         visible = line_of_sight(ctx.mind.voxels, camera, points)[0]
         frustums = list(self.frustums_here(points, density, visible))
+        if again:
+            frustums = [f for f in frustums if f.score > 0.0]
         used: list[tuple[float, float]] = []
-        for i in range(self.opt["frustums"]):
+        for i in range(self.opt["frustums"] if looks is None else looks):
             if self.opt["rerank"] and i > 0:
                 fresh = self.frustums_here(points, self.density(planes), visible)
                 frustums = [f for f in fresh if (f.pan, f.tilt) not in used]
@@ -299,9 +365,10 @@ class QsrSearch:
             if self.search_time() >= self.opt["abort_s"]:
                 break
             used.append((f.pan, f.tilt))
+            self.looks_here += 1
             ctx.robot.look(f.pan, f.tilt)
             ctx.trace.emit("action", action="(look)", pan=round(f.pan, 3), tilt=round(f.tilt, 3),
-                           score=round(f.score, 4))
+                           score=round(f.score, 4), again=again)
             x, y, yaw = ctx.robot.pose
             self.looks.append(_Look(np.array([x, y, body.camera_height]), yaw + f.pan, f.tilt))
             self._depth()

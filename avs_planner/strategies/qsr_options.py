@@ -10,12 +10,18 @@ from avs_planner.errors import AvsError
 OPTIONS: dict[str, Any] = {
     "abort_s": 120.0,  # the seed's search monitor: simulated seconds of search before abort
     "n_poses": 20,  # poses sampled per selection (Algorithm 1's n)
-    "frustums": 2,  # best frustums perceived at each pose (of the nine ranked)
+    "frustums": 2,  # looks a pose is rated for (utility rate's look time), and the looks
+    # taken at each pose without relook (the best of the nine ranked frustums)
     "pan_sweep_deg": 0.0,  # widen the 2D cone by a head pan each way (the seed's Table IV: 60)
     "seen_weight": 0.25,  # density factor of a voxel per look that covered it: about the
     # chance that a look misses a cup in view (camera miss 0.2, + 0.8 x 0.2^2 unconfirmed)
     "rerank": True,  # rank the frustums at a pose again after each look that found nothing
     # (on the belief with that look's miss), instead of taking the first ranking's next one
+    "relook": True,  # with utility rate (not random): after a look that found nothing,
+    # another look from where the robot stands (any frustum, the one just used included, on
+    # the updated belief) competes with the sampled poses by the same score per second
+    "max_looks": 9,  # looks from one pose at most (a safety bound on relook; each look
+    # multiplies what it covered by seen_weight, so the utility moves on long before)
     "confirm_frames": 2,  # frames to confirm a first detection (any one agreeing suffices)
     "uniform_floor": 0.02,  # qsr: share of uniform density mixed in (wrong QSRs stay findable)
     "utility": "rate",  # pose choice: rate (eq. 2's score per second of getting there and
@@ -39,3 +45,5 @@ def check_options(options: dict[str, Any]) -> None:
     if options["utility"] not in UTILITIES:
         raise AvsError(f"option 'utility' must be one of {', '.join(UTILITIES)}, "
                        f"got {options['utility']!r}")
+    if options["max_looks"] < 1:
+        raise AvsError(f"option 'max_looks' must be >= 1, got {options['max_looks']}")

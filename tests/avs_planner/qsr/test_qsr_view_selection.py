@@ -17,10 +17,12 @@ from avs_planner.qsr import (
     cone_half_angle,
     in_frustums,
     in_view_cones,
+    pose_rates,
     pose_times,
     rank_frustums,
     sample_poses,
     score_cones,
+    score_poses,
     select_view,
 )
 from bench import qsr_scene
@@ -246,3 +248,27 @@ def test_best_rate_trades_density_against_time():
     assert best_rate((far,), boxed, start, BODY, 1.0) is None  # behind a wall: no path
     with pytest.raises(ViewSelectionError):
         best_rate((near,), grid, start, BODY, 0.0)
+
+
+def test_score_poses_scores_any_pose_as_the_selection_does():
+    """The robot's own pose is scored like the samples (relook compares it with them)."""
+    grid = _open_grid()
+    dense, plain = _patch(1.0, 8.0, 2.0, 9.0), _patch(7.0, 1.0, 9.0, 3.0)
+    points = np.vstack([dense, plain])
+    density = np.r_[np.ones(len(dense)), np.full(len(plain), 1e-3)]
+    density /= density.sum()
+    view = select_view(grid, points, density, BODY, ViewMethod.QSR, rng=5)
+    poses = np.array([[p.x, p.y, p.yaw] for p in view.poses])
+    np.testing.assert_allclose(score_poses(poses, points, density, BODY),
+                               [p.score for p in view.poses])
+    # facing the dense patch from 1.5 m: nearly all of it; facing away: nothing
+    toward, away = score_poses(np.array([[1.5, 6.5, math.pi / 2], [1.5, 6.5, -math.pi / 2]]),
+                               points, density, BODY)
+    assert toward > 0.9 and away == 0.0
+    start = (1.5, 6.5, math.pi / 2)
+    rates = pose_rates(view.poses, grid, start, BODY, 1.2)
+    best = best_rate(view.poses, grid, start, BODY, 1.2)
+    assert best is view.poses[int(np.argmax(rates))]
+    assert toward / 1.2 > rates.max()  # staying here beats every sample per second
+    with pytest.raises(ViewSelectionError, match="density has 3 values"):
+        score_poses(poses, points, np.ones(3), BODY)

@@ -41,3 +41,62 @@ def test_most_likely_room_starts_with_the_likeliest_room():
     assert choices, "the strategy never ranked a room or placeholder"
     assert all(0.0 <= e["probability"] <= 1.0 for e in choices)
     assert choices[0]["kind"] == "placeholder"
+
+
+def test_accidental_agreement_by_hand():
+    """A 60 x 45 degree view 2 m away is 3.82 m2 across; a 0.25 m disc is 5% of it. Facing
+    a wall 0.4 m away, the whole view lies within 0.25 m of the spot."""
+    import math
+
+    from avs_planner.strategies.looking import accidental_agreement, verify_distance
+
+    h, v = math.radians(60), math.radians(45)
+    section = 4 * 2.0**2 * math.tan(h / 2) * math.tan(v / 2)
+    assert accidental_agreement(2.0, 0.25, h, v) == pytest.approx(math.pi * 0.0625 / section)
+    assert accidental_agreement(2.0, 0.25, h, v) == pytest.approx(0.0513, abs=1e-4)
+    assert accidental_agreement(0.4, 0.25, h, v) == 1.0
+    far = verify_distance(0.25, h, v)
+    assert far == pytest.approx(1.433, abs=1e-3)
+    assert accidental_agreement(far, 0.25, h, v) == pytest.approx(0.1)
+
+
+def test_a_phantom_confirmed_close_to_the_camera_is_verified_from_further_away_and_forgotten():
+    """The executor's watch confirms a target by two of three frames; a phantom 0.4 m in front
+    of the camera (on a wall there every phantom lands within the 0.25 m agreement) passes
+    that in three frames in a row (forced here). Before reporting, the baseline steps back
+    to where agreement means something, looks again, sees nothing there, and forgets it
+    (generated office world 23 reported a stapler that way)."""
+    import math
+
+    from avs_planner.episode.robot import Seen
+    from avs_planner.episode.runner import Episode, EpisodeSpec
+
+    spec = load_scenario("a").episode_spec(strategy="exhaustive", seed=1, time_budget_s=200)
+    episode = Episode(EpisodeSpec.from_dict(spec))
+    robot, detect = episode.robot, episode.robot.detect
+    target, phantoms = spec["target"], []
+
+    def with_phantoms(labels):
+        seen = detect(labels)
+        if target in labels and len(phantoms) < 3:
+            x, y, yaw = robot.pose
+            sid = len(robot.truth_of) + 1
+            robot.truth_of[sid] = None  # no object of the world
+            where = (x + 0.4 * math.cos(yaw), y + 0.4 * math.sin(yaw), robot.camera_height)
+            phantoms.append(where)
+            seen = [*seen, Seen(sid, target, where, 0.6)]
+        return seen
+
+    robot.detect = with_phantoms
+    events: list[dict] = []
+    episode.trace.subscribe(events.append)
+    summary = episode.run()
+    assert len(phantoms) == 3
+    kinds = [e.get("action") or ("forgotten" if "forgotten" in e else None) for e in events]
+    assert "(step-back)" in kinds and "forgotten" in kinds
+    assert kinds.index("(step-back)") < kinds.index("forgotten")
+    back = next(e for e in events if e.get("action") == "(step-back)")
+    assert back["status"] == "start" and back["distance"] < 0.5 < 1.4 < back["needed"]
+    verifying = [e for e in events if e.get("verifying")]
+    assert verifying and not verifying[0]["detected"]
+    assert summary["outcome"] != "found" or summary["correct"]

@@ -138,3 +138,55 @@ def test_pose_utility_option_is_checked():
         assert get_strategy(name).options["utility"] == "rate"
         with pytest.raises(StrategyError, match="'utility' must be one of rate, eq2"):
             get_strategy(name).check_options({"utility": "fastest"})
+
+
+def _search_with_one_miss(relook: bool):
+    """A qsr search on the desks whose camera misses the cup once, on the first frame of the
+    first look (forced here); the summary, the trace and the robot's pose at every cup frame."""
+    from avs_planner.episode.runner import Episode
+
+    episode = Episode(EpisodeSpec.from_dict(_spec("qsr", options={"relook": relook})))
+    robot, detect, asked = episode.robot, episode.robot.detect, []
+
+    def missing_once(labels):
+        seen = detect(labels)
+        if "cup" in labels:
+            asked.append(robot.pose)
+            if len(asked) == 1:
+                return []
+        return seen
+
+    robot.detect = missing_once
+    events: list[dict] = []
+    episode.trace.subscribe(events.append)
+    return episode.run(), events, asked
+
+
+def _looks(events):
+    return [e for e in events if e["type"] == "action" and e["action"] == "(look)"]
+
+
+def test_after_a_missed_look_the_robot_looks_again_from_the_same_pose():
+    """The cup is in the best frustum of the first pose and the camera misses it once: the
+    belief there drops by `seen_weight`, but staying for another look costs only sensing
+    time while any other pose costs driving, so by the same score per second the robot looks
+    again from where it stands (its best frustum may be the one just used) and finds the cup
+    without a second pose."""
+    summary, events, asked = _search_with_one_miss(relook=True)
+    assert summary["outcome"] == "found" and summary["correct"], summary["reason"]
+    starts = [e for e in events if e["type"] == "action" and e["action"] == "(view-pose qsr)"
+              and e["status"] == "start"]
+    assert summary["details"]["poses"] == 1 and len(starts) == 1
+    assert [e["again"] for e in _looks(events)[:2]] == [False, True]
+    assert np.allclose(asked[0], asked[-1])  # every cup frame from the same pose
+    stay = next(e for e in events if e["type"] == "belief" and "stay_rate" in e)
+    assert stay["stay_rate"] >= stay["move_rate"] > 0.0
+
+
+@pytest.mark.slow
+def test_without_relook_the_second_look_is_the_next_unused_frustum():
+    summary, events, _ = _search_with_one_miss(relook=False)
+    looks = _looks(events)
+    assert not any(e["again"] for e in looks)
+    assert not any("stay_rate" in e for e in events if e["type"] == "belief")
+    assert (looks[0]["pan"], looks[0]["tilt"]) != (looks[1]["pan"], looks[1]["tilt"])
