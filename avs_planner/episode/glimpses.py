@@ -14,7 +14,10 @@ before the building's hypotheses did. Here every such frame counts:
   support height inside the vertical field of view, and a free line of sight on the
   occupancy grid (an unknown or occupied cell in between blocks it).
 - **Supports.** The top of a known support counts as looked at when it is in view by the
-  same tests (at twice its detected centre's height, the executor's rule for a top).
+  same tests (at twice its detected centre's height, the executor's rule for a top), except
+  that the line of sight may end in the support's own body: the laser maps a desk as its
+  outline with unknown cells inside, which a ray to its centre crosses (without this, no top
+  in view ever counted).
 
 A look is one chance for the detector (hit rate `p_detect`, the DT's own detector model), so
 a cell or top looked at from k different standpoints (camera positions 1 m apart; frames
