@@ -43,17 +43,18 @@ def assumed_descriptions(
     it as their subject. With several tasks, a step's effects come from the first that has
     it (an assumption that came true is no longer possible in the current task)."""
     described: dict[str, set[Atom]] = {}
+    tasks = _tasks(task)
     for step in plan:
         for arg in step.args:
             if is_virtual(arg):
                 described.setdefault(arg, set())
         if not step.assumptive:
             continue
-        task, action = _first_action(_tasks(task), step)
-        if task is None or action is None:
+        owner, action = _first_action(tasks, step)
+        if owner is None or action is None:
             continue
         for i in action.add_facts:
-            atom = task.facts[i]
+            atom = owner.facts[i]
             if len(atom) > 1 and atom[1] in described:
                 described[atom[1]].add(atom)
     return described

@@ -10,7 +10,7 @@ from avs_planner.cp.continual import ContinualPlanner, Decision
 from avs_planner.cp.grounding import ground, world_state
 from avs_planner.cp.matching import match_virtual_objects, rename_plan
 from avs_planner.cp.monitor import MonitorStatus, monitor
-from avs_planner.cp.search import SearchOptions
+from avs_planner.cp.search import PlanStep, SearchOptions
 from avs_planner.pddl import read_text
 
 OPTIONS = SearchOptions(reward=500.0)
@@ -171,3 +171,15 @@ def test_the_report_gives_each_assumptions_probability_in_the_new_state(planned)
     assert dict(report.assumptions)[leads] == pytest.approx(0.55)
     gone = _check(planner, planner.state.updated(add=[("defined-leads-to", "place1")]))
     assert gone.assumptions == ((leads, 0.0),)  # the first one, contradicted
+
+
+def test_matching_reads_every_assumption_when_one_is_in_no_task(planned):
+    """An assumptive step no task has any more is skipped, and the steps after it are still
+    read in every task (the loop once rebound its task list to the step's owner, None here:
+    'NoneType' object is not iterable, generated office world 14, book)."""
+    planner, _ = planned
+    task = ground(planner.pproblem, world_state(planner.pproblem.problem), planner.cache)
+    gone = PlanStep("assume-category", ("no-such-room", "kitchen"), 0.0, 0.5, assumptive=True)
+    table = {("label-of", "table1", "table"), ("related", "table1", "in", "new-room1")}
+    mapping = match_virtual_objects((gone, *planner.plan), [task, task], {"table1": table})
+    assert mapping == {"new-object1": "table1"}
