@@ -738,10 +738,12 @@ typedef struct {
     double *n_c, *n_p, *n_h;
     int8_t *n_alive, *n_eval;
     int32_t n_nodes, cap_nodes;
-    /* queues */
-    Queue heap, pref;
-    int64_t priority[2];
-    double best_h;
+    /* queues: the main one, helpful actions', and with goal_count the goal-count ones
+     * (search.py's _Search.queues; Q_* index priority) */
+    Queue heap, pref, gc_heap, gc_pref;
+    int64_t priority[4];
+    double best_h, best_gc;
+    int goal_count, commute; /* QF_GOAL_COUNT set; QF_NO_COMMUTE not set */
     /* LAZY_UNHELPFUL defers only while h improves: expansions so far, the expansion count
      * when best_h last dropped, and whether the node being expanded defers (STALL) */
     int64_t n_expanded, progress_at;
@@ -749,7 +751,7 @@ typedef struct {
     int32_t *waiting; /* nodes deferred since the last flush_deferred */
     int64_t n_waiting, cap_waiting;
     double popped_h;  /* h of the queue entry pop_node took */
-    int from_pref, pruned_threshold;
+    int from_queue, pruned_threshold; /* from_queue: Q_* of the queue pop_node took from */
     /* helpful pool: StateRec.help_off/help_n index it */
     int32_t *help;
     int64_t n_help, cap_help;
@@ -769,6 +771,19 @@ typedef struct {
     int oom;
     PyThreadState *thread; /* saved while the GIL is released (NULL: not released) */
 } Search;
+
+enum { Q_MAIN = 0, Q_PREF = 1, Q_GC = 2, Q_GC_PREF = 3 };
+/* native_search's queue flags: helpful actions first, goal-count queues, and no pruning of
+ * the second order of two commuting actions (search.py's _preferred, _goal_count and
+ * SearchOptions.commute) */
+enum { QF_PREFERRED = 1, QF_GOAL_COUNT = 2, QF_NO_COMMUTE = 4 };
+static const int POP_ORDER[4] = {Q_PREF, Q_MAIN, Q_GC_PREF, Q_GC}; /* ties broken in order */
+
+static inline Queue *queue_of(Search *s, int q)
+{
+    return q == Q_MAIN ? &s->heap : q == Q_PREF ? &s->pref : q == Q_GC ? &s->gc_heap
+                                                                        : &s->gc_pref;
+}
 
 static inline int qless(const QEntry *a, const QEntry *b)
 {
@@ -1369,6 +1384,14 @@ static int grow_nodes(Search *s)
 /* ------------------------------------------------------------------------------------------ */
 /* The search (_Search)                                                                         */
 
+/* progress: trust the helpful actions for a while (LAMA's boost of 1000) */
+static inline void boost(Search *s)
+{
+    s->priority[Q_PREF] -= 1000;
+    if (s->goal_count)
+        s->priority[Q_GC_PREF] -= 1000;
+}
+
 static int queue_node(Search *s, double f, double h, int32_t node, int preferred)
 {
     if (qpush(s, &s->heap, f, h, node))
@@ -1378,7 +1401,27 @@ static int queue_node(Search *s, double f, double h, int32_t node, int preferred
     if (h < s->best_h && s->n_eval[node]) {
         s->best_h = h;
         s->progress_at = s->n_expanded;
-        s->priority[1] -= 1000;
+        boost(s);
+    }
+    return 0;
+}
+
+/* _Search.queue_goal_count: the goal-count queues, by goal facts left (ties: h, then age) */
+static int queue_goal_count(Search *s, const word *state, double h, int32_t node,
+                            int preferred)
+{
+    int64_t left = 0;
+    for (Py_ssize_t i = 0; i < s->W; i++)
+        left += __builtin_popcountll(s->goal[i] & ~state[i]) +
+                __builtin_popcountll(state[i] & s->goal_neg[i]);
+    double count = (double)left;
+    if (qpush(s, &s->gc_heap, count, h, node))
+        return -1;
+    if (preferred && qpush(s, &s->gc_pref, count, h, node))
+        return -1;
+    if (count < s->best_gc) {
+        s->best_gc = count;
+        boost(s);
     }
     return 0;
 }
@@ -1431,17 +1474,25 @@ static int push_node(Search *s, const word *state, double c, double p, int32_t p
     if (deferred && s->lazy == LAZY_UNHELPFUL &&
         list_push(&s->waiting, &s->n_waiting, &s->cap_waiting, node, &s->oom))
         return -1;
-    if (hv != INFINITY)
-        return queue_node(s, g + hv, hv, node, preferred);
-    return 0;
+    if (hv == INFINITY)
+        return 0;
+    if (queue_node(s, g + hv, hv, node, preferred))
+        return -1;
+    return s->goal_count ? queue_goal_count(s, state, hv, node, preferred) : 0;
 }
 
 static int32_t pop_node(Search *s)
 {
-    int use_pref = s->pref.n && (s->priority[1] <= s->priority[0] || !s->heap.n);
-    s->from_pref = use_pref;
-    s->priority[use_pref ? 1 : 0] += 1;
-    QEntry e = qpop(use_pref ? &s->pref : &s->heap);
+    /* the non-empty queue that has had the fewest turns (ties: POP_ORDER) */
+    int pick = -1;
+    for (int i = 0; i < 4; i++) {
+        int q = POP_ORDER[i];
+        if (queue_of(s, q)->n && (pick < 0 || s->priority[q] < s->priority[pick]))
+            pick = q;
+    }
+    s->from_queue = pick;
+    s->priority[pick] += 1;
+    QEntry e = qpop(queue_of(s, pick));
     s->popped_h = e.h;
     return e.node;
 }
@@ -1495,16 +1546,19 @@ static int evaluate_node(Search *s, int32_t node)
     int ok = evaluate_now(s, node, 1, &f, &h);
     if (ok <= 0)
         return ok;
-    Queue *q = s->from_pref ? &s->pref : &s->heap;
-    if (q->n && f > q->v[0].f) {
-        if (queue_node(s, f, h, node, s->from_pref))
-            return -1;
-        return 0;
+    if (s->from_queue == Q_MAIN || s->from_queue == Q_PREF) {
+        /* goal-count keys do not change with h: a node from those queues is expanded now */
+        Queue *q = queue_of(s, s->from_queue);
+        if (q->n && f > q->v[0].f) {
+            if (queue_node(s, f, h, node, s->from_queue == Q_PREF))
+                return -1;
+            return 0;
+        }
     }
     if (h < s->best_h) {
         s->best_h = h;
         s->progress_at = s->n_expanded;
-        s->priority[1] -= 1000;
+        boost(s);
     }
     return 1;
 }
@@ -1584,7 +1638,7 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
     *expanded_out = 0;
     if (push_node(s, init, 0.0, 1.0, -1, -1, 0) < 0)
         return -1;
-    while (s->heap.n || s->pref.n) {
+    while (s->heap.n || s->pref.n || s->gc_heap.n || s->gc_pref.n) {
         int32_t node = pop_node(s);
         if (!s->n_alive[node])
             continue;
@@ -1608,7 +1662,7 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
                 best = node;
                 best_at = expanded;
             }
-            if (s->from_pref && s->heap.n && s->heap.v[0].f < obj) {
+            if (s->from_queue != Q_MAIN && s->heap.n && s->heap.v[0].f < obj) {
                 s->n_alive[node] = 1;
                 if (qpush(s, &s->heap, obj, 0.0, node))
                     return -1;
@@ -1666,7 +1720,7 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
                 continue;
             if (t->cl_off[a] != t->cl_off[a + 1] && !applicable(t, W, (int32_t)a, state))
                 continue;
-            if (last > a && commutes(t, W, (int32_t)a, last))
+            if (s->commute && last > a && commutes(t, W, (int32_t)a, last))
                 continue; /* the order (a, last) is explored instead */
             if (s->has_sym && sym_prunes(s, (int32_t)a, state))
                 continue; /* a mirror image with a lower object is explored */
@@ -1756,7 +1810,8 @@ static void search_free(Search *s)
         free(s->recs[i].labels);
     void *ptrs[] = {s->goal, s->goal_neg, s->goal_facts, s->is_goal, s->sdata, s->recs,
                     s->slots, s->n_state, s->n_parent, s->n_via, s->n_c, s->n_p, s->n_h,
-                    s->n_alive, s->n_eval, s->heap.v, s->pref.v, s->help, s->combined,
+                    s->n_alive, s->n_eval, s->heap.v, s->pref.v, s->gc_heap.v,
+                    s->gc_pref.v, s->help, s->combined,
                     s->help_stamp, s->parent, s->kids, s->kid_act, s->todo, s->kid_c,
                     s->kid_p, s->todo_hc, s->todo_hl, s->todo_at, s->todo_n, s->kid_pref,
                     s->todo_owner, s->waiting};
@@ -2092,17 +2147,21 @@ static PyObject *native_search(PyObject *self, PyObject *args)
     Search s;
     memset(&s, 0, sizeof(s));
     long long node_limit, patience;
-    if (!PyArg_ParseTuple(args, "O!y*y*y*iddddLLipy*y*y*y*i:search", &TaskType, &t, &b[0],
+    int flags; /* QF_* */
+    if (!PyArg_ParseTuple(args, "O!y*y*y*iddddLLiiy*y*y*y*i:search", &TaskType, &t, &b[0],
                           &b[1], &b[2], &s.heuristic, &s.reward, &s.weight, &s.min_success,
-                          &s.timeout, &node_limit, &patience, &s.lazy, &s.preferred, &b[3],
+                          &s.timeout, &node_limit, &patience, &s.lazy, &flags, &b[3],
                           &b[4], &b[5], &b[6], &s.threads))
         return NULL;
+    s.preferred = (flags & QF_PREFERRED) != 0;
+    s.goal_count = (flags & QF_GOAL_COUNT) != 0;
+    s.commute = (flags & QF_NO_COMMUTE) == 0;
     PyObject *result = NULL;
     s.t = t;
     s.W = t->W;
     s.node_limit = node_limit;
     s.patience = patience;
-    s.best_h = INFINITY;
+    s.best_h = s.best_gc = INFINITY;
     Py_ssize_t W = t->W, F = t->n_facts, A = t->n_actions;
     if (s.heuristic < H_BLIND || s.heuristic > H_FF) {
         PyErr_SetString(PyExc_ValueError, "native search: unknown heuristic code");

@@ -2,8 +2,9 @@
 
 LAMA's schedule on our objective: first a greedy best-first search with the FF heuristic,
 helpful actions first (alternating with a round without them) and deferred evaluation, on
-unit action costs (LAMA's first
-iteration: plan length guides it, so it finds a plan fast); then weighted A* restarted with
+unit action costs, FF's open list alternating with a goal-count one (LAMA's first
+iteration, with the goal count where LAMA counts landmarks: plan length guides it, so it
+finds a plan fast); then weighted A* restarted with
 decreasing weights (5, 3, 2, 1) on the real objective c + R(1 - p). Every plan is judged by
 that objective and the best so far is kept; at the deadline (`timeout_s`) it is returned,
 with `stopped_by = "timeout"` when a later iteration was still running. Probabilistic tasks
@@ -72,13 +73,20 @@ def anytime_search(
 
 
 def greedy_search(task: GroundTask, options: SearchOptions, symmetries: Symmetries,
-                  deadline: float | None) -> tuple[PlanResult, int]:
-    """Greedy best-first on unit costs, with and without the helpful-actions queue in turn,
+                  deadline: float | None, goal_count: bool = True,
+                  commute: bool = False) -> tuple[PlanResult, int]:
+    """Greedy best-first on unit costs, with and without the helpful-actions queues in turn,
     each under an expansion budget that grows fourfold per round until one finds a plan or proves
     there is none: helpful actions make barman easy and mislead on tetris, and the rounds
-    cost at most a small factor over the better of the two."""
+    cost at most a small factor over the better of the two.
+
+    Each round alternates FF's open list with a goal-count list (`goal_count`; LAMA
+    alternates with its landmark count), each with its helpful-actions list, and does not
+    prune the second order of commuting actions (`commute`; see SearchOptions.commute).
+    Both defaults are what the anytime mode runs; the arguments are there to compare."""
     unit = unit_cost(task)
-    greedy = replace(options, anytime=False, weight=GREEDY_WEIGHT, lazy=True, patience=0)
+    greedy = replace(options, anytime=False, weight=GREEDY_WEIGHT, lazy=True, patience=0,
+                     goal_count=goal_count, commute=commute)
     budget, expanded = FIRST_BUDGET, 0
     result = PlanResult(PlanStatus.TIMEOUT)
     while True:
