@@ -80,6 +80,11 @@ typedef struct {
     Py_ssize_t n_facts, n_actions, W;
     Py_ssize_t n_rfacts, n_rel; /* with the merge's auxiliary facts, extra actions */
     word *pre, *pre_neg, *add, *del, *reads; /* n_actions * W each */
+    /* pre and pre_neg without their zero words: per action (CSR pw_off), the index and
+     * bits of each non-zero word, pre's first (pw_n_pre of them; the one with the most bits
+     * first), then pre_neg's; what successor generation tests instead of 2W words */
+    int32_t *pw_off, *pw_n_pre, *pw_idx;
+    word *pw_mask;
     double *cost, *prob, *neglog; /* per relaxed action (extra: a member's, aux: 0, 0, 1) */
     int8_t *kind;                 /* K_* per relaxed action */
     int32_t *link;                /* merged: its fact X; aux: its position among X's */
@@ -117,7 +122,8 @@ static void task_free_arrays(TaskObject *t)
                     t->unit_neg_off, t->unit_neg,
                     t->pair_action, t->cls_of, t->cls_off, t->cls_members, t->cls_len,
                     t->cof_off, t->cof, t->xcof_off, t->xcof_cls, t->xcof_pair, t->no_pre,
-                    t->n_pairs_of, t->pre_len, t->kind, t->link, t->member_off, t->members};
+                    t->n_pairs_of, t->pre_len, t->kind, t->link, t->member_off, t->members,
+                    t->pw_off, t->pw_n_pre, t->pw_idx, t->pw_mask};
     for (size_t i = 0; i < sizeof(ptrs) / sizeof(ptrs[0]); i++)
         free(ptrs[i]);
 }
@@ -526,6 +532,47 @@ done:
     return ok;
 }
 
+/* TaskObject.pw_*: the non-zero words of each action's pre and pre_neg */
+static int sparse_pre(TaskObject *t)
+{
+    Py_ssize_t A = t->n_actions, W = t->W, n = 0;
+    for (Py_ssize_t i = 0; i < A * W; i++)
+        n += (t->pre[i] != 0) + (t->pre_neg[i] != 0);
+    t->pw_off = xcalloc((size_t)A + 1, sizeof(int32_t));
+    t->pw_n_pre = xcalloc((size_t)A + 1, sizeof(int32_t));
+    t->pw_idx = xcalloc((size_t)n + 1, sizeof(int32_t));
+    t->pw_mask = xcalloc((size_t)n + 1, sizeof(word));
+    if (!t->pw_off || !t->pw_n_pre || !t->pw_idx || !t->pw_mask || n > INT32_MAX / 2)
+        return -1;
+    int32_t k = 0;
+    for (Py_ssize_t a = 0; a < A; a++) {
+        const word *pre = t->pre + a * W, *neg = t->pre_neg + a * W;
+        t->pw_off[a] = k;
+        int32_t first = k;
+        for (Py_ssize_t i = 0; i < W; i++)
+            if (pre[i]) {
+                t->pw_idx[k] = (int32_t)i;
+                t->pw_mask[k] = pre[i];
+                if (__builtin_popcountll(pre[i]) > __builtin_popcountll(t->pw_mask[first])) {
+                    t->pw_idx[k] = t->pw_idx[first]; /* the word with the most bits first */
+                    t->pw_mask[k] = t->pw_mask[first];
+                    t->pw_idx[first] = (int32_t)i;
+                    t->pw_mask[first] = pre[i];
+                }
+                k++;
+            }
+        t->pw_n_pre[a] = k - first;
+        for (Py_ssize_t i = 0; i < W; i++)
+            if (neg[i]) {
+                t->pw_idx[k] = (int32_t)i;
+                t->pw_mask[k] = neg[i];
+                k++;
+            }
+    }
+    t->pw_off[A] = k;
+    return 0;
+}
+
 static PyObject *task_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
 {
     Py_ssize_t n_facts, n_actions, n_rfacts, n_merged;
@@ -596,6 +643,10 @@ static PyObject *task_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
                              n_facts);
                 goto fail;
             }
+    if (sparse_pre(t)) {
+        PyErr_NoMemory();
+        goto fail;
+    }
     if (task_merge(t, n_rfacts, n_merged, b + 14) || task_derive(t))
         goto fail;
     for (int i = 0; i < NBUF; i++)
@@ -1709,14 +1760,16 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
         int32_t n_kids = 0, n_todo = 0;
         int batching = s->lazy != LAZY_ALL && s->heuristic != H_BLIND;
         for (Py_ssize_t a = 0; a < A; a++) {
-            const word *pre = t->pre + a * W, *neg = t->pre_neg + a * W;
-            int ok = 1;
-            for (Py_ssize_t i = 0; i < W; i++)
-                if ((state[i] & pre[i]) != pre[i] || (state[i] & neg[i])) {
-                    ok = 0;
+            int32_t j = t->pw_off[a], mid = j + t->pw_n_pre[a], end = t->pw_off[a + 1];
+            for (; j < mid; j++)
+                if ((state[t->pw_idx[j]] & t->pw_mask[j]) != t->pw_mask[j])
                     break;
-                }
-            if (!ok)
+            if (j < mid)
+                continue;
+            for (; j < end; j++)
+                if (state[t->pw_idx[j]] & t->pw_mask[j])
+                    break;
+            if (j < end)
                 continue;
             if (t->cl_off[a] != t->cl_off[a + 1] && !applicable(t, W, (int32_t)a, state))
                 continue;

@@ -17,7 +17,7 @@ from __future__ import annotations
 import copy
 import math
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -72,34 +72,55 @@ def anytime_search(
     return _done(best, options, start, expanded, history, stopped)
 
 
-def greedy_search(task: GroundTask, options: SearchOptions, symmetries: Symmetries,
-                  deadline: float | None, goal_count: bool = True,
-                  commute: bool = False) -> tuple[PlanResult, int]:
-    """Greedy best-first on unit costs, with and without the helpful-actions queues in turn,
-    each under an expansion budget that grows fourfold per round until one finds a plan or proves
-    there is none: helpful actions make barman easy and mislead on tetris, and the rounds
-    cost at most a small factor over the better of the two.
+@dataclass(frozen=True)
+class Variant:
+    """One greedy search of a round: its open lists and successor pruning (SearchOptions'
+    fields of the same names)."""
 
-    Each round alternates FF's open list with a goal-count list (`goal_count`; LAMA
-    alternates with its landmark count), each with its helpful-actions list, and does not
-    prune the second order of commuting actions (`commute`; see SearchOptions.commute).
-    Both defaults are what the anytime mode runs; the arguments are there to compare."""
+    preferred: bool = True
+    goal_count: bool = True
+    commute: bool = False
+
+    def label(self) -> str:
+        return (f"{'helpful' if self.preferred else 'plain'}"
+                f"{'+goal-count' if self.goal_count else ''}"
+                f"{'' if self.commute else ', all orders'}")
+
+
+VARIANTS = (Variant(True), Variant(False))
+
+
+def greedy_search(task: GroundTask, options: SearchOptions, symmetries: Symmetries,
+                  deadline: float | None,
+                  variants: tuple[Variant, ...] = VARIANTS) -> tuple[PlanResult, int]:
+    """Greedy best-first on unit costs, each variant in turn under an expansion budget that
+    grows fourfold per round until one finds a plan or proves there is none; the rounds cost
+    at most a small factor over the best variant alone.
+
+    By default the variants are with and without the helpful-actions lists (they make barman
+    easy and mislead on tetris), each alternating FF's open list with a goal-count list
+    (LAMA alternates with its landmark count) and expanding every order of commuting actions
+    (SearchOptions.goal_count, .commute). `extra["greedy_round"]` says which round and
+    variant found the plan."""
     unit = unit_cost(task)
-    greedy = replace(options, anytime=False, weight=GREEDY_WEIGHT, lazy=True, patience=0,
-                     goal_count=goal_count, commute=commute)
+    greedy = replace(options, anytime=False, weight=GREEDY_WEIGHT, lazy=True, patience=0)
     budget, expanded = FIRST_BUDGET, 0
     result = PlanResult(PlanStatus.TIMEOUT)
     while True:
-        for preferred in (True, False):
+        for variant in variants:
             left = None if deadline is None else deadline - time.perf_counter()
             if left is not None and left <= 0:
                 return result, expanded
             limit = budget if options.node_limit is None else min(budget, options.node_limit)
-            result = search(unit, replace(greedy, preferred=preferred, node_limit=limit,
+            result = search(unit, replace(greedy, preferred=variant.preferred,
+                                          goal_count=variant.goal_count,
+                                          commute=variant.commute, node_limit=limit,
                                           timeout_s=left), symmetries)
             expanded += result.expanded
             if result.status is not PlanStatus.NODE_LIMIT:
-                return result, expanded
+                round_ = {"budget": limit, "variant": variant.label(),
+                          "expanded": result.expanded}
+                return replace(result, extra={**result.extra, "greedy_round": round_}), expanded
             if options.node_limit is not None and limit >= options.node_limit:
                 return result, expanded
         budget *= BUDGET_GROWTH

@@ -10,7 +10,7 @@ import pytest
 from unified_planning.engines.plan_validator import SequentialPlanValidator
 
 from avs_planner.cp import native
-from avs_planner.cp.anytime import GREEDY_WEIGHT, greedy_search, unit_cost
+from avs_planner.cp.anytime import GREEDY_WEIGHT, Variant, greedy_search, unit_cost
 from avs_planner.cp.grounding import ground
 from avs_planner.cp.search import PlanStatus, SearchOptions, search
 from avs_planner.cp.symmetry import NO_SYMMETRIES
@@ -26,9 +26,11 @@ def maintenance():
     return read_files(DATA / "maintenance-domain.pddl", DATA / "maintenance-small-problem.pddl")
 
 
-def _greedy(problem, **queues):
+def _greedy(problem, goal_count: bool = True, commute: bool = False):
+    """The greedy phase's rounds (with and without helpful actions) with these lists."""
+    variants = (Variant(True, goal_count, commute), Variant(False, goal_count, commute))
     result, expanded = greedy_search(ground(problem), SearchOptions(node_limit=100_000),
-                                     NO_SYMMETRIES, None, **queues)
+                                     NO_SYMMETRIES, None, variants)
     assert result.status is PlanStatus.SOLVED
     return result, expanded
 
