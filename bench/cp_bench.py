@@ -98,13 +98,27 @@ def avs_cases(quick: bool, building: bool, scratch: Path) -> list[Case]:
     return cases
 
 
-def ipc_cases(quick: bool, full: bool = False) -> list[Case]:
+def ipc_cases(quick: bool, full: bool = False, domains: tuple[str, ...] = (),
+              numbers: tuple[int, ...] = ()) -> list[Case]:
+    """The IPC instances: every other one (`quick`: the first two, `full`: all), or those
+    numbered `numbers`; of every domain, or of `domains`."""
     cases = []
-    for domain in sorted(require_ipc().glob("*/domain.pddl")):
+    found = {d.parent.name: d for d in sorted(require_ipc().glob("*/domain.pddl"))}
+    unknown = sorted(set(domains) - set(found))
+    if unknown:
+        raise SystemExit(f"no IPC domain {', '.join(unknown)} in {IPC} (there are: "
+                         f"{', '.join(found)})")
+    for name, domain in found.items():
+        if domains and name not in domains:
+            continue
         instances = sorted(domain.parent.glob("instance-*.pddl"),
                            key=lambda p: int(p.stem.split("-")[1]))
-        for problem in instances if full else instances[:2] if quick else instances[::2]:
-            cases.append(Case(f"{domain.parent.name}/{problem.stem}", domain, problem, False))
+        if numbers:
+            picked = [p for p in instances if int(p.stem.split("-")[1]) in numbers]
+        else:
+            picked = instances if full else instances[:2] if quick else instances[::2]
+        for problem in picked:
+            cases.append(Case(f"{name}/{problem.stem}", domain, problem, False))
     if full:  # instance 1 of every domain first, then 2, ...: a run stopped early is a sample
         cases.sort(key=lambda c: int(c.problem.stem.split("-")[1]))  # stable: by domain within
     return cases
@@ -283,6 +297,11 @@ def main() -> None:
     parser.add_argument("--limit", type=float, default=LIMIT_S,
                         help="seconds per run; a failure counts as this")
     parser.add_argument("--only", choices=("avs", "ipc"), default=None)
+    parser.add_argument("--domains", type=_names, default=(),
+                        help="IPC domains to run, comma-separated (default: all)")
+    parser.add_argument("--instances", type=_numbers, default=(),
+                        help="IPC instance numbers to run, comma-separated, e.g. 2,3 "
+                             "(default: as --quick/--full say)")
     parser.add_argument("--grounding", action="store_true", help="compare the grounders too")
     parser.add_argument("--jsonl", type=Path, default=None,
                         help="append each instance's row to this file as it finishes (a long "
@@ -316,9 +335,22 @@ def main() -> None:
             rows = rows_of(avs_cases(args.quick, args.building, Path(scratch)), "avs")
             report(rows, AVS_TITLE, True)
         if args.only != "avs":
-            rows = rows_of(ipc_cases(args.quick, args.full), "ipc")
+            rows = rows_of(ipc_cases(args.quick, args.full, args.domains, args.instances),
+                           "ipc")
             report(rows, IPC_TITLE, False)
     sys.stdout.flush()
+
+
+def _names(text: str) -> tuple[str, ...]:
+    return tuple(n.strip() for n in text.split(",") if n.strip())
+
+
+def _numbers(text: str) -> tuple[int, ...]:
+    try:
+        return tuple(int(n) for n in _names(text))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"instance numbers must be integers, got {text!r}") from None
 
 
 AVS_TITLE = "AVS problems (probabilistic; FD on -ln p costs)"

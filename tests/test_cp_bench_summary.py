@@ -66,3 +66,17 @@ def test_rows_saved_as_json_lines_are_summarized(tmp_path, capsys):
     assert "IPC instances (deterministic): 2 rows from" in out
     assert "-- coverage: ours 1/2, FD 2/2; FD solved and we did not: tetris/instance-5" in out
     assert "plan cost, ours/FD, median over the 1 both solved: 1.000" in out
+
+
+def test_ipc_instances_can_be_picked_by_domain_and_number() -> None:
+    import pytest
+
+    from bench.cp_bench import ipc_cases
+    from tests.ipc import require_ipc
+
+    require_ipc()
+    picked = ipc_cases(False, domains=("blocks", "tetris"), numbers=(2, 3))
+    assert [c.label for c in picked] == ["blocks/instance-2", "blocks/instance-3",
+                                         "tetris/instance-2", "tetris/instance-3"]
+    with pytest.raises(SystemExit, match="no IPC domain nosuch"):
+        ipc_cases(False, domains=("nosuch",))

@@ -80,6 +80,11 @@ typedef struct {
     Py_ssize_t n_facts, n_actions, W;
     Py_ssize_t n_rfacts, n_rel; /* with the merge's auxiliary facts, extra actions */
     word *pre, *pre_neg, *add, *del, *reads; /* n_actions * W each */
+    /* pre and pre_neg without their zero words: per action (CSR pw_off), the index and
+     * bits of each non-zero word, pre's first (pw_n_pre of them; the one with the most bits
+     * first), then pre_neg's; what successor generation tests instead of 2W words */
+    int32_t *pw_off, *pw_n_pre, *pw_idx;
+    word *pw_mask;
     double *cost, *prob, *neglog; /* per relaxed action (extra: a member's, aux: 0, 0, 1) */
     int8_t *kind;                 /* K_* per relaxed action */
     int32_t *link;                /* merged: its fact X; aux: its position among X's */
@@ -117,7 +122,8 @@ static void task_free_arrays(TaskObject *t)
                     t->unit_neg_off, t->unit_neg,
                     t->pair_action, t->cls_of, t->cls_off, t->cls_members, t->cls_len,
                     t->cof_off, t->cof, t->xcof_off, t->xcof_cls, t->xcof_pair, t->no_pre,
-                    t->n_pairs_of, t->pre_len, t->kind, t->link, t->member_off, t->members};
+                    t->n_pairs_of, t->pre_len, t->kind, t->link, t->member_off, t->members,
+                    t->pw_off, t->pw_n_pre, t->pw_idx, t->pw_mask};
     for (size_t i = 0; i < sizeof(ptrs) / sizeof(ptrs[0]); i++)
         free(ptrs[i]);
 }
@@ -526,6 +532,47 @@ done:
     return ok;
 }
 
+/* TaskObject.pw_*: the non-zero words of each action's pre and pre_neg */
+static int sparse_pre(TaskObject *t)
+{
+    Py_ssize_t A = t->n_actions, W = t->W, n = 0;
+    for (Py_ssize_t i = 0; i < A * W; i++)
+        n += (t->pre[i] != 0) + (t->pre_neg[i] != 0);
+    t->pw_off = xcalloc((size_t)A + 1, sizeof(int32_t));
+    t->pw_n_pre = xcalloc((size_t)A + 1, sizeof(int32_t));
+    t->pw_idx = xcalloc((size_t)n + 1, sizeof(int32_t));
+    t->pw_mask = xcalloc((size_t)n + 1, sizeof(word));
+    if (!t->pw_off || !t->pw_n_pre || !t->pw_idx || !t->pw_mask || n > INT32_MAX / 2)
+        return -1;
+    int32_t k = 0;
+    for (Py_ssize_t a = 0; a < A; a++) {
+        const word *pre = t->pre + a * W, *neg = t->pre_neg + a * W;
+        t->pw_off[a] = k;
+        int32_t first = k;
+        for (Py_ssize_t i = 0; i < W; i++)
+            if (pre[i]) {
+                t->pw_idx[k] = (int32_t)i;
+                t->pw_mask[k] = pre[i];
+                if (__builtin_popcountll(pre[i]) > __builtin_popcountll(t->pw_mask[first])) {
+                    t->pw_idx[k] = t->pw_idx[first]; /* the word with the most bits first */
+                    t->pw_mask[k] = t->pw_mask[first];
+                    t->pw_idx[first] = (int32_t)i;
+                    t->pw_mask[first] = pre[i];
+                }
+                k++;
+            }
+        t->pw_n_pre[a] = k - first;
+        for (Py_ssize_t i = 0; i < W; i++)
+            if (neg[i]) {
+                t->pw_idx[k] = (int32_t)i;
+                t->pw_mask[k] = neg[i];
+                k++;
+            }
+    }
+    t->pw_off[A] = k;
+    return 0;
+}
+
 static PyObject *task_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
 {
     Py_ssize_t n_facts, n_actions, n_rfacts, n_merged;
@@ -596,6 +643,10 @@ static PyObject *task_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
                              n_facts);
                 goto fail;
             }
+    if (sparse_pre(t)) {
+        PyErr_NoMemory();
+        goto fail;
+    }
     if (task_merge(t, n_rfacts, n_merged, b + 14) || task_derive(t))
         goto fail;
     for (int i = 0; i < NBUF; i++)
@@ -738,10 +789,12 @@ typedef struct {
     double *n_c, *n_p, *n_h;
     int8_t *n_alive, *n_eval;
     int32_t n_nodes, cap_nodes;
-    /* queues */
-    Queue heap, pref;
-    int64_t priority[2];
-    double best_h;
+    /* queues: the main one, helpful actions', and with goal_count the goal-count ones
+     * (search.py's _Search.queues; Q_* index priority) */
+    Queue heap, pref, gc_heap, gc_pref;
+    int64_t priority[4];
+    double best_h, best_gc;
+    int goal_count, commute; /* QF_GOAL_COUNT set; QF_NO_COMMUTE not set */
     /* LAZY_UNHELPFUL defers only while h improves: expansions so far, the expansion count
      * when best_h last dropped, and whether the node being expanded defers (STALL) */
     int64_t n_expanded, progress_at;
@@ -749,7 +802,7 @@ typedef struct {
     int32_t *waiting; /* nodes deferred since the last flush_deferred */
     int64_t n_waiting, cap_waiting;
     double popped_h;  /* h of the queue entry pop_node took */
-    int from_pref, pruned_threshold;
+    int from_queue, pruned_threshold; /* from_queue: Q_* of the queue pop_node took from */
     /* helpful pool: StateRec.help_off/help_n index it */
     int32_t *help;
     int64_t n_help, cap_help;
@@ -769,6 +822,19 @@ typedef struct {
     int oom;
     PyThreadState *thread; /* saved while the GIL is released (NULL: not released) */
 } Search;
+
+enum { Q_MAIN = 0, Q_PREF = 1, Q_GC = 2, Q_GC_PREF = 3 };
+/* native_search's queue flags: helpful actions first, goal-count queues, and no pruning of
+ * the second order of two commuting actions (search.py's _preferred, _goal_count and
+ * SearchOptions.commute) */
+enum { QF_PREFERRED = 1, QF_GOAL_COUNT = 2, QF_NO_COMMUTE = 4 };
+static const int POP_ORDER[4] = {Q_PREF, Q_MAIN, Q_GC_PREF, Q_GC}; /* ties broken in order */
+
+static inline Queue *queue_of(Search *s, int q)
+{
+    return q == Q_MAIN ? &s->heap : q == Q_PREF ? &s->pref : q == Q_GC ? &s->gc_heap
+                                                                        : &s->gc_pref;
+}
 
 static inline int qless(const QEntry *a, const QEntry *b)
 {
@@ -1369,6 +1435,14 @@ static int grow_nodes(Search *s)
 /* ------------------------------------------------------------------------------------------ */
 /* The search (_Search)                                                                         */
 
+/* progress: trust the helpful actions for a while (LAMA's boost of 1000) */
+static inline void boost(Search *s)
+{
+    s->priority[Q_PREF] -= 1000;
+    if (s->goal_count)
+        s->priority[Q_GC_PREF] -= 1000;
+}
+
 static int queue_node(Search *s, double f, double h, int32_t node, int preferred)
 {
     if (qpush(s, &s->heap, f, h, node))
@@ -1378,7 +1452,27 @@ static int queue_node(Search *s, double f, double h, int32_t node, int preferred
     if (h < s->best_h && s->n_eval[node]) {
         s->best_h = h;
         s->progress_at = s->n_expanded;
-        s->priority[1] -= 1000;
+        boost(s);
+    }
+    return 0;
+}
+
+/* _Search.queue_goal_count: the goal-count queues, by goal facts left (ties: h, then age) */
+static int queue_goal_count(Search *s, const word *state, double h, int32_t node,
+                            int preferred)
+{
+    int64_t left = 0;
+    for (Py_ssize_t i = 0; i < s->W; i++)
+        left += __builtin_popcountll(s->goal[i] & ~state[i]) +
+                __builtin_popcountll(state[i] & s->goal_neg[i]);
+    double count = (double)left;
+    if (qpush(s, &s->gc_heap, count, h, node))
+        return -1;
+    if (preferred && qpush(s, &s->gc_pref, count, h, node))
+        return -1;
+    if (count < s->best_gc) {
+        s->best_gc = count;
+        boost(s);
     }
     return 0;
 }
@@ -1431,17 +1525,25 @@ static int push_node(Search *s, const word *state, double c, double p, int32_t p
     if (deferred && s->lazy == LAZY_UNHELPFUL &&
         list_push(&s->waiting, &s->n_waiting, &s->cap_waiting, node, &s->oom))
         return -1;
-    if (hv != INFINITY)
-        return queue_node(s, g + hv, hv, node, preferred);
-    return 0;
+    if (hv == INFINITY)
+        return 0;
+    if (queue_node(s, g + hv, hv, node, preferred))
+        return -1;
+    return s->goal_count ? queue_goal_count(s, state, hv, node, preferred) : 0;
 }
 
 static int32_t pop_node(Search *s)
 {
-    int use_pref = s->pref.n && (s->priority[1] <= s->priority[0] || !s->heap.n);
-    s->from_pref = use_pref;
-    s->priority[use_pref ? 1 : 0] += 1;
-    QEntry e = qpop(use_pref ? &s->pref : &s->heap);
+    /* the non-empty queue that has had the fewest turns (ties: POP_ORDER) */
+    int pick = -1;
+    for (int i = 0; i < 4; i++) {
+        int q = POP_ORDER[i];
+        if (queue_of(s, q)->n && (pick < 0 || s->priority[q] < s->priority[pick]))
+            pick = q;
+    }
+    s->from_queue = pick;
+    s->priority[pick] += 1;
+    QEntry e = qpop(queue_of(s, pick));
     s->popped_h = e.h;
     return e.node;
 }
@@ -1495,16 +1597,19 @@ static int evaluate_node(Search *s, int32_t node)
     int ok = evaluate_now(s, node, 1, &f, &h);
     if (ok <= 0)
         return ok;
-    Queue *q = s->from_pref ? &s->pref : &s->heap;
-    if (q->n && f > q->v[0].f) {
-        if (queue_node(s, f, h, node, s->from_pref))
-            return -1;
-        return 0;
+    if (s->from_queue == Q_MAIN || s->from_queue == Q_PREF) {
+        /* goal-count keys do not change with h: a node from those queues is expanded now */
+        Queue *q = queue_of(s, s->from_queue);
+        if (q->n && f > q->v[0].f) {
+            if (queue_node(s, f, h, node, s->from_queue == Q_PREF))
+                return -1;
+            return 0;
+        }
     }
     if (h < s->best_h) {
         s->best_h = h;
         s->progress_at = s->n_expanded;
-        s->priority[1] -= 1000;
+        boost(s);
     }
     return 1;
 }
@@ -1584,7 +1689,7 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
     *expanded_out = 0;
     if (push_node(s, init, 0.0, 1.0, -1, -1, 0) < 0)
         return -1;
-    while (s->heap.n || s->pref.n) {
+    while (s->heap.n || s->pref.n || s->gc_heap.n || s->gc_pref.n) {
         int32_t node = pop_node(s);
         if (!s->n_alive[node])
             continue;
@@ -1608,7 +1713,7 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
                 best = node;
                 best_at = expanded;
             }
-            if (s->from_pref && s->heap.n && s->heap.v[0].f < obj) {
+            if (s->from_queue != Q_MAIN && s->heap.n && s->heap.v[0].f < obj) {
                 s->n_alive[node] = 1;
                 if (qpush(s, &s->heap, obj, 0.0, node))
                     return -1;
@@ -1655,18 +1760,20 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
         int32_t n_kids = 0, n_todo = 0;
         int batching = s->lazy != LAZY_ALL && s->heuristic != H_BLIND;
         for (Py_ssize_t a = 0; a < A; a++) {
-            const word *pre = t->pre + a * W, *neg = t->pre_neg + a * W;
-            int ok = 1;
-            for (Py_ssize_t i = 0; i < W; i++)
-                if ((state[i] & pre[i]) != pre[i] || (state[i] & neg[i])) {
-                    ok = 0;
+            int32_t j = t->pw_off[a], mid = j + t->pw_n_pre[a], end = t->pw_off[a + 1];
+            for (; j < mid; j++)
+                if ((state[t->pw_idx[j]] & t->pw_mask[j]) != t->pw_mask[j])
                     break;
-                }
-            if (!ok)
+            if (j < mid)
+                continue;
+            for (; j < end; j++)
+                if (state[t->pw_idx[j]] & t->pw_mask[j])
+                    break;
+            if (j < end)
                 continue;
             if (t->cl_off[a] != t->cl_off[a + 1] && !applicable(t, W, (int32_t)a, state))
                 continue;
-            if (last > a && commutes(t, W, (int32_t)a, last))
+            if (s->commute && last > a && commutes(t, W, (int32_t)a, last))
                 continue; /* the order (a, last) is explored instead */
             if (s->has_sym && sym_prunes(s, (int32_t)a, state))
                 continue; /* a mirror image with a lower object is explored */
@@ -1756,7 +1863,8 @@ static void search_free(Search *s)
         free(s->recs[i].labels);
     void *ptrs[] = {s->goal, s->goal_neg, s->goal_facts, s->is_goal, s->sdata, s->recs,
                     s->slots, s->n_state, s->n_parent, s->n_via, s->n_c, s->n_p, s->n_h,
-                    s->n_alive, s->n_eval, s->heap.v, s->pref.v, s->help, s->combined,
+                    s->n_alive, s->n_eval, s->heap.v, s->pref.v, s->gc_heap.v,
+                    s->gc_pref.v, s->help, s->combined,
                     s->help_stamp, s->parent, s->kids, s->kid_act, s->todo, s->kid_c,
                     s->kid_p, s->todo_hc, s->todo_hl, s->todo_at, s->todo_n, s->kid_pref,
                     s->todo_owner, s->waiting};
@@ -2092,17 +2200,21 @@ static PyObject *native_search(PyObject *self, PyObject *args)
     Search s;
     memset(&s, 0, sizeof(s));
     long long node_limit, patience;
-    if (!PyArg_ParseTuple(args, "O!y*y*y*iddddLLipy*y*y*y*i:search", &TaskType, &t, &b[0],
+    int flags; /* QF_* */
+    if (!PyArg_ParseTuple(args, "O!y*y*y*iddddLLiiy*y*y*y*i:search", &TaskType, &t, &b[0],
                           &b[1], &b[2], &s.heuristic, &s.reward, &s.weight, &s.min_success,
-                          &s.timeout, &node_limit, &patience, &s.lazy, &s.preferred, &b[3],
+                          &s.timeout, &node_limit, &patience, &s.lazy, &flags, &b[3],
                           &b[4], &b[5], &b[6], &s.threads))
         return NULL;
+    s.preferred = (flags & QF_PREFERRED) != 0;
+    s.goal_count = (flags & QF_GOAL_COUNT) != 0;
+    s.commute = (flags & QF_NO_COMMUTE) == 0;
     PyObject *result = NULL;
     s.t = t;
     s.W = t->W;
     s.node_limit = node_limit;
     s.patience = patience;
-    s.best_h = INFINITY;
+    s.best_h = s.best_gc = INFINITY;
     Py_ssize_t W = t->W, F = t->n_facts, A = t->n_actions;
     if (s.heuristic < H_BLIND || s.heuristic > H_FF) {
         PyErr_SetString(PyExc_ValueError, "native search: unknown heuristic code");

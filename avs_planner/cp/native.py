@@ -326,11 +326,15 @@ def run(
     symmetries: Symmetries,
     start: float,
     threads: int | None = None,
+    goal_count: bool = False,
+    commute: bool = True,
 ) -> tuple[str, tuple[int, ...], int, int, str | None]:
     """Run the C search: (status name, action indices of the plan, expanded, generated, why
     the best plan so far was returned: one of STOP_NAMES). `threads`: 1 or 2 evaluating
     threads, None for the core's choice (two for large tasks on a multi-CPU machine).
-    `lazy`: one of search.py's EAGER, DEFERRED, DEFERRED_UNHELPFUL."""
+    `lazy`: one of search.py's EAGER, DEFERRED, DEFERRED_UNHELPFUL. `preferred`,
+    `goal_count` and not `commute` go to the core as the bits 1, 2 and 4 of its queue
+    flags (the core's QF_*)."""
     packed = pack_task(task)
     n_facts = len(task.facts)
     n_bytes = 8 * words(n_facts)
@@ -344,7 +348,8 @@ def run(
         _bits(task.goal, n_bytes, n_facts, "the goal"),
         _bits(task.goal_neg, n_bytes, n_facts, "the goal"),
         HEURISTIC_CODES[heuristic], float(reward), float(weight), float(min_success),
-        remaining, _c_limit(node_limit), _c_limit(patience), int(lazy), preferred, *sym,
+        remaining, _c_limit(node_limit), _c_limit(patience), int(lazy),
+        int(preferred) | (2 if goal_count else 0) | (0 if commute else 4), *sym,
         0 if threads is None else threads,
     )
     return STATUS_NAMES[status], path, expanded, generated, STOP_NAMES[stopped]

@@ -54,12 +54,26 @@ class SearchOptions:
     deterministic tasks; on probabilistic ones, successors by a helpful action are evaluated
     when generated and the others when popped (FF with helpful actions only; else eager)."""
     preferred: bool = True  # helpful actions first (dual queue) when h is inadmissible and has them
+    goal_count: bool = False
+    """A second open list ordered by goal count (goal facts not yet true, negative goal facts
+    true), alternated with the heuristic's and, with `preferred`, its own helpful-actions
+    list: LAMA's multi-queue search with the goal count where LAMA has its landmark count.
+    Boosting on progress of either estimate favours the helpful-action lists. Ignored when h
+    is admissible (optimality counts). The anytime mode's greedy phase turns it on."""
     engine: str = "auto"  # "native" (C core, same results), "python", or auto: native if built
     threads: int | None = None
     """Threads the native core evaluates states on (1 or 2; same results either way). None:
     two on a machine with two or more CPUs when the task is large enough for it to pay
     (at least 1,000 (class, precondition) entries in the relaxed task, as the 8- to 20-place
     AVS problems); one otherwise. The Python engine always uses one."""
+    commute: bool = True
+    """Skip the second order of two commuting actions (b after a where a < b is explored,
+    a after b is not). Sound for a search that keeps every node, but it makes a node's
+    successors depend on how it was reached, which its estimate (of the state) does not
+    see: a greedy search that took a high-numbered action first is held to higher-numbered
+    ones below it (IPC maintenance: every `workat` commutes with every other, and the
+    greedy phase exhausted 20,000 expansions on instance 2 with it, 805 without). The
+    anytime mode's greedy phase turns it off."""
     anytime: bool = False
     """LAMA-style anytime satisficing (`anytime.py`): greedy best-first with FF and helpful
     actions on unit costs, then weighted A* restarts (w = 5, 3, 2, 1) on the objective; the
@@ -251,6 +265,14 @@ def _lazy(task: GroundTask, options: SearchOptions) -> int:
     return DEFERRED_UNHELPFUL if _preferred(options) and options.heuristic == "ff" else EAGER
 
 
+POP_ORDER = (1, 0, 3, 2)  # _Search.queues in the order ties are broken
+
+
+def _goal_count(options: SearchOptions) -> bool:
+    """The goal-count lists: asked for, and optimality does not count."""
+    return options.goal_count and not get_heuristic(options.heuristic).admissible
+
+
 def _preferred(options: SearchOptions) -> bool:
     """LAMA's dual queue: only where optimality does not count (and h records helpful
     actions: FF; the native core checks that itself)."""
@@ -263,7 +285,8 @@ def _native_search(
     status, path, expanded, generated, stopped = native.run(
         task, options.heuristic, options.reward, options.weight, options.min_success,
         options.timeout_s, options.node_limit, options.patience_used, _lazy(task, options),
-        _preferred(options), symmetries, start, options.threads,
+        _preferred(options), symmetries, start, options.threads, _goal_count(options),
+        options.commute,
     )
     steps = task.steps(path)
     return _finish(task, options, PlanStatus(status), steps, start, expanded, generated,
@@ -293,15 +316,21 @@ class _Search:
         if not _preferred(options):
             self.helpful = None
         self.pref_heap: list[tuple[float, float, int]] = []
-        self.priority = [0, 0]
-        self.best_h = math.inf
-        self.from_pref = False
+        # _goal_count: a goal-count list and its helpful-actions list beside them (LAMA)
+        self.count_goals = _goal_count(options)
+        self.gc_heap: list[tuple[float, float, int]] = []
+        self.gc_pref: list[tuple[float, float, int]] = []
+        self.queues = (self.heap, self.pref_heap, self.gc_heap, self.gc_pref)
+        self.priority = [0, 0, 0, 0]
+        self.best_h = self.best_gc = math.inf
+        self.from_queue = 0  # which of self.queues pop() took the node from
         self.popped_h = 0.0  # h of the queue entry pop() took
         self.pruned_threshold = False
         self.lazy = _lazy(task, options)
         self.h_of_node: list[float] = []
         self.evaluated: list[bool] = []
         self.commutes: dict[tuple[int, int], bool] = {}
+        self.commute_pruning = options.commute
         self.patience = options.patience_used
         self.best: tuple[float, int, int] | None = None  # incumbent: (objective, node, expanded)
         self.expanded = self.progress_at = 0  # expansions; when best_h last dropped
@@ -348,6 +377,25 @@ class _Search:
             self.waiting.append(node)
         if h != math.inf:
             self.queue(g + h, h, node, preferred)
+            if self.count_goals:
+                self.queue_goal_count(state, h, node, preferred)
+
+    def queue_goal_count(self, state: int, h: float, node: int, preferred: bool) -> None:
+        """The goal-count lists: by goal facts left (ties: the node's h, then age)."""
+        task = self.task
+        count = float((task.goal & ~state).bit_count() + (state & task.goal_neg).bit_count())
+        heapq.heappush(self.gc_heap, (count, h, node))
+        if preferred:
+            heapq.heappush(self.gc_pref, (count, h, node))
+        if count < self.best_gc:
+            self.best_gc = count
+            self.boost()
+
+    def boost(self) -> None:
+        """Progress: trust the helpful actions for a while (LAMA's boost of 1000)."""
+        self.priority[1] -= 1000
+        if self.count_goals:
+            self.priority[3] -= 1000
 
     def deferred(self, parent: int, preferred: bool) -> bool:
         """Whether a successor of `parent` is evaluated only when popped (see _lazy)."""
@@ -362,14 +410,18 @@ class _Search:
         if h < self.best_h and self.evaluated[node]:
             self.best_h = h
             self.progress_at = self.expanded
-            self.priority[1] -= 1000  # progress: trust the helpful actions for a while
+            self.boost()
 
     def pop(self) -> int:
-        """Next node: from the preferred queue or the main one, whichever has had fewer turns."""
-        use_pref = bool(self.pref_heap) and (self.priority[1] <= self.priority[0] or not self.heap)
-        self.from_pref = use_pref
-        self.priority[1 if use_pref else 0] += 1
-        _, self.popped_h, node = heapq.heappop(self.pref_heap if use_pref else self.heap)
+        """Next node: from the non-empty queue that has had the fewest turns (ties: the
+        preferred one, then the main one, then the goal-count ones)."""
+        pick = -1
+        for i in POP_ORDER:
+            if self.queues[i] and (pick < 0 or self.priority[i] < self.priority[pick]):
+                pick = i
+        self.from_queue = pick
+        self.priority[pick] += 1
+        _, self.popped_h, node = heapq.heappop(self.queues[pick])
         return node
 
     def flush(self) -> None:
@@ -410,14 +462,15 @@ class _Search:
             return False
         h = f - objective(c, p, self.reward)
         self.h_of_node[node] = h
-        heap = self.pref_heap if self.from_pref else self.heap
-        if heap and f > heap[0][0]:
-            self.queue(f, h, node, self.from_pref)
-            return False
+        if self.from_queue < 2:  # goal-count keys do not change with h: expanded now
+            heap = self.queues[self.from_queue]
+            if heap and f > heap[0][0]:
+                self.queue(f, h, node, self.from_queue == 1)
+                return False
         if h < self.best_h:
             self.best_h = h
             self.progress_at = self.expanded
-            self.priority[1] -= 1000
+            self.boost()
         return True
 
     def run(self) -> PlanResult:
@@ -426,7 +479,7 @@ class _Search:
         expanded = 0
         actions = task.actions
         symmetries = self.symmetries
-        while self.heap or self.pref_heap:
+        while any(self.queues):
             node = self.pop()
             if not self.alive[node]:
                 continue
@@ -440,8 +493,8 @@ class _Search:
                 obj = objective(c, p, self.reward)
                 if self.best is None or obj < self.best[0]:
                     self.best = (obj, node, expanded)
-                if self.from_pref and self.heap and self.heap[0][0] < obj:
-                    # a helpful-action goal is only taken if no open node promises better
+                if self.from_queue and self.heap and self.heap[0][0] < obj:
+                    # a goal from another list is only taken if no open node promises better
                     self.alive[node] = True
                     heapq.heappush(self.heap, (obj, 0.0, node))
                     continue
@@ -465,7 +518,7 @@ class _Search:
                 if (state & a.pre) == a.pre and not (state & a.pre_neg):
                     if a.clauses and not a.applicable(state):
                         continue
-                    if last > a.index and self.commute(a.index, last):
+                    if self.commute_pruning and last > a.index and self.commute(a.index, last):
                         continue  # the order (a, last) is explored instead
                     if symmetries.checks and symmetries.prunes(a.index, state):
                         continue  # a mirror image with a lower object is explored
