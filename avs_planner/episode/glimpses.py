@@ -13,11 +13,12 @@ before the building's hypotheses did. Here every such frame counts:
   and 0.9 x the recognition range (the room cones' own limits), an object at the assumed
   support height inside the vertical field of view, and a free line of sight on the
   occupancy grid (an unknown or occupied cell in between blocks it).
-- **Supports.** The top of a known support counts as looked at when it is in view by the
-  same tests (at twice its detected centre's height, the executor's rule for a top), except
-  that the line of sight may end in the support's own body: the laser maps a desk as its
-  outline with unknown cells inside, which a ray to its centre crosses (without this, no top
-  in view ever counted).
+- **Supports.** The top of a known support (at twice its detected centre's height, the
+  executor's rule for a top) counts as looked at when all of it is in view: the disc within
+  `support_radius` of its centre, where the executor calls a detection "on" it, inside the
+  field of view and the range, and a free line of sight to the centre that may end in the
+  support's own body (the laser maps a desk as its outline with unknown cells inside, which
+  a ray to its centre crosses; without this, no top in view ever counted).
 
 A look is one chance for the detector (hit rate `p_detect`, the DT's own detector model), so
 a cell or top looked at from k different standpoints (camera positions 1 m apart; frames
@@ -32,6 +33,7 @@ support whose P(target on it) falls below the planner's threshold is settled
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 
 import numpy as np
@@ -117,14 +119,39 @@ class Glimpses:
             if obj is None:
                 continue
             top = 2.0 * obj.position[2]  # the executor's rule: a support's centre is half-way
-            point = np.array([obj.position[:2]])
-            if not self._in_view(point, pose, pan, tilt, top, self.support_body)[0]:
+            if not self._top_in_view(obj.position[:2], pose, pan, tilt, top):
                 continue
             seen = self.tops.setdefault((label, oid), set())
             if stand in seen or len(seen) >= MAX_LOOKS:
                 continue
             seen.add(stand)
             self._observe(label, RelatedSpace("on", oid), self._share([len(seen)]))
+
+    def _top_in_view(self, centre: tuple[float, float], pose: tuple[float, float, float],
+                     pan: float, tilt: float, top: float) -> bool:
+        """The whole top is in the frame: an object anywhere on it (within `support_body` of
+        the centre, where the executor calls a detection "on" the support) would be inside
+        the field of view, horizontally and from its near to its far edge, within range,
+        and the centre has a free line of sight up to the support's own body. (Testing the
+        centre alone counted tops whose far side was out of the frame: a stapler at a desk's
+        end went unseen there, and the desk was settled.)"""
+        cam, body = self.camera, self.support_body
+        d = np.asarray(centre, dtype=float) - np.asarray(pose[:2])
+        r = float(np.hypot(d[0], d[1]))
+        if r - body < self.min_range or r + body > self.max_range:
+            return False
+        margin = math.atan2(body, r)
+        bearing = abs((math.atan2(d[1], d[0]) - pose[2] - pan + math.pi) % (2 * math.pi)
+                      - math.pi)
+        if bearing + margin > cam.hfov / 2:
+            return False
+        if cam.vfov is not None:
+            for reach in (r - body, r + body):
+                elevation = math.atan2(top - cam.height, reach)
+                if abs(elevation - tilt) > cam.vfov / 2:
+                    return False
+        point = np.array([centre], dtype=float)
+        return bool(self._line_of_sight(np.asarray(pose[:2]), point, body)[0])
 
     def _keys(self, points: np.ndarray) -> np.ndarray:
         return np.round(points / self.mind.grid.resolution).astype(np.int64)

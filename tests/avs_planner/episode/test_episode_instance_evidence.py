@@ -167,3 +167,18 @@ def test_a_room_searched_through_is_not_worth_reading_again(corridor) -> None:
     mind.searched("cerealbox", "on", table.id, coverage=1.0, p_detect=0.99)
     assert not builder.could_hold(room)
     assert not builder.could_hold("no-such-room")
+
+
+def test_a_top_counts_only_when_all_of_it_is_in_the_frame() -> None:
+    """The centre in view is not enough: an object at the desk's end (anywhere within
+    `support_body` of its centre) must be in the frame too, or the desk would be settled by
+    frames that never had its far end in view."""
+    mind = _box_room((3.0, 2.0, 4.2, 3.0))
+    glimpses = Glimpses(mind, CameraModel(1.2, math.radians(60), 4.0), p_detect=0.64)
+    table = mind.add_object("table", (3.6, 2.5, 0.375))
+    where = RelatedSpace("on", table.id)
+    turned = math.radians(20)  # the centre 20 deg off the axis: inside the 30 deg half-view
+    glimpses.frame((1.0, 2.5, turned), 0.0, -0.2, [], [table.id], tops_label="cerealbox")
+    assert mind.cmap.objects.remaining(where, "cerealbox") == 1.0
+    glimpses.frame((1.0, 2.5, 0.0), 0.0, -0.2, [], [table.id], tops_label="cerealbox")
+    assert mind.cmap.objects.remaining(where, "cerealbox") < 1.0
