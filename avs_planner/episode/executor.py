@@ -1,6 +1,7 @@
 """The executor: runs the physical and sensing steps of a plan through the robot adapter.
 
-MOVE drives A* legs on the robot's own grid, scanning and growing the maps after each leg;
+MOVE drives A* legs on the robot's own grid, scanning and growing the maps after each leg
+(`episode/driving.py`);
 CREATEVIEWCONES samples cones; SEARCHFOROBJECT runs a DT session against the detector;
 REPORTPOSITION ends the task. Assumptive steps never reach the executor.
 """
@@ -12,11 +13,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-import numpy as np
-
 from avs_planner.cp.search import PlanStep
 from avs_planner.cp.task import Atom
 from avs_planner.dt import DetectorModel
+from avs_planner.episode.driving import Driving
 from avs_planner.episode.dt_search import ViewConeSearch
 from avs_planner.episode.glimpses import Glimpses
 from avs_planner.episode.mind import KnownObject, Mind
@@ -24,9 +24,7 @@ from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
 from avs_planner.episode.state_builder import AvsState, StateBuilder
 from avs_planner.episode.viewcones import CameraModel, ConeSet, room_cones, support_cones
 from conceptual_map.conceptual.errors import ConceptualError
-from conceptual_map.errors import MapError
-from conceptual_map.metric import distance_field, plan_path
-from conceptual_map.metric.path_planning import PathResult, PathStatus
+from conceptual_map.metric import distance_field
 
 Event = Callable[..., None]
 
@@ -90,7 +88,7 @@ class Stats:
     found_sid: int | None = None
 
 
-class Executor:
+class Executor(Driving):
     """Runs plan steps; `emit(type, **fields)` records trace events."""
 
     def __init__(self, robot: Any, mind: Mind, builder: StateBuilder, camera: CameraModel,
@@ -414,124 +412,6 @@ class Executor:
             self.mind.move_failed(target)
         return status
 
-    def drive_to(self, goal: tuple[float, float], stop: Callable[[], bool] = lambda: False
-                 ) -> StepOutcome:
-        """Drive leg by leg to `goal`, re-planning the path on the growing grid."""
-        cfg = self.config
-        route: list[tuple[float, float]] = []  # the rest of the last A* path
-        age = detours = 0
-        for _ in range(cfg.max_legs):
-            if stop():
-                return StepOutcome(StepStatus.DONE, "explored on the way")
-            here = self.robot.pose
-            if math.dist(here[:2], goal) <= cfg.arrive:
-                return StepOutcome(StepStatus.DONE)
-            if age >= cfg.replan_legs or not self._clear(route):
-                try:
-                    path = plan_path(self.mind.grid, here[:2], goal,
-                                     self.mind.config.robot_radius)
-                except MapError as exc:
-                    nearby = self._free_near(goal)
-                    if nearby is None:
-                        return StepOutcome(StepStatus.FAILED, str(exc))
-                    goal, route = nearby, []
-                    continue
-                if not path.found:
-                    path = self._squeeze(here[:2], goal)
-                if not path.found:
-                    return StepOutcome(StepStatus.FAILED, self._no_path(goal))
-                route, age = list(path.waypoints), 0
-            route[0] = here[:2]
-            leg, route = _split_leg(route, cfg.leg)
-            age += 1
-            if not self.robot.move_along(leg):
-                detours += 1
-                why = self._blocked()
-                if getattr(self.robot, "last_contact", None) is None or detours > cfg.detours:
-                    return StepOutcome(StepStatus.FAILED, f"blocked {detours} times on the way "
-                                       f"to ({goal[0]:.2f}, {goal[1]:.2f}): {why}")
-                route = []  # plan around the keep-out disc
-                continue
-            self.stats.distance += sum(math.dist(a, b) for a, b in
-                                       zip([here[:2], *leg], leg, strict=False))
-            self._sense([(x, y, self.robot.pose[2]) for x, y in leg])
-        return StepOutcome(StepStatus.FAILED, "too many legs")
-
-    def _blocked(self) -> str:
-        """The base refused a leg: its contact point becomes a blockage the paths avoid
-        (reported to the trace). Returns what was learned."""
-        contact = getattr(self.robot, "last_contact", None)
-        if contact is None:
-            return "the base refused the leg and gave no contact point"
-        blockage = self.mind.block(contact, self.robot.clock)
-        self.emit("belief", blocked=blockage.id, at=[round(v, 2) for v in blockage.centre],
-                  door=blockage.door, retry_at=round(blockage.until, 1),
-                  detail=blockage.describe())
-        return blockage.describe()
-
-    def _no_path(self, goal: tuple[float, float]) -> str:
-        """Why no path leads to `goal`, naming the blockages the robot has run into."""
-        known = [b.describe() for b in self.mind.blockages.items.values()]
-        return f"no path to ({goal[0]:.2f}, {goal[1]:.2f})" + (
-            f" ({'; '.join(known)})" if known else "")
-
-    def _clear(self, route: list[tuple[float, float]]) -> bool:
-        """The rest of the last path still keeps the full margin on the grown grid (so the
-        A* search is not repeated after every leg). The robot's own footprint is skipped:
-        the laser never sees the cells under the base."""
-        if len(route) < 2:
-            return False
-        grid = self.mind.grid
-        radius = self.mind.config.robot_radius
-        free = grid.traversable(radius)
-        step = grid.resolution / 2
-        start = np.asarray(route[0])
-        for a, b in zip(route, route[1:], strict=False):
-            n = max(2, int(math.dist(a, b) / step) + 1)
-            t = np.linspace(0.0, 1.0, n)[:, None]
-            points = np.asarray(a) + t * (np.asarray(b) - np.asarray(a))
-            points = points[np.linalg.norm(points - start, axis=1) > radius]
-            cells = np.asarray(grid.to_cell(points), dtype=int)
-            if (cells < 0).any() or (cells >= np.asarray(free.shape)).any():
-                return False
-            if not free[cells[:, 0], cells[:, 1]].all():
-                return False
-        return True
-
-    def _squeeze(self, start: tuple[float, float], goal: tuple[float, float]):  # noqa: ANN202
-        """A path with a slimmer margin (the robot may start close to furniture; never below
-        its footprint less a cell: `clearance` underestimates by half a cell), then one
-        through unknown cells (a laser mounted ahead of the base never sees the cells under
-        and behind it); the simulator still refuses any motion that would collide."""
-        radius = self.mind.config.robot_radius
-        slim = self.mind.config.squeeze_radius  # the mind's own (`mind.squeeze_radius`)
-        if slim is None:
-            slim = radius - self.config.squeeze
-        tries = ((slim, False), (radius, True))
-        for margin, unknown in tries:
-            try:
-                path = plan_path(self.mind.grid, start, goal, margin, allow_unknown=unknown)
-            except MapError:
-                continue
-            if path.found:
-                return path
-        # no path (the robot may stand where only a squeeze fits: a query from there with
-        # the full radius is refused, which must not end the episode)
-        return PathResult(PathStatus.NO_PATH, (), math.inf, 0)
-
-    def _free_near(self, goal: tuple[float, float], reach: float = 0.6
-                   ) -> tuple[float, float] | None:
-        """The traversable cell nearest to a blocked goal, within `reach` metres."""
-        grid = self.mind.grid
-        free = grid.traversable(self.mind.config.robot_radius)
-        cells = np.argwhere(free)
-        if len(cells) == 0:
-            return None
-        points = grid.to_world(cells)
-        d = np.linalg.norm(points - np.asarray(goal), axis=1)
-        best = int(np.argmin(d))
-        return (float(points[best, 0]), float(points[best, 1])) if d[best] <= reach else None
-
     def _target_probability(self, label: str, relation: str, location: str, state: AvsState,
                             assumed: dict[str, str]) -> float | None:
         """P(ObjectAt) of the searched location under the plan's category assumption (the
@@ -613,20 +493,3 @@ class Executor:
             self.builder.cannot_search(label, relation, location)
         return outcome
 
-
-def _split_leg(waypoints: list[tuple[float, float]], step: float
-               ) -> tuple[list[tuple[float, float]], list[tuple[float, float]]]:
-    """The waypoints of the first ~`step` metres of a path (the robot stands at the first),
-    and the rest of the path from the leg's end."""
-    leg: list[tuple[float, float]] = []
-    budget = step
-    for i, (a, b) in enumerate(zip(waypoints, waypoints[1:], strict=False)):
-        length = math.dist(a, b)
-        if length > budget:
-            t = budget / length
-            end = (a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t)
-            leg.append(end)
-            return leg, [end, *waypoints[i + 1:]]
-        leg.append((float(b[0]), float(b[1])))
-        budget -= length
-    return leg, leg[-1:]

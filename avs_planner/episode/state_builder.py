@@ -433,14 +433,8 @@ class StateBuilder:
         cmap = self.mind.cmap
         if not cmap.graph.has_room(room):
             return False
-        label = self.task.target
-        ledger = cmap.objects
-        places = [room, *ledger.sublocations(room, label)]
-        if any(ledger.count(place, label) for place in places):
-            return True
-        residual = sum(ledger.location_lambda(label, place) * ledger.remaining(place, label)
-                       for place in places)
-        return float(np.max(p_at_least_one(residual))) >= self.config.min_probability
+        p = cmap.p_object_at_per_category(self.task.target, room)
+        return float(np.max(p)) >= self.config.min_probability
 
     def _speed(self) -> float:
         body = self.mind.body

@@ -254,17 +254,35 @@ class ConceptualMap:
         averages 1 - exp(-lambda) over the category belief.
         """
         location = _as_location(location)
+        residual = self._residual(label, location, include_sublocations)
+        if residual is None:
+            return 1.0
+        return float(self.room_marginal(self._room_of(location)) @ p_at_least_one(residual))
+
+    def p_object_at_per_category(
+        self, label: str, location: Location | tuple[str, str], include_sublocations: bool = True
+    ) -> np.ndarray:
+        """`p_object_at` under each room category (`knowledge.categories` order), before
+        the category belief averages it: 1 where a `label` was seen there."""
+        residual = self._residual(label, _as_location(location), include_sublocations)
+        if residual is None:
+            return np.ones(len(self.knowledge.categories))
+        return p_at_least_one(residual)
+
+    def _residual(self, label: str, location: Location, include_sublocations: bool
+                  ) -> np.ndarray | None:
+        """Per category, the lambda of `label` left unseen by searches over the location
+        (and a room's in/on spaces); None where a `label` was seen there."""
         room = self._room_of(location)
         places = [location]
         if include_sublocations and not isinstance(location, RelatedSpace):
             places += self.objects.sublocations(room, label)
         if any(self.objects.count(place, label) for place in places):
-            return 1.0
-        residual = sum(
+            return None
+        return sum(
             self.objects.location_lambda(label, place) * self.objects.remaining(place, label)
             for place in places
         )
-        return float(self.room_marginal(room) @ p_at_least_one(residual))
 
     def p_object_at_category(
         self, label: str, category: str, support_label: str | None = None, relation: str = "on"

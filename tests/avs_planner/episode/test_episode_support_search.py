@@ -14,8 +14,8 @@ from avs_planner.cp.search import SearchOptions
 from avs_planner.dt import ViewCone
 from avs_planner.dt.domain import ActionKind, DTAction
 from avs_planner.dt.session import DTResult, DTStatus, DTStep
+from avs_planner.episode.driving import _split_leg
 from avs_planner.episode.dt_search import ViewConeSearch
-from avs_planner.episode.executor import _split_leg
 from avs_planner.episode.loop import LoopConfig, SwitchingLoop
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import StepStatus
