@@ -313,10 +313,11 @@ class StateBuilder:
                 values[("p-placeholder-category", pid, c)] = self._prune(belief.get(c, 0.0))
         knowledge = cmap.knowledge
         for label in self.labels:
-            lam = knowledge.total_room_lambda(label)
+            prior = p_at_least_one(knowledge.total_room_lambda(label))
             for rid in [*rooms, *self._virtual("new-room", self.config.virtual_rooms)]:
-                remaining = cmap.objects.remaining(rid, label) if rid in rooms else 1.0
-                p = p_at_least_one(lam * remaining)
+                # a known room: the target outside its known supports (their share is in
+                # p-find-on), the supports not found yet counted by the looks for them
+                p = cmap.p_object_in_room_per_category(label, rid) if rid in rooms else prior
                 for c in self._current_categories:
                     k = knowledge.category_index(c)
                     useful = label == self.task.target or self._support_useful(label, c)

@@ -180,6 +180,29 @@ class ObjectLedger:
         key = (location, label)
         return self._remaining.get(key, 1.0) * (1.0 - self._glimpsed.get(key, 0.0))
 
+    def unexplained_lambda(self, label: str, room: str) -> np.ndarray:
+        """Per category, the expected count of `label` in `room` that no known object's space
+        holds and no look so far has ruled out.
+
+        The room's own lambda, thinned by the looks for `label` there, plus, for every
+        support the knowledge puts `label` on or in, the supports of that label not found
+        yet (their prior count thinned by the looks for the support label there: Poisson
+        thinning, so the undiscovered count does not depend on how many were found) times
+        the per-support lambda. Supports already found hold their share in their own
+        related spaces. A support label nothing has looked for yet is thinned by the looks
+        for `label` instead (the old rule for every support).
+        """
+        self.require_label(label)
+        knowledge = self.knowledge
+        total = knowledge.room_lambda(label) * self.remaining(room, label)
+        for (lab, _relation, support), lam in knowledge.relation_lambda.items():
+            if lab != label:
+                continue
+            looked = (room, support) in self._remaining or (room, support) in self._glimpsed
+            unseen = self.remaining(room, support if looked else label)
+            total = total + knowledge.room_lambda(support) * unseen * lam
+        return total
+
     def location_lambda(self, label: str, location: Location) -> np.ndarray:
         """Prior expected count of `label` at `location`, per category."""
         self.require_label(label)

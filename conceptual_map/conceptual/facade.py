@@ -284,6 +284,14 @@ class ConceptualMap:
             for place in places
         )
 
+    def p_object_in_room_per_category(self, label: str, room: str) -> np.ndarray:
+        """P(at least one `label` in `room` outside its known objects' spaces) under each
+        room category (`knowledge.categories` order): the room itself and the supports not
+        found yet, after the looks so far (`ObjectLedger.unexplained_lambda`). Objects of
+        `label` already found do not count: this is about one more."""
+        self.graph.require_room(room)
+        return p_at_least_one(self.objects.unexplained_lambda(label, room))
+
     def p_object_at_category(
         self, label: str, category: str, support_label: str | None = None, relation: str = "on"
     ) -> float:

@@ -141,3 +141,29 @@ def test_a_forgotten_object_leaves_the_beliefs_as_if_never_seen():
         cmap.forget_object(table)
     with pytest.raises(ConceptualError, match="unknown object"):
         cmap.forget_object("object99")
+
+
+def test_the_room_hypothesis_counts_supports_not_found_yet_not_the_prior_number():
+    """P(label in the room, off its known supports): the room's own lambda and the supports
+    still unfound (their prior count thinned by the looks for them) times the per-support
+    lambda. A room whose desks were all looked for, and found, no longer holds the prior
+    number of desks' worth of keyboards (which kept a searched office worth another room
+    search: the known desks' keyboards are in their own `on` spaces)."""
+    cmap = ConceptualMap()
+    cmap.add_room("office1")
+    knowledge = cmap.knowledge
+    prior = cmap.p_object_in_room_per_category("keyboard", "office1")
+    np.testing.assert_allclose(prior, p_at_least_one(knowledge.total_room_lambda("keyboard")))
+    cmap.observe_object("desk", "office1")
+    cmap.observe_glimpses("desk", "office1", 0.9)  # 90% of the room's desks would be seen
+    after = cmap.p_object_in_room_per_category("keyboard", "office1")
+    expected = knowledge.room_lambda("keyboard") + knowledge.room_lambda("desk") * 0.1 * \
+        knowledge.relation_lambda_of("keyboard", "on", "desk")
+    np.testing.assert_allclose(after, p_at_least_one(expected))
+    office = knowledge.category_index("office")
+    assert after[office] < 0.5 * prior[office]
+    # the keyboard's own looks thin the room's own lambda; unlooked-for supports keep theirs
+    cmap.observe_glimpses("keyboard", "office1", 0.5)
+    thinned = cmap.p_object_in_room_per_category("keyboard", "office1")
+    np.testing.assert_allclose(thinned, p_at_least_one(
+        expected - 0.5 * knowledge.room_lambda("keyboard")))
