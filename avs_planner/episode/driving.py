@@ -23,6 +23,8 @@ from conceptual_map.metric.path_planning import PathResult, PathStatus
 if TYPE_CHECKING:
     from avs_planner.episode.executor import ExecutorConfig, Stats
 
+TARGET_SEEN = "saw the target on the way"  # a drive stopped early: the watch confirmed it
+
 
 class Driving:
     """Moves the robot to a goal on the growing grid (see the module's doc)."""
@@ -74,7 +76,11 @@ class Driving:
                 continue
             self.stats.distance += sum(math.dist(a, b) for a, b in
                                        zip([here[:2], *leg], leg, strict=False))
-            self._sense([(x, y, self.robot.pose[2]) for x, y in leg])
+            if self._sense([(x, y, self.robot.pose[2]) for x, y in leg]) is not None:
+                # the detector confirmed the target on the way: driving on to a goal picked
+                # to look for it is wasted time (the object reaches the planner with this
+                # step's outcome, and its next plan reports it)
+                return StepOutcome(StepStatus.DONE, TARGET_SEEN)
         return StepOutcome(StepStatus.FAILED, "too many legs")
 
     def _blocked(self) -> str:

@@ -12,7 +12,8 @@ import math
 from typing import TYPE_CHECKING
 
 from avs_planner.dt import DTRewards, DTSession, DTStatus, SearchBudget
-from avs_planner.dt.domain import ActionKind
+from avs_planner.dt.domain import REJECT, ActionKind
+from avs_planner.episode.driving import TARGET_SEEN
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
 from avs_planner.episode.viewcones import ConeSet
 
@@ -41,13 +42,19 @@ class ViewConeSearch:
                                               self.ex.config.miss_penalty),
                             seed=self.ex.seed + self.ex.stats.dt_calls)
         self.ex.dt_session = session  # the running session, for observers (the recorder)
+        interrupted = False
         while True:
             action = session.next_action()
             if session.finished:
                 break
             cone = session.cone(action)
             if action.kind is ActionKind.MOVE:
-                self.ex.drive_to(cone.pose[:2])
+                if self.ex.drive_to(cone.pose[:2]).detail == TARGET_SEEN:
+                    # the watch confirmed the target on the way to this cone: stop here
+                    # (the looks so far still count) and let the planner report it
+                    session.update(REJECT)
+                    interrupted = True
+                    break
                 self.ex.robot.turn_to(cone.pose[2])
                 self.ex.robot.look(*(cone.head or (0.0, 0.0)))
                 self.head = cone.head or (0.0, 0.0)
@@ -62,7 +69,7 @@ class ViewConeSearch:
         self.ex.emit("dt", label=label, relation=relation, location=location,
                      result=result.status.value, probability=round(result.probability, 4),
                      steps=len(result.trace), cones=len(made.cones))
-        return self._conclude(result, label, relation, location, made)
+        return self._conclude(result, label, relation, location, made, interrupted)
 
     def _look(self, label: str, relation: str, location: str) -> SeenLike | None:
         """PROCESSVIEWCONE: a detection in the searched location, seen twice."""
@@ -114,7 +121,7 @@ class ViewConeSearch:
 
 
     def _conclude(self, result, label: str, relation: str, location: str,  # noqa: ANN001
-                  made: ConeSet) -> StepOutcome:
+                  made: ConeSet, interrupted: bool = False) -> StepOutcome:
         looks: dict[int, int] = {}
         for step in result.trace:
             if step.action.kind is not ActionKind.MOVE:
@@ -140,6 +147,8 @@ class ViewConeSearch:
             return StepOutcome(StepStatus.DONE, f"confirmed {obj.id}", {obj.id: atoms})
         if coverage > 0.0:
             self.ex.mind.searched(label, relation, location, coverage, 1.0)
+        if interrupted:  # not a failed search: it stopped because the target turned up
+            return StepOutcome(StepStatus.DONE, TARGET_SEEN)
         if relation == "on":
             key = (label, location)
             self.ex.builder.failed_on[key] = self.ex.builder.failed_on.get(key, 0) + 1

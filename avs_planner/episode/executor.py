@@ -16,7 +16,7 @@ from typing import Any
 from avs_planner.cp.search import PlanStep
 from avs_planner.cp.task import Atom
 from avs_planner.dt import DetectorModel
-from avs_planner.episode.driving import Driving
+from avs_planner.episode.driving import TARGET_SEEN, Driving
 from avs_planner.episode.dt_search import ViewConeSearch
 from avs_planner.episode.glimpses import Glimpses
 from avs_planner.episode.mind import KnownObject, Mind
@@ -406,7 +406,7 @@ class Executor(Driving):
             self.mind.tried_placeholders[target] = self.mind.tried_placeholders.get(target, 0) + 1
         status = self.drive_to(goal, stop=lambda: is_placeholder and
                                target not in self.mind.place_map.placeholders)
-        if status.status is StepStatus.DONE and is_placeholder:
+        if status.status is StepStatus.DONE and is_placeholder and status.detail != TARGET_SEEN:
             self.look_around()
         if status.status is StepStatus.FAILED:
             self.mind.move_failed(target)

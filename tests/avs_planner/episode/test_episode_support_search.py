@@ -14,11 +14,11 @@ from avs_planner.cp.search import SearchOptions
 from avs_planner.dt import ViewCone
 from avs_planner.dt.domain import ActionKind, DTAction
 from avs_planner.dt.session import DTResult, DTStatus, DTStep
-from avs_planner.episode.driving import _split_leg
+from avs_planner.episode.driving import TARGET_SEEN, _split_leg
 from avs_planner.episode.dt_search import ViewConeSearch
 from avs_planner.episode.loop import LoopConfig, SwitchingLoop
 from avs_planner.episode.mind import Mind
-from avs_planner.episode.outcome import StepStatus
+from avs_planner.episode.outcome import StepOutcome, StepStatus
 from avs_planner.episode.robot import Seen
 from avs_planner.episode.trace import Trace
 from avs_planner.episode.viewcones import ConeSet
@@ -188,3 +188,53 @@ def test_a_room_search_thins_the_unseen_count_whether_or_not_it_found_one(corrid
         left * (1.0 - 0.8 * (1.0 - executor.config.detector.false_negative)))
     after = _p_in(builder.build(), "table", room)
     assert after < before
+
+
+def test_a_drive_stops_once_the_watch_confirms_the_target(corridor, monkeypatch) -> None:
+    """Driving on to a goal picked to look for the target is wasted once the detector has
+    confirmed the target on the way: the drive ends there, and a DT search whose move it was
+    ends too (not as a failed search of its location)."""
+    mind, builder, executor = corridor
+    _, (x, y) = _here(mind)
+    target = builder.task.target
+    monkeypatch.setattr(executor.robot, "detect", lambda labels=None: [])
+    assert executor.drive_to((x + 3.0, y)).detail != TARGET_SEEN  # nothing seen: arrives
+    assert math.dist(executor.robot.pose[:2], (x + 3.0, y)) <= executor.config.arrive
+    spot = (x + 1.0, y + 0.8, 0.5)
+    monkeypatch.setattr(executor.robot, "detect",
+                        lambda labels=None: [Seen(9, target, spot, 0.9)]
+                        if labels is None or target in labels else [])
+    outcome = executor.drive_to((x, y))
+    assert outcome.status is StepStatus.DONE and outcome.detail == TARGET_SEEN
+    assert math.dist(executor.robot.pose[:2], (x, y)) > executor.config.arrive
+    assert [o.label for o in mind.objects.values()] == [target]
+    # a DT search whose move to a cone meets the target: it ends, not as a failed search
+    room, _ = _here(mind)
+    assert executor.create_cones(target, "in", room).status is StepStatus.DONE
+
+    class MovesFirst:  # the DT's first decision: drive to cone 0
+        def __init__(self, *args, **kwargs) -> None:
+            self.result, self.finished, self.actions = None, False, []
+
+        def next_action(self) -> DTAction:
+            if len(self.actions) >= 2:  # (without the early stop: give up after two moves)
+                self.update(DTAction(ActionKind.REJECT))
+                return DTAction(ActionKind.REJECT)
+            return DTAction(ActionKind.MOVE, 0)
+
+        def cone(self, action: DTAction) -> ViewCone:
+            return executor.cones_now(target, "in", room).cones[action.cone]
+
+        def update(self, action: DTAction, *args, **kwargs) -> None:
+            self.actions.append(action)
+            if action.terminal:
+                self.finished = True
+                self.result = DTResult(DTStatus.REJECTED, 0.5, 0.0, ())
+
+    monkeypatch.setattr("avs_planner.episode.dt_search.DTSession", MovesFirst)
+    monkeypatch.setattr(executor, "drive_to",
+                        lambda goal, stop=None: StepOutcome(StepStatus.DONE, TARGET_SEEN))
+    outcome = ViewConeSearch(executor, target, "in", room).run()
+    assert outcome.status is StepStatus.DONE and outcome.detail == TARGET_SEEN
+    assert executor.dt_session.actions == [DTAction(ActionKind.REJECT)]
+    assert builder.failed_in.get((target, room), 0) == 0
