@@ -14,11 +14,15 @@ before the building's hypotheses did. Here every such frame counts:
   support height inside the vertical field of view, and a free line of sight on the
   occupancy grid (an unknown or occupied cell in between blocks it).
 - **Supports.** The top of a known support (at twice its detected centre's height, the
-  executor's rule for a top) counts as looked at when all of it is in view: the disc within
-  `support_radius` of its centre, where the executor calls a detection "on" it, inside the
-  field of view and the range, and a free line of sight to the centre that may end in the
-  support's own body (the laser maps a desk as its outline with unknown cells inside, which
-  a ray to its centre crosses; without this, no top in view ever counted).
+  executor's rule for a top) is the disc within `support_radius` of its centre, where the
+  executor calls a detection "on" it, sampled by points spread evenly over it. A point
+  counts as looked at when it is inside the field of view and the range, and the centre has
+  a free line of sight that may end in the support's own body (the laser maps a desk as its
+  outline with unknown cells inside, which a ray to its centre crosses; without this, no top
+  in view ever counted). Like a room's cells, a top seen in part is searched in part: the
+  share is the mean over its points (an object at the desk's far end is not ruled out by
+  frames that only had its near end in view, and a desk seen whole from one standpoint is
+  not needed whole in every frame).
 
 A look is one chance for the detector (hit rate `p_detect`, the DT's own detector model), so
 a cell or top looked at from k different standpoints (camera positions 1 m apart; frames
@@ -60,8 +64,10 @@ class Glimpses:
         self.max_range = 0.9 * camera.detect_range
         # label -> {world key of a candidate cell: standpoints it was looked at from}
         self.cells: dict[str, dict[tuple[int, int], set[tuple[int, int]]]] = {}
-        # (label, support id) -> standpoints its top was looked at from
-        self.tops: dict[tuple[str, str], set[tuple[int, int]]] = {}
+        # (label, support id) -> per point of its top (`_top_points`), the standpoints it
+        # was looked at from
+        self.tops: dict[tuple[str, str], list[set[tuple[int, int]]]] = {}
+        self._top_points = _disc_points(support_body)
         self.frames = 0
 
     def frame(self, pose: tuple[float, float, float], pan: float, tilt: float,
@@ -119,39 +125,39 @@ class Glimpses:
             if obj is None:
                 continue
             top = 2.0 * obj.position[2]  # the executor's rule: a support's centre is half-way
-            if not self._top_in_view(obj.position[:2], pose, pan, tilt, top):
+            seen = self._top_in_view(obj.position[:2], pose, pan, tilt, top)
+            if not seen.any():
                 continue
-            seen = self.tops.setdefault((label, oid), set())
-            if stand in seen or len(seen) >= MAX_LOOKS:
-                continue
-            seen.add(stand)
-            self._observe(label, RelatedSpace("on", oid), self._share([len(seen)]))
+            looks = self.tops.setdefault((label, oid), [set() for _ in self._top_points])
+            new = False
+            for i in np.flatnonzero(seen):
+                if stand not in looks[i] and len(looks[i]) < MAX_LOOKS:
+                    looks[i].add(stand)
+                    new = True
+            if new:
+                self._observe(label, RelatedSpace("on", oid),
+                              self._share([len(where) for where in looks]))
 
     def _top_in_view(self, centre: tuple[float, float], pose: tuple[float, float, float],
-                     pan: float, tilt: float, top: float) -> bool:
-        """The whole top is in the frame: an object anywhere on it (within `support_body` of
-        the centre, where the executor calls a detection "on" the support) would be inside
-        the field of view, horizontally and from its near to its far edge, within range,
-        and the centre has a free line of sight up to the support's own body. (Testing the
-        centre alone counted tops whose far side was out of the frame: a stapler at a desk's
-        end went unseen there, and the desk was settled.)"""
-        cam, body = self.camera, self.support_body
-        d = np.asarray(centre, dtype=float) - np.asarray(pose[:2])
-        r = float(np.hypot(d[0], d[1]))
-        if r - body < self.min_range or r + body > self.max_range:
-            return False
-        margin = math.atan2(body, r)
-        bearing = abs((math.atan2(d[1], d[0]) - pose[2] - pan + math.pi) % (2 * math.pi)
-                      - math.pi)
-        if bearing + margin > cam.hfov / 2:
-            return False
+                     pan: float, tilt: float, top: float) -> np.ndarray:
+        """Which points of the top (`_top_points` around `centre`, at height `top`) are in
+        the frame: inside the field of view, horizontally and vertically, and within range;
+        none unless the centre has a free line of sight up to the support's own body."""
+        cam = self.camera
+        points = np.asarray(centre, dtype=float) + self._top_points
+        d = points - np.asarray(pose[:2])
+        r = np.hypot(d[:, 0], d[:, 1])
+        bearing = np.abs((np.arctan2(d[:, 1], d[:, 0]) - pose[2] - pan + np.pi)
+                         % (2 * np.pi) - np.pi)
+        seen = (r >= self.min_range) & (r <= self.max_range) & (bearing <= cam.hfov / 2)
         if cam.vfov is not None:
-            for reach in (r - body, r + body):
-                elevation = math.atan2(top - cam.height, reach)
-                if abs(elevation - tilt) > cam.vfov / 2:
-                    return False
-        point = np.array([centre], dtype=float)
-        return bool(self._line_of_sight(np.asarray(pose[:2]), point, body)[0])
+            elevation = np.arctan2(top - cam.height, np.maximum(r, 1e-6))
+            seen &= np.abs(elevation - tilt) <= cam.vfov / 2
+        if seen.any():
+            point = np.array([centre], dtype=float)
+            if not self._line_of_sight(np.asarray(pose[:2]), point, self.support_body)[0]:
+                seen[:] = False
+        return seen
 
     def _keys(self, points: np.ndarray) -> np.ndarray:
         return np.round(points / self.mind.grid.resolution).astype(np.int64)
@@ -211,3 +217,16 @@ class Glimpses:
         blocked = ~clear & tail
         after_block = np.maximum.accumulate(blocked, axis=1)
         return np.all(clear | ~before, axis=1) & ~np.any(after_block & clear & tail, axis=1)
+
+
+def _disc_points(radius: float, spacing_share: float = 1.0 / 3.0) -> np.ndarray:
+    """Offsets of points spread evenly over a disc of `radius` (a square grid `radius` x
+    `spacing_share` apart, clipped to the disc; its centre always among them)."""
+    if radius <= 0.0:
+        return np.zeros((1, 2))
+    step = radius * spacing_share
+    n = int(math.floor(radius / step))
+    axis = np.arange(-n, n + 1) * step
+    xs, ys = np.meshgrid(axis, axis)
+    grid = np.stack([xs.ravel(), ys.ravel()], axis=1)
+    return grid[np.hypot(grid[:, 0], grid[:, 1]) <= radius + 1e-9]
