@@ -34,6 +34,11 @@ from conceptual_map.knowledge import load_knowledge
 
 Emit = Callable[[dict[str, Any]], None]
 
+# m: a report scores as correct when it names a spot this near a true instance of the target
+# (several times the detector's position noise, 0.02 m per metre of range on each axis; half
+# the 1 m within which two detections of a label are taken for one object)
+REPORT_TOLERANCE = 0.5
+
 _KEYS = {"target", "category", "world", "world_file", "robot", "start_room", "start", "seed",
          "time_budget_s", "wall_budget_s", "task_id", "output_dir", "pre_explore", "dt_policy",
          "strategy", "strategy_options", "generate", "qsr", "record", "view"}
@@ -292,7 +297,7 @@ class Episode:
             sid = self.executor.found_sids.get(found.id)
             obj = {"id": found.id, "label": found.label,
                    "position": [round(v, 3) for v in found.position],
-                   "room": found.room, "truth": self.robot.truth_of.get(sid)}
+                   "room": found.room, "truth": self._truth_of(sid, found.position)}
         return {
             "outcome": result.outcome.value, "reason": result.reason,
             "target": self.spec.target, "category": self.spec.category, "object": obj,
@@ -309,6 +314,20 @@ class Episode:
             "strategy": self.spec.strategy, "details": result.details,
             "wall_time_s": round(self.trace.wall, 2),
         }
+
+    def _truth_of(self, sid: int | None, position: tuple[float, float, float]) -> str | None:
+        """The world entry a report names (scoring only: the robot never sees this). The
+        detection it was made from says, when that was of the target; otherwise the nearest
+        target instance within `REPORT_TOLERANCE` m of the reported spot does: the first frame
+        of a confirmed detection may be a phantom beside the real object that the frames
+        confirming and verifying it saw, and the report then still names the object."""
+        named = self.robot.truth_of.get(sid) if sid is not None else None
+        if named is not None and self._truth_label(named) == self.spec.target:
+            return named
+        near = [(math.dist(thing.center, position), thing.name)
+                for thing in self.robot.world.detectables if thing.label == self.spec.target]
+        near = [entry for entry in near if entry[0] <= REPORT_TOLERANCE]
+        return min(near)[1] if near else named
 
     def _truth_label(self, name: str) -> str | None:
         for item in (*self.world_spec.objects, *self.world_spec.furniture):

@@ -69,3 +69,28 @@ def test_should_stop_ends_the_episode_as_timeout(tmp_path) -> None:
                            "output_dir": str(tmp_path)}, None, lambda: True)
     assert summary["outcome"] == "timeout" and "stopped" in summary["reason"]
     assert summary["dt_calls"] == 0
+
+
+def test_a_report_beside_the_real_object_scores_as_that_object() -> None:
+    """Scoring only: a report is correct when the detection behind it was of the target, or
+    when it names a spot within `REPORT_TOLERANCE` of a true target (the first frame of a
+    confirmed detection may be a phantom beside the object the next frames saw)."""
+    import math
+
+    from avs_planner.episode.runner import REPORT_TOLERANCE, Episode, EpisodeSpec
+
+    episode = Episode(EpisodeSpec.from_dict(load_scenario("a").episode_spec(seed=1)))
+    try:
+        cereal = next(t for t in episode.robot.world.detectables if t.name == "cereal1")
+        beside = (cereal.center[0] + 0.3, cereal.center[1], cereal.center[2])
+        assert episode._truth_of(None, beside) == "cereal1"
+        episode.robot.truth_of[7] = None  # a phantom's detection
+        assert episode._truth_of(7, beside) == "cereal1"
+        far = (cereal.center[0] + REPORT_TOLERANCE + 0.3, cereal.center[1], cereal.center[2])
+        assert all(math.dist(t.center, far) > REPORT_TOLERANCE
+                   for t in episode.robot.world.detectables if t.label == "cerealbox")
+        assert episode._truth_of(7, far) is None
+        episode.robot.truth_of[8] = "table1"  # a real detection of something else, far off
+        assert episode._truth_of(8, far) == "table1"
+    finally:
+        episode.robot.world.close()
