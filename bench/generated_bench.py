@@ -29,9 +29,11 @@ STRATEGIES = ("switching", "exhaustive", "most-likely-room")
 
 
 def episodes(worlds: int, style: str, strategies: list[str], first: int = 0,
-             robot: str | None = None, options: dict | None = None) -> list[dict]:
+             robot: str | None = None, options: dict | None = None,
+             budget: float | None = None) -> list[dict]:
     """One spec per (world, target, strategy); the targets come from the generator's record.
-    `options` are the switching strategy's (`--option K=V`)."""
+    `options` are the switching strategy's (`--option K=V`); `budget` the simulated seconds
+    per episode (default: the episode's own, 1200)."""
     specs = []
     for seed in range(first, first + worlds):
         for label, present in generated_targets(seed, style):
@@ -40,7 +42,8 @@ def episodes(worlds: int, style: str, strategies: list[str], first: int = 0,
                     else {}
                 specs.append({"generate": {"seed": seed, "style": style}, "target": label,
                               "seed": seed, "strategy": strategy, "present": present,
-                              **({"robot": robot} if robot else {}), **extra})
+                              **({"robot": robot} if robot else {}),
+                              **({"time_budget_s": budget} if budget else {}), **extra})
     return specs
 
 
@@ -131,13 +134,18 @@ def main(argv: list[str] | None = None) -> int:
                         help="robot model (default: the world's, the pioneer)")
     parser.add_argument("--option", action="append", default=[], metavar="K=V",
                         help="a switching-strategy option (repeatable), e.g. reward=1000")
+    parser.add_argument("--budget", type=float, default=None, metavar="S",
+                        help="simulated seconds per episode (default: the episode's, 1200)")
     args = parser.parse_args(argv)
+    if args.budget is not None and args.budget <= 0:
+        parser.error(f"--budget must be a positive number of seconds, got {args.budget:g}")
     strategies = args.strategies.split(",")
     specs = episodes(3 if args.quick else args.worlds, args.style, strategies, args.first,
-                     args.robot, _options(args.option))
+                     args.robot, _options(args.option), args.budget)
     print(f"generated bench: {len(specs)} episodes ({args.style} worlds "
           f"{args.first}..{args.first + (3 if args.quick else args.worlds) - 1}, "
-          f"strategies {', '.join(strategies)})", flush=True)
+          f"strategies {', '.join(strategies)}"
+          f"{f', budget {args.budget:g} s' if args.budget else ''})", flush=True)
     rows, start = [], time.perf_counter()
     out = args.jsonl.open("w", encoding="utf-8") if args.jsonl else None
     with ProcessPoolExecutor(args.workers) as pool:
