@@ -238,3 +238,23 @@ def test_a_drive_stops_once_the_watch_confirms_the_target(corridor, monkeypatch)
     assert outcome.status is StepStatus.DONE and outcome.detail == TARGET_SEEN
     assert executor.dt_session.actions == [DTAction(ActionKind.REJECT)]
     assert builder.failed_in.get((target, room), 0) == 0
+
+
+@pytest.mark.parametrize(("frames", "extra", "confirmed", "taken"), [
+    ("hmmh", 2, True, 4),    # one short after three frames, one agreed: two more, one hits
+    ("hmmmm", 2, False, 5),  # ... and neither of the two more does
+    ("mm", 2, False, 2),     # no frame agreed: rejected as before, no more frames
+    ("hmmh", 0, False, 3),   # without the extension: the old two of three
+    ("hh", 2, True, 2),
+])
+def test_a_confirmation_one_short_with_agreement_looks_again(corridor, monkeypatch, frames,
+                                                             extra, confirmed, taken) -> None:
+    _, builder, executor = corridor
+    target = builder.task.target
+    x, y, _ = executor.robot.pose
+    seen = Seen(1, target, (x + 2.0, y, 0.7), 0.9)
+    queue = [[Seen(2, target, (x + 2.1, y, 0.7), 0.9)] if f == "h" else [] for f in frames]
+    monkeypatch.setattr(executor.robot, "detect", lambda labels=None: queue.pop(0))
+    executor.config = replace(executor.config, confirm_extra=extra)
+    assert executor.confirm(seen) is confirmed
+    assert len(frames) - len(queue) == taken
