@@ -141,18 +141,10 @@ class Glimpses:
     def _top_in_view(self, centre: tuple[float, float], pose: tuple[float, float, float],
                      pan: float, tilt: float, top: float) -> np.ndarray:
         """Which points of the top (`_top_points` around `centre`, at height `top`) are in
-        the frame: inside the field of view, horizontally and vertically, and within range;
-        none unless the centre has a free line of sight up to the support's own body."""
-        cam = self.camera
+        the frame (`_in_frame`); none unless the centre has a free line of sight up to the
+        support's own body."""
         points = np.asarray(centre, dtype=float) + self._top_points
-        d = points - np.asarray(pose[:2])
-        r = np.hypot(d[:, 0], d[:, 1])
-        bearing = np.abs((np.arctan2(d[:, 1], d[:, 0]) - pose[2] - pan + np.pi)
-                         % (2 * np.pi) - np.pi)
-        seen = (r >= self.min_range) & (r <= self.max_range) & (bearing <= cam.hfov / 2)
-        if cam.vfov is not None:
-            elevation = np.arctan2(top - cam.height, np.maximum(r, 1e-6))
-            seen &= np.abs(elevation - tilt) <= cam.vfov / 2
+        seen = self._in_frame(points, pose, pan, tilt, top)
         if seen.any():
             point = np.array([centre], dtype=float)
             if not self._line_of_sight(np.asarray(pose[:2]), point, self.support_body)[0]:
@@ -162,10 +154,10 @@ class Glimpses:
     def _keys(self, points: np.ndarray) -> np.ndarray:
         return np.round(points / self.mind.grid.resolution).astype(np.int64)
 
-    def _in_view(self, points: np.ndarray, pose: tuple[float, float, float], pan: float,
-                 tilt: float, height: float, body: float = 0.0) -> np.ndarray:
-        """Points (at `height`) inside the frame's view with a free line of sight (up to a
-        support's own `body`, see `_line_of_sight`)."""
+    def _in_frame(self, points: np.ndarray, pose: tuple[float, float, float], pan: float,
+                  tilt: float, height: float) -> np.ndarray:
+        """Points (at `height`) inside the frame: within the horizontal and vertical fields
+        of view and between `min_range` and `max_range` (no line of sight tested)."""
         cam = self.camera
         d = points - np.asarray(pose[:2])
         r = np.hypot(d[:, 0], d[:, 1])
@@ -175,10 +167,16 @@ class Glimpses:
         if cam.vfov is not None:
             elevation = np.arctan2(height - cam.height, np.maximum(r, 1e-6))
             ok &= np.abs(elevation - tilt) <= cam.vfov / 2
+        return ok
+
+    def _in_view(self, points: np.ndarray, pose: tuple[float, float, float], pan: float,
+                 tilt: float, height: float) -> np.ndarray:
+        """Points (at `height`) inside the frame (`_in_frame`) with a free line of sight."""
+        ok = self._in_frame(points, pose, pan, tilt, height)
         if not ok.any():
             return ok
         idx = np.flatnonzero(ok)
-        ok[idx] = self._line_of_sight(np.asarray(pose[:2]), points[idx], body)
+        ok[idx] = self._line_of_sight(np.asarray(pose[:2]), points[idx])
         return ok
 
     def _line_of_sight(self, origin: np.ndarray, points: np.ndarray, body: float = 0.0
