@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from avs_planner.episode.blockages import Blockage
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import StepOutcome, StepStatus
 from conceptual_map.errors import MapError
@@ -68,10 +69,11 @@ class Driving:
             age += 1
             if not self.robot.move_along(leg):
                 detours += 1
-                why = self._blocked()
-                if getattr(self.robot, "last_contact", None) is None or detours > cfg.detours:
+                blockage, why = self._blocked()
+                if blockage is None or detours > cfg.detours:
                     return StepOutcome(StepStatus.FAILED, f"blocked {detours} times on the way "
                                        f"to ({goal[0]:.2f}, {goal[1]:.2f}): {why}")
+                self._back_off(blockage)
                 route = []  # plan around the keep-out disc
                 continue
             self.stats.distance += sum(math.dist(a, b) for a, b in
@@ -83,17 +85,37 @@ class Driving:
                 return StepOutcome(StepStatus.DONE, TARGET_SEEN)
         return StepOutcome(StepStatus.FAILED, "too many legs")
 
-    def _blocked(self) -> str:
+    def _blocked(self) -> tuple[Blockage | None, str]:
         """The base refused a leg: its contact point becomes a blockage the paths avoid
-        (reported to the trace). Returns what was learned."""
+        (reported to the trace). Returns it (None without a contact point) and what was
+        learned."""
         contact = getattr(self.robot, "last_contact", None)
         if contact is None:
-            return "the base refused the leg and gave no contact point"
+            return None, "the base refused the leg and gave no contact point"
         blockage = self.mind.block(contact, self.robot.clock)
         self.emit("belief", blocked=blockage.id, at=[round(v, 2) for v in blockage.centre],
                   door=blockage.door, retry_at=round(blockage.until, 1),
                   detail=blockage.describe())
-        return blockage.describe()
+        return blockage, blockage.describe()
+
+    def _back_off(self, blockage: Blockage) -> None:
+        """Step straight away from the touched point until the robot's centre is outside the
+        new keep-out disc. Standing inside it (the refused leg started next to what it
+        touched: a corner the scans had not shown), every path out begins in the disc, the
+        next one is planned from there past the same corner, and the base touches it again
+        until the move fails with a free way round in plain sight (a PR2 leaving a room by
+        a sink beside its door touched the sink's corner three times from one pose). A
+        back-off the base refuses too is left: the next path is planned from where it is."""
+        x, y = self.robot.pose[:2]
+        cx, cy = blockage.centre
+        away = math.dist((x, y), (cx, cy))
+        gap = blockage.radius + self.mind.grid.resolution - away
+        if gap <= 0.0 or away < 1e-6:
+            return
+        step = (x + (x - cx) / away * gap, y + (y - cy) / away * gap)
+        if self.robot.move_along([step]):
+            self.stats.distance += gap
+            self.emit("belief", backed_off=blockage.id, to=[round(v, 2) for v in step])
 
     def _no_path(self, goal: tuple[float, float]) -> str:
         """Why no path leads to `goal`, naming the blockages the robot has run into."""
@@ -130,10 +152,7 @@ class Driving:
         through unknown cells (a laser mounted ahead of the base never sees the cells under
         and behind it); the simulator still refuses any motion that would collide."""
         radius = self.mind.config.robot_radius
-        slim = self.mind.config.squeeze_radius  # the mind's own (`mind.squeeze_radius`)
-        if slim is None:
-            slim = radius - self.config.squeeze
-        tries = ((slim, False), (radius, True))
+        tries = ((self.squeeze_margin(), False), (radius, True))
         for margin, unknown in tries:
             try:
                 path = plan_path(self.mind.grid, start, goal, margin, allow_unknown=unknown)
@@ -144,6 +163,12 @@ class Driving:
         # no path (the robot may stand where only a squeeze fits: a query from there with
         # the full radius is refused, which must not end the episode)
         return PathResult(PathStatus.NO_PATH, (), math.inf, 0)
+
+    def squeeze_margin(self) -> float:
+        """The slimmest margin a path may keep: the mind's own squeeze radius
+        (`mind.squeeze_radius`), else the planning radius less `ExecutorConfig.squeeze`."""
+        slim = self.mind.config.squeeze_radius
+        return self.mind.config.robot_radius - self.config.squeeze if slim is None else slim
 
     def _free_near(self, goal: tuple[float, float], reach: float = 0.6
                    ) -> tuple[float, float] | None:

@@ -362,18 +362,24 @@ class Executor(Driving):
         return StepOutcome(StepStatus.FAILED, f"no skill executes {step.name}")
 
     def nearest_placeholder(self) -> str | None:
-        """The placeholder nearest by grid path that was not given up on."""
+        """The placeholder nearest by grid path that was not given up on; when none is
+        reachable with the full margin, the nearest one a squeeze reaches (as `drive_to`
+        squeezes when no full-margin path is left: the grid draws an opening a few cm
+        narrower than it is, and a PR2 fits a 0.8 m door with 6 cm to spare)."""
         mind = self.mind
-        field_ = distance_field(mind.grid, self.robot.pose[:2], mind.config.robot_radius)
-        best, best_cost = None, math.inf
-        for pid, ph in mind.place_map.placeholders.items():
-            cell = mind.grid.cell_of(ph.position)
-            if mind.tried_placeholders.get(pid, 0) >= self.builder.config.max_placeholder_tries \
-                    or not mind.grid.contains(cell):
-                continue
-            if field_[cell] < best_cost:
-                best, best_cost = pid, float(field_[cell])
-        return best
+        for margin in (mind.config.robot_radius, self.squeeze_margin()):
+            field_ = distance_field(mind.grid, self.robot.pose[:2], margin)
+            best, best_cost = None, math.inf
+            for pid, ph in mind.place_map.placeholders.items():
+                cell = mind.grid.cell_of(ph.position)
+                if mind.tried_placeholders.get(pid, 0) >= \
+                        self.builder.config.max_placeholder_tries or not mind.grid.contains(cell):
+                    continue
+                if field_[cell] < best_cost:
+                    best, best_cost = pid, float(field_[cell])
+            if best is not None:
+                return best
+        return None
 
     def uncertain_room(self, certain: float, skip: set[str],
                        worth: Callable[[str], bool] = lambda room: True) -> str | None:

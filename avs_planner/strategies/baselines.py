@@ -4,7 +4,10 @@
 stop; no priors. `most-likely-room`: known rooms in order of P(object in room) from the
 conceptual map's category beliefs and default knowledge, each swept fully (standpoints over its
 free space, all round at each); unexplored space (a placeholder) competes as a hypothetical
-room weighted by the chance that it leads to one. Both give up when nothing is left.
+room weighted by the chance that it leads to one. Both give up when nothing is left, after
+trying the spots the base was blocked at again (`retry_blocked` times, as the switching loop
+does: a touched spot is kept out of for minutes, and what it cut off would otherwise count as
+searched).
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ MAX_SWEEP_STOPS = 12  # standpoints per room sweep
 def run_exhaustive(ctx: SearchContext) -> SearchResult:
     result = SearchResult(Outcome.GAVE_UP, "")
     ctx.executor.look_around()
-    headings = ctx.options["headings"]
+    headings, retries = ctx.options["headings"], [0]
     for _ in range(ctx.options["max_stops"]):
         stop = ctx.budget_spent()
         if stop:
@@ -35,6 +38,8 @@ def run_exhaustive(ctx: SearchContext) -> SearchResult:
         if found is not None:
             return _found(ctx, result, found)
         target = ctx.executor.nearest_placeholder()
+        if target is None and retry_blocked(ctx, retries):
+            target = ctx.executor.nearest_placeholder()
         if target is None:
             return ctx.end(result, Outcome.GAVE_UP, "explored every reachable placeholder")
         explore(ctx, target)
@@ -44,7 +49,7 @@ def run_exhaustive(ctx: SearchContext) -> SearchResult:
 def run_most_likely_room(ctx: SearchContext) -> SearchResult:
     result = SearchResult(Outcome.GAVE_UP, "")
     ctx.executor.look_around()
-    headings, swept = ctx.options["headings"], set()
+    headings, swept, retries = ctx.options["headings"], set(), [0]
     found = look_all_round(ctx, headings)
     for _ in range(ctx.options["max_stops"]):
         if found is not None:
@@ -53,6 +58,8 @@ def run_most_likely_room(ctx: SearchContext) -> SearchResult:
         if stop:
             return ctx.end(result, Outcome.TIMEOUT, stop)
         choice = most_likely(ctx, swept)
+        if choice is None and retry_blocked(ctx, retries):
+            choice = most_likely(ctx, swept)
         if choice is None:
             return ctx.end(result, Outcome.GAVE_UP, "swept every known room, nothing to explore")
         kind, ident, p = choice
@@ -70,6 +77,20 @@ def _found(ctx: SearchContext, result: SearchResult, obj: KnownObject) -> Search
     result.found = obj
     where = ", ".join(f"{v:.2f}" for v in obj.position)
     return ctx.end(result, Outcome.FOUND, f"{obj.label} at ({where}) in {obj.room}")
+
+
+def retry_blocked(ctx: SearchContext, retries: list[int]) -> bool:
+    """Nothing is left while blocked spots are kept out of: forget them (the place map
+    re-derives what they cut off), at most `retry_blocked` times per episode (`retries` counts
+    them; each touch there widens the berth). True when something was forgotten."""
+    if retries[0] >= ctx.options["retry_blocked"]:
+        return False
+    gone = ctx.mind.retry_blocked()
+    if not gone:
+        return False
+    retries[0] += 1
+    ctx.trace.emit("belief", retry_blocked=[b.id for b in gone], reason="nothing else is left")
+    return True
 
 
 def explore(ctx: SearchContext, placeholder: str) -> None:
@@ -130,23 +151,29 @@ def sweep(ctx: SearchContext, room: str, headings: int) -> KnownObject | None:
 
 
 def standpoints(ctx: SearchContext, room: str, spacing: float) -> list[tuple[float, float]]:
-    """Reachable free cells of the room, one per `spacing` square, nearest-first tour."""
+    """Reachable free cells of the room, one per `spacing` square, nearest-first tour (cells
+    a squeeze reaches when none is reachable with the full margin, as `nearest_placeholder`
+    does)."""
     mind = ctx.mind
     grid, pm = mind.grid, mind.place_map
     ids = [p for p in sorted(pm.places) if pm.room_of(p) is not None]
     if not ids:
         return []
     here = ctx.robot.pose[:2]
-    reach = distance_field(grid, here, mind.config.robot_radius)
-    cells = np.argwhere(np.isfinite(reach))
-    cells = cells[(cells % 4 == 0).all(axis=1)]  # a 4-cell lattice is dense enough here
-    if len(cells) == 0:
-        return []
-    points = grid.to_world(cells)
     centres = np.array([pm.places[p].position for p in ids])
-    nearest = np.linalg.norm(points[:, None, :] - centres[None, :, :], axis=2).argmin(axis=1)
-    mine = np.array([pm.room_of(p) == room for p in ids])[nearest]
-    points = points[mine]
+    mine_of = np.array([pm.room_of(p) == room for p in ids])
+    points = np.zeros((0, 2))
+    for margin in (mind.config.robot_radius, ctx.executor.squeeze_margin()):
+        reach = distance_field(grid, here, margin)
+        cells = np.argwhere(np.isfinite(reach))
+        cells = cells[(cells % 4 == 0).all(axis=1)]  # a 4-cell lattice is dense enough here
+        if len(cells) == 0:
+            continue
+        points = grid.to_world(cells)
+        nearest = np.linalg.norm(points[:, None, :] - centres[None, :, :], axis=2).argmin(axis=1)
+        points = points[mine_of[nearest]]
+        if len(points):
+            break
     keys = np.floor(points / spacing).astype(int)
     picked: dict[tuple[int, int], np.ndarray] = {}
     for key, point in zip(map(tuple, keys), points, strict=True):

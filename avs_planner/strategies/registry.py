@@ -126,11 +126,11 @@ STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
     Strategy("exhaustive", "baseline: frontier exploration, nearest placeholder first, "
              "looking all round at every stop; no priors",
              "avs_planner.strategies.baselines:run_exhaustive",
-             {"headings": 6, "max_stops": 400}),
+             {"headings": 6, "max_stops": 400, "retry_blocked": 2}),
     Strategy("most-likely-room", "baseline: rooms in order of P(object in room), each swept "
              "fully; unexplored space competes as a hypothetical room",
              "avs_planner.strategies.baselines:run_most_likely_room",
-             {"headings": 6, "sweep_spacing": 1.5, "max_stops": 400}),
+             {"headings": 6, "sweep_spacing": 1.5, "max_stops": 400, "retry_blocked": 2}),
     Strategy("qsr", "indirect search (Kunze et al.): survey landmarks and supporting planes, "
              "then views where the QSR mixture (target relative to landmarks) is densest; "
              "abort after 120 s of search",

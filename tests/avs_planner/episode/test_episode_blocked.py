@@ -302,3 +302,31 @@ def test_a_target_behind_a_door_first_seen_obliquely_is_found(robot: str) -> Non
                                   "robot": robot, "seed": 1, "time_budget_s": 900.0})
     summary = Episode(spec).run()
     assert summary["outcome"] == "found" and summary["correct"], summary["reason"]
+
+
+@pytest.mark.parametrize("robot", ["pioneer", "pr2"])
+def test_a_robot_inside_a_new_keep_out_disc_first_steps_out_of_it(robot: str) -> None:
+    """A refused leg that started next to what it touched (a corner the scans had not shown)
+    leaves the robot inside the new keep-out disc: it steps straight away from the touched
+    point before the next path is planned (else that path starts past the same corner)."""
+    sim = open_world(load_spec("office", robot, start=(6.0, 3.2, 0.0)), seed=1)
+    try:
+        mind = Mind.for_body(sim.body())
+        builder = StateBuilder(mind, SearchTask("cerealbox"))
+        events: list[tuple] = []
+        executor = Executor(sim, mind, builder, CameraModel(sim.camera_height, 1.0, 3.5),
+                            lambda *a, **k: events.append((a, k)))
+        executor.look_around()
+        touch = (6.0 + mind.config.robot_radius - 0.02, 3.2)  # just ahead of the rim
+        blockage = mind.block(touch, sim.clock)
+        assert math.dist(sim.pose[:2], touch) < blockage.radius
+        executor._back_off(blockage)
+        assert math.dist(sim.pose[:2], touch) >= blockage.radius
+        assert sim.pose[0] < 6.0 and sim.pose[1] == pytest.approx(3.2, abs=1e-6)
+        assert any(k.get("backed_off") == blockage.id for _, k in events)
+        far = mind.block((9.0, 3.2), sim.clock)  # a touch well away: nothing to step out of
+        before = sim.pose
+        executor._back_off(far)
+        assert sim.pose == before
+    finally:
+        sim.world.close()
