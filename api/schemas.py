@@ -28,6 +28,20 @@ class TaskState(StrEnum):
         return self not in (TaskState.QUEUED, TaskState.RUNNING)
 
 
+class GeneratedWorld(BaseModel):
+    """A building made by the floor-plan generator (`avs world generate`): the same arguments
+    give the same building. The room count's range depends on the style (422 naming it)."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+    seed: int = Field(ge=0, le=2**31 - 1, examples=[3])
+    style: Literal["office", "apartment", "lab"] = "office"
+    rooms: int | None = Field(None, ge=1, le=64, description="rooms off the spine; default: "
+                              "drawn from the seed")
+    surprise: float = Field(0.25, ge=0.0, le=1.0, description="share of small objects placed "
+                            "where the knowledge base rates them unlikely")
+
+
 class TaskCreate(BaseModel):
     """Find `target` (a label) [in a room of `category`] in a world, with a robot.
 
@@ -42,6 +56,9 @@ class TaskCreate(BaseModel):
     world_file: str | None = Field(
         None, max_length=MAX_TEXT, description="an inline world file (YAML text)"
     )
+    generate: GeneratedWorld | None = Field(
+        None, description="a generated building (see `avs world generate`)",
+        examples=[{"seed": 3, "style": "office"}])
     robot: Literal["pioneer", "pr2"] | None = Field(
         None, description="robot model; default: the one the world file names")
     start_room: str | None = Field(None, pattern=NAME_PATTERN)
@@ -66,8 +83,10 @@ class TaskCreate(BaseModel):
 
     @model_validator(mode="after")
     def _one_world(self) -> TaskCreate:
-        if (self.world is None) == (self.world_file is None):
-            raise ValueError("give exactly one of 'world' (a name) or 'world_file' (YAML text)")
+        given = [self.world, self.world_file, self.generate]
+        if sum(v is not None for v in given) != 1:
+            raise ValueError("give exactly one of 'world' (a name), 'world_file' (YAML text) "
+                             "or 'generate' ({seed, style, rooms, surprise})")
         if self.start is not None and self.start_room is not None:
             raise ValueError("give at most one of 'start' and 'start_room'")
         return self

@@ -66,7 +66,7 @@ def _check_task(body: TaskCreate, request: dict, settings: SettingsDep,
         problem = world_file_problem(body.world_file)
         if problem:
             raise _invalid([("world_file", problem)])
-    else:
+    elif body.world is not None:
         path = world_path(settings.worlds_dir, str(body.world))
         if path is None:
             known = ", ".join(f.stem for f in world_files(settings.worlds_dir)) or "none"

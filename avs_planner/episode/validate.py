@@ -18,7 +18,7 @@ from typing import Any
 from matplotlib.path import Path as MplPath
 
 from avs_planner.episode.errors import EpisodeError
-from avs_planner.episode.robot import check_categories, free_spot
+from avs_planner.episode.robot import check_categories, free_spot, generated_spec
 from avs_planner.strategies import get_strategy, strategy_names
 from conceptual_map.knowledge.loader import load_knowledge
 from conceptual_map.knowledge.model import Knowledge
@@ -40,7 +40,8 @@ def check_task(task: Mapping[str, Any], world_path: Path | None = None) -> list[
     """Everything wrong with `task` (the episode spec keys), or []; `world_path` is the file of
     the built-in world `task["world"]` names (ignored when `world_file` is given)."""
     problems = _check_strategy(task) + _check_labels(task, _knowledge()) + _check_qsr(task)
-    field = "world_file" if task.get("world_file") is not None else "world"
+    field = next((key for key in ("world_file", "generate") if task.get(key) is not None),
+                 "world")
     try:
         spec = _world(task, world_path)
         check_categories(spec, _knowledge().categories)
@@ -106,9 +107,23 @@ def _world(task: Mapping[str, Any], world_path: Path | None) -> WorldSpec:
     text = task.get("world_file")
     if text is not None:
         return load_world_text(str(text), "world_file")
+    generate = task.get("generate")
+    if generate is not None:
+        return _generated(tuple(sorted((k, v) for k, v in dict(generate).items()
+                                       if v is not None)))
     if world_path is None:
         raise EpisodeError(f"unknown world {task.get('world')!r}")
     return _world_file(str(world_path), world_path.stat().st_mtime_ns)
+
+
+@lru_cache(maxsize=32)
+def _generated(arguments: tuple[tuple[str, Any], ...]) -> WorldSpec:
+    """The generated building (its robot and start as generated; the task's are checked
+    after). The message drops the runner's `generate: ` prefix: the field names it."""
+    try:
+        return generated_spec(dict(arguments))
+    except EpisodeError as exc:
+        raise EpisodeError(str(exc).removeprefix("generate: ")) from exc
 
 
 @lru_cache(maxsize=32)

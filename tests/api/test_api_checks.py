@@ -146,3 +146,39 @@ def test_a_task_with_qsr_descriptions_is_accepted_and_reaches_the_episode(
         [description] = spec.qsr.descriptions_for("cup")
         assert description.text() == "right(cup, keyboard) & close(cup, keyboard)"
         assert description.count == 2
+
+
+def test_a_generated_building_is_accepted_and_reaches_the_episode(client: TestClient) -> None:
+    from avs_planner.episode.runner import EpisodeSpec
+
+    accepted = client.post("/v1/tasks", json={"target": "stapler", "robot": "pr2",
+                                              "generate": {"seed": 3, "style": "lab"}})
+    assert accepted.status_code == 202, accepted.text
+    request = accepted.json()["request"]
+    assert request["generate"] == {"seed": 3, "style": "lab", "rooms": None, "surprise": 0.25}
+    spec = EpisodeSpec.from_dict({**request, "task_id": "t", "output_dir": None})
+    assert spec.generate["seed"] == 3 and spec.robot == "pr2"
+
+
+@pytest.mark.parametrize(("generate", "loc", "names"), [
+    ({"seed": 3, "rooms": 40}, ["body", "generate"], "rooms: style office takes 3 to 12"),
+    ({"seed": 3, "style": "castle"}, ["body", "generate", "style"], "office"),
+    ({"seed": -1}, ["body", "generate", "seed"], "greater than or equal to 0"),
+    ({"style": "lab"}, ["body", "generate", "seed"], "required"),
+    ({"seed": 3, "floors": 2}, ["body", "generate", "floors"], "not permitted"),
+])
+def test_a_bad_generated_building_is_422_naming_it(client: TestClient, generate: dict,
+                                                   loc: list, names: str) -> None:
+    response = client.post("/v1/tasks", json={"target": "stapler", "generate": generate})
+    assert response.status_code == 422, response.text
+    [error] = [e for e in response.json()["detail"] if e["loc"] == loc]
+    assert names in error["msg"]
+
+
+def test_a_generated_building_is_checked_like_any_world(client: TestClient) -> None:
+    """Its start room and start pose are checked against the generated plan; two worlds at
+    once are refused."""
+    locs = _loc(client, world=None, generate={"seed": 3}, start_room="ballroom")
+    assert ["body", "start_room"] in locs
+    both = client.post("/v1/tasks", json={**GOOD, "generate": {"seed": 3}})
+    assert both.status_code == 422 and "exactly one of" in both.text
