@@ -114,7 +114,7 @@
       return el("tr", { "data-id": task.id },
         el("td", {}, link),
         el("td", { text: r.target + (r.category ? ` (${r.category})` : "") }),
-        el("td", { text: r.world || "(inline)" }),
+        el("td", { text: r.world || (r.generate ? `generated ${r.generate.style || "office"} ${r.generate.seed}` : "(inline)") }),
         el("td", { text: r.strategy || "switching" }),
         el("td", { text: r.seed ?? "" }),
         el("td", {}, el("span", { class: `state state-${task.state}`, text: task.state })),
