@@ -155,7 +155,8 @@ class Driving:
         tries = ((self.squeeze_margin(), False), (radius, True))
         for margin, unknown in tries:
             try:
-                path = plan_path(self.mind.grid, start, goal, margin, allow_unknown=unknown)
+                path = plan_path(self.mind.grid, start, goal, margin, allow_unknown=unknown,
+                                 comfort=radius)
             except MapError:
                 continue
             if path.found:

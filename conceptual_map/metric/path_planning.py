@@ -58,8 +58,15 @@ def plan_path(
     robot_radius: float = 0.25,
     allow_unknown: bool = False,
     smooth: bool = True,
+    comfort: float | None = None,
 ) -> PathResult:
     """Shortest 8-connected path keeping `robot_radius` from obstacles (no corner cutting).
+
+    With `comfort` (a margin larger than `robot_radius`: a squeeze), the smoothed path keeps
+    `comfort` wherever it can: a straight shortcut may enter cells closer to obstacles than
+    that only where the grid path itself had to, so the path squeezes through a narrow door
+    along the cells A* found there, not on a diagonal from the room before it that clips the
+    jamb at the slim margin.
 
     Raises PathQueryError when start or goal lies outside the map, or the goal is blocked.
     A start inside the inflation zone (the robot brushed a wall) may escape it.
@@ -70,7 +77,12 @@ def plan_path(
     if cells is None:
         return PathResult(PathStatus.NO_PATH, (), math.inf, expanded)
     if smooth:
-        cells = _shortcut(grid, cells, mask)
+        sight = mask
+        if comfort is not None and comfort > robot_radius:
+            sight = grid.traversable(comfort, allow_unknown).copy()
+            along = np.asarray(cells)
+            sight[along[:, 0], along[:, 1]] = True
+        cells = _shortcut(grid, cells, sight)
     points = [tuple(p) for p in grid.to_world(np.asarray(cells)).tolist()]
     points[0], points[-1] = (float(start[0]), float(start[1])), (float(goal[0]), float(goal[1]))
     length = float(sum(math.dist(a, b) for a, b in zip(points, points[1:], strict=False)))

@@ -123,3 +123,25 @@ def test_unknown_cells_under_the_robot_do_not_wall_it_in(world: BoxWorld) -> Non
     assert plan_path(blind, start, (2.3, 2.0), robot_radius=0.25).status is PathStatus.FOUND
     # an obstacle under the base is still an obstacle: only unknown cells are assumed free
     assert np.isinf(field[blind.cell_of((-0.5, -0.5))])
+
+
+def test_a_squeeze_keeps_the_comfort_margin_except_where_it_must_squeeze(
+    world: BoxWorld, grid: OccupancyGrid
+) -> None:
+    """Slim margin 0.3 m, comfort 0.42 m, through the 0.92 m door from a corner of one room
+    to the far corner of the other: string pulling on the slim mask alone cuts a diagonal
+    that passes the jamb at the slim margin; with `comfort` the path leaves the comfortable
+    space only for the cells A* had to use in the doorway, so it passes further from the
+    walls (and no nearer than the slim margin anywhere)."""
+    start, goal = (0.6, 3.4), (5.4, 0.6)
+    slim = plan_path(grid, start, goal, robot_radius=0.3)
+    kept = plan_path(grid, start, goal, robot_radius=0.3, comfort=0.42)
+    assert slim.status is kept.status is PathStatus.FOUND
+    near_slim = wall_distance(world, densify(slim.waypoints)).min()
+    near_kept = wall_distance(world, densify(kept.waypoints)).min()
+    assert near_kept >= 0.3 - grid.resolution
+    assert near_kept > near_slim + 0.02
+    assert kept.waypoints[0] == start and kept.waypoints[-1] == goal
+    # no comfort beyond the path's own margin changes nothing
+    same = plan_path(grid, start, goal, robot_radius=0.3, comfort=0.3)
+    assert same.waypoints == slim.waypoints
