@@ -66,6 +66,10 @@ class ExecutorConfig:
     # 96% of the time instead of 78%; a phantom gets there only if another frame put a phantom
     # within `agree` of it, so phantoms cost no more frames than before
     confirm_extra: int = 2
+    # a DT look whose second frame does not repeat the first detection takes a third frame
+    # (`episode/dt_search.py`, `ViewConeSearch._look`); the DT's detector model above stays
+    # the two-frame rule's, so it now slightly over-states misses
+    dt_tiebreak: bool = True
     # before the target is reported the robot faces it and looks again: at least one of
     # this many frames must see it within `agree` m (0: report without looking). Two frames
     # that agree on a phantom are rare, but over the hundreds of looks of a search for an

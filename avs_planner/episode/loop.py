@@ -181,6 +181,9 @@ class SwitchingLoop:
         assert self.planner is not None
         if not _timed_out(result):
             return result
+        # a CP call that ran out of nodes is a call too: `plans` counts the `plan` events,
+        # one per entry of `cp_time_s`
+        self.result.plans += 1
         self.result.cp_times.append(result.planning_time_s)
         dumped = self._dump_problem()
         self.trace.emit("plan", why="timeout", status=result.status.value, plan=[],

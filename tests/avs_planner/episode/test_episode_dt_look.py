@@ -1,0 +1,49 @@
+"""A DT look (PROCESSVIEWCONE): two frames must agree; when they split, a third decides."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from types import SimpleNamespace
+
+import pytest
+
+from avs_planner.episode.dt_search import ViewConeSearch
+
+
+def _seen(x: float, y: float) -> SimpleNamespace:
+    return SimpleNamespace(label="cerealbox", position=(x, y, 0.8))
+
+
+def _look(executor, frames: list, tiebreak: bool = True):  # noqa: ANN001, ANN202
+    executor.config = replace(executor.config, dt_tiebreak=tiebreak)
+    search = ViewConeSearch(executor, "cerealbox", "in", "room1")
+    script = iter(frames)
+    taken = []
+
+    def detect_once(*_args):  # noqa: ANN002, ANN202
+        taken.append(1)
+        return next(script)
+
+    search._detect_once = detect_once
+    return search._look("cerealbox", "in", "room1"), len(taken)
+
+
+@pytest.mark.parametrize(("frames", "found", "taken"), [
+    ([_seen(2.0, 1.0), _seen(2.1, 1.0)], True, 2),  # both agree: two frames, as before
+    ([_seen(2.0, 1.0), None, _seen(2.05, 1.1)], True, 3),  # split: the third agrees
+    ([_seen(2.0, 1.0), None, None], False, 3),  # split: the third does not
+    ([_seen(2.0, 1.0), _seen(4.0, 1.0), None], False, 3),  # a second spot is no agreement
+    ([None], False, 1),  # nothing: one frame
+])
+def test_a_split_look_is_decided_by_a_third_frame(corridor, frames, found, taken) -> None:
+    _, _, executor = corridor
+    match, count = _look(executor, frames)
+    assert (match is not None) == found and count == taken
+    if found:
+        assert match is frames[0]
+
+
+def test_without_the_tiebreak_a_split_look_is_a_miss(corridor) -> None:
+    _, _, executor = corridor
+    match, count = _look(executor, [_seen(2.0, 1.0), None, _seen(2.0, 1.0)], tiebreak=False)
+    assert match is None and count == 2
