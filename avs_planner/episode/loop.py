@@ -209,8 +209,14 @@ class SwitchingLoop:
 
     def _options(self) -> SearchOptions:
         cfg = self.config
+        # the success threshold bounds the search, it does not filter its result: the best
+        # plan by c + R(1 - p) may be a cheap hopeless one (search the kitchen table for a
+        # stapler, p = 0.008, cost 12) while exploring finds it with p = 0.07; filtered
+        # afterwards, that read as "no plan above the threshold" and the robot gave up 27 s
+        # into a building it had not explored (generated office 3, stapler)
         return SearchOptions(reward=cfg.reward, weight=cfg.weight, heuristic=cfg.heuristic,
-                             node_limit=cfg.cp_node_limit, timeout_s=cfg.cp_timeout_s)
+                             node_limit=cfg.cp_node_limit, timeout_s=cfg.cp_timeout_s,
+                             min_success=cfg.min_success)
 
     def _execute(self, step: PlanStep, state: AvsState) -> StepOutcome:
         self.trace.emit("action", action=step.label, status="start")

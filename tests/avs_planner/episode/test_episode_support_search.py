@@ -258,3 +258,19 @@ def test_a_confirmation_one_short_with_agreement_looks_again(corridor, monkeypat
     executor.config = replace(executor.config, confirm_extra=extra)
     assert executor.confirm(seen) is confirmed
     assert len(frames) - len(queue) == taken
+
+
+def test_the_success_threshold_bounds_the_search_not_its_result(corridor) -> None:
+    """The CP is asked for the best plan among those with p >= min_success: filtered after the
+    search, a cheap hopeless best plan (p 0.008) hid a worthwhile one (p 0.07) and the robot
+    gave up 27 s in (generated office 3, stapler)."""
+    from avs_planner.cp.continual import ContinualPlanner
+
+    _, builder, executor = corridor
+    loop = SwitchingLoop(builder, executor, Trace(lambda: executor.robot.clock),
+                         LoopConfig(min_success=0.2))
+    assert loop._options().min_success == 0.2
+    state = builder.build()
+    planner = ContinualPlanner(state.skeleton(), loop._options(), min_success=0.2)
+    result = planner.replan(state.world_state())
+    assert not result.solved or result.probability >= 0.2
