@@ -82,7 +82,6 @@ class SwitchingLoop:
         # (action, belief state) pairs that failed: never executed again (a guard; the state
         # builder already withholds a failed move until something new is learned)
         self.failed: set[tuple[str, int]] = set()
-        self.retries = 0
 
     def run(self) -> SearchResult:
         self.executor.watching = self.config.watch
@@ -294,12 +293,9 @@ class SwitchingLoop:
     def _retry_blocked(self) -> bool:
         """No plan is good enough while blocked spots are kept out of: try them again before
         giving up, at most `retry_blocked` times (each touch there widens the berth)."""
-        if self.retries >= self.config.retry_blocked:
-            return False
-        gone = self.executor.mind.retry_blocked()
+        gone = self.executor.mind.retry_blocked(self.config.retry_blocked)
         if not gone:
             return False
-        self.retries += 1
         self.trace.emit("belief", retry_blocked=[b.id for b in gone],
                         reason="no plan above the threshold")
         return True

@@ -72,6 +72,7 @@ class Mind:
     # (place, move target) -> the blockage evidence when that move failed from that place:
     # while the robot stands there with the same evidence, the move is not offered again
     failed_moves: dict[tuple[str, str], frozenset[str]] = field(default_factory=dict)
+    blocked_retries: int = 0  # times the blocked spots were forgotten (`retry_blocked`)
     clock: float = 0.0  # s: the time of the last scan sensed
 
     def __post_init__(self) -> None:
@@ -109,12 +110,16 @@ class Mind:
             self.grid.set_keep_out(self.blockages.discs())
         return gone
 
-    def retry_blocked(self) -> list[Blockage]:
-        """Forget the active blockages now (nothing else is left to try). The placeholders
-        are re-derived at once: space that only a kept-out spot cut off is a goal again
-        (else the planner would see none until the next scan, and give up)."""
+    def retry_blocked(self, limit: int | None = None) -> list[Blockage]:
+        """Forget the active blockages now (nothing else is left to try), at most `limit`
+        times per episode (each touch there widens the berth, so retrying ends). The
+        placeholders are re-derived at once: space that only a kept-out spot cut off is a
+        goal again (else the planner would see none until the next scan, and give up)."""
+        if limit is not None and self.blocked_retries >= limit:
+            return []
         gone = self.blockages.clear()
         if gone:
+            self.blocked_retries += 1
             self.grid.set_keep_out([])
             self._feed.apply(self.place_map.refresh(self.grid, self.clock))
         return gone

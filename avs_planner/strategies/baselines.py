@@ -29,7 +29,7 @@ MAX_SWEEP_STOPS = 12  # standpoints per room sweep
 def run_exhaustive(ctx: SearchContext) -> SearchResult:
     result = SearchResult(Outcome.GAVE_UP, "")
     ctx.executor.look_around()
-    headings, retries = ctx.options["headings"], [0]
+    headings = ctx.options["headings"]
     for _ in range(ctx.options["max_stops"]):
         stop = ctx.budget_spent()
         if stop:
@@ -38,7 +38,7 @@ def run_exhaustive(ctx: SearchContext) -> SearchResult:
         if found is not None:
             return _found(ctx, result, found)
         target = ctx.executor.nearest_placeholder()
-        if target is None and retry_blocked(ctx, retries):
+        if target is None and retry_blocked(ctx):
             target = ctx.executor.nearest_placeholder()
         if target is None:
             return ctx.end(result, Outcome.GAVE_UP, "explored every reachable placeholder")
@@ -49,7 +49,7 @@ def run_exhaustive(ctx: SearchContext) -> SearchResult:
 def run_most_likely_room(ctx: SearchContext) -> SearchResult:
     result = SearchResult(Outcome.GAVE_UP, "")
     ctx.executor.look_around()
-    headings, swept, retries = ctx.options["headings"], set(), [0]
+    headings, swept = ctx.options["headings"], set()
     found = look_all_round(ctx, headings)
     for _ in range(ctx.options["max_stops"]):
         if found is not None:
@@ -58,7 +58,7 @@ def run_most_likely_room(ctx: SearchContext) -> SearchResult:
         if stop:
             return ctx.end(result, Outcome.TIMEOUT, stop)
         choice = most_likely(ctx, swept)
-        if choice is None and retry_blocked(ctx, retries):
+        if choice is None and retry_blocked(ctx):
             choice = most_likely(ctx, swept)
         if choice is None:
             return ctx.end(result, Outcome.GAVE_UP, "swept every known room, nothing to explore")
@@ -79,16 +79,13 @@ def _found(ctx: SearchContext, result: SearchResult, obj: KnownObject) -> Search
     return ctx.end(result, Outcome.FOUND, f"{obj.label} at ({where}) in {obj.room}")
 
 
-def retry_blocked(ctx: SearchContext, retries: list[int]) -> bool:
+def retry_blocked(ctx: SearchContext) -> bool:
     """Nothing is left while blocked spots are kept out of: forget them (the place map
-    re-derives what they cut off), at most `retry_blocked` times per episode (`retries` counts
-    them; each touch there widens the berth). True when something was forgotten."""
-    if retries[0] >= ctx.options["retry_blocked"]:
-        return False
-    gone = ctx.mind.retry_blocked()
+    re-derives what they cut off), at most `retry_blocked` times per episode
+    (`Mind.retry_blocked`). True when something was forgotten."""
+    gone = ctx.mind.retry_blocked(ctx.options["retry_blocked"])
     if not gone:
         return False
-    retries[0] += 1
     ctx.trace.emit("belief", retry_blocked=[b.id for b in gone], reason="nothing else is left")
     return True
 

@@ -97,16 +97,23 @@ class _HiddenObstacle:
         return self._robot.move_along(path)
 
 
+def _executor(sim, robot) -> tuple[Mind, Executor, list[tuple]]:  # noqa: ANN001
+    """An executor for `robot` (the adapter `sim`, or a wrapper of it) that has looked around
+    once; its events are collected."""
+    mind = Mind.for_body(sim.body())
+    builder = StateBuilder(mind, SearchTask("cerealbox"))
+    events: list[tuple] = []
+    executor = Executor(robot, mind, builder, CameraModel(sim.camera_height, 1.0, 3.5),
+                        lambda *a, **k: events.append((a, k)))
+    executor.look_around()
+    return mind, executor, events
+
+
 def test_a_move_blocked_by_an_unmapped_obstacle_goes_around_it() -> None:
     sim = open_world(load_spec("office", start=(6.0, 3.2, 0.0)), seed=1)
     try:
         robot = _HiddenObstacle(sim, (8.0, 2.9), 0.1)
-        mind = Mind.for_body(sim.body())
-        builder = StateBuilder(mind, SearchTask("cerealbox"))
-        events: list[tuple] = []
-        executor = Executor(robot, mind, builder, CameraModel(sim.camera_height, 1.0, 3.5),
-                            lambda *a, **k: events.append((a, k)))
-        executor.look_around()
+        mind, executor, events = _executor(sim, robot)
         outcome = executor.drive_to((10.0, 3.2))
         assert outcome.status is StepStatus.DONE, outcome.detail
         assert 1 <= robot.refused <= 2 and len(mind.blockages.items) == robot.refused
@@ -308,12 +315,7 @@ def test_a_robot_inside_a_new_keep_out_disc_first_steps_out_of_it(robot: str) ->
     point before the next path is planned (else that path starts past the same corner)."""
     sim = open_world(load_spec("office", robot, start=(6.0, 3.2, 0.0)), seed=1)
     try:
-        mind = Mind.for_body(sim.body())
-        builder = StateBuilder(mind, SearchTask("cerealbox"))
-        events: list[tuple] = []
-        executor = Executor(sim, mind, builder, CameraModel(sim.camera_height, 1.0, 3.5),
-                            lambda *a, **k: events.append((a, k)))
-        executor.look_around()
+        mind, executor, events = _executor(sim, sim)
         touch = (6.0 + mind.config.robot_radius - 0.02, 3.2)  # just ahead of the rim
         blockage = mind.block(touch, sim.clock)
         assert math.dist(sim.pose[:2], touch) < blockage.radius

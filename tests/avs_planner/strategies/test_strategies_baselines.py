@@ -102,20 +102,12 @@ def test_a_phantom_confirmed_close_to_the_camera_is_verified_from_further_away_a
     assert summary["outcome"] != "found" or summary["correct"]
 
 
-_TWO_ROOMS = """name: two_rooms
-size: [15.0, 5.0]
-wall_height: 2.0
-rooms:
-  - {name: hall, category: office, rect: [0.0, 0.0, 5.0, 5.0]}
-  - {name: kitchen, category: kitchen, rect: [5.0, 0.0, 15.0, 5.0]}
-doors:
-  - {rooms: [hall, kitchen], at: [5.0, 2.5], width: 0.9}
-furniture:
-  - {name: table1, label: table, room: kitchen, pose: [12.5, 2.5, 0.0], size: [1.2, 0.8, 0.75]}
-objects:
-  - {name: cereal1, label: cerealbox, on: table1, offset: [0.0, 0.0], size: [0.2, 0.07, 0.3]}
-robot: {model: pioneer, start: [2.5, 2.5, 0.0]}
-"""
+def _two_rooms(door: float) -> str:
+    """A hall and a kitchen joined by one door `door` m wide; the cereal box on a table 7.5 m
+    beyond it (the blocked-move tests' world)."""
+    from tests.avs_planner.episode.test_episode_blocked import _WORLD
+
+    return _WORLD.format(w=door)
 
 
 @pytest.mark.parametrize("strategy", ["exhaustive", "most-likely-room"])
@@ -128,7 +120,7 @@ def test_a_baseline_tries_blocked_spots_again_before_it_gives_up(strategy):
 
     def run(retries: int) -> dict:
         episode = Episode(EpisodeSpec.from_dict(
-            {"target": "cerealbox", "world_file": _TWO_ROOMS, "strategy": strategy, "seed": 1,
+            {"target": "cerealbox", "world_file": _two_rooms(0.9), "strategy": strategy, "seed": 1,
              "strategy_options": {"retry_blocked": retries}}))
         episode.mind.block((5.0, 2.5), 0.0)  # the door
         return episode.run()
@@ -146,7 +138,7 @@ def test_exhaustive_squeezes_a_pr2_through_a_door_the_grid_draws_too_narrow(widt
     goal with the squeeze margin `drive_to` uses (it used to give up at once, 20 s in)."""
     from avs_planner.episode import Episode, EpisodeSpec
 
-    world = _TWO_ROOMS.replace("width: 0.9", f"width: {width}")
+    world = _two_rooms(width)
     summary = Episode(EpisodeSpec.from_dict(
         {"target": "cerealbox", "world_file": world, "strategy": "exhaustive", "seed": 1,
          "robot": "pr2"})).run()
