@@ -339,7 +339,9 @@ def _search_region(ctx: SearchContext, result: SearchResult, volumes: list[Targe
                                                                   head.pan, head.tilt))
         plan = decision.plan
         ctx.trace.emit("flap", event="decision", cycle=k, status=decision.status.value,
-                       candidates=decision.candidates, p_remaining=round(decision.p_remaining, 4),
+                       # unrounded: the value the omega test compared (rounding 0.349956 to
+                       # 4 places would print a 'done' decision at 0.35, above omega 0.35)
+                       candidates=decision.candidates, p_remaining=decision.p_remaining,
                        planned=len(plan.sequence) if plan else 0,
                        expected_time=(round(plan.expected_time, 2) if plan and
                                       math.isfinite(plan.expected_time) else None),
