@@ -430,6 +430,10 @@ class Executor(Driving):
                                target not in self.mind.place_map.placeholders)
         if status.status is StepStatus.DONE and is_placeholder and status.detail != TARGET_SEEN:
             self.look_around()
+        places = self.mind.place_map.places
+        if status.status is StepStatus.DONE and target in places and \
+                math.dist(self.robot.pose[:2], places[target].position) <= self.config.arrive:
+            self.mind.place_map.arrive_at(target)  # arrived by the executor's test: at it
         if status.status is StepStatus.FAILED:
             self.mind.move_failed(target)
         return status

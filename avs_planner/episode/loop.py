@@ -118,6 +118,7 @@ class SwitchingLoop:
             if tried in self.failed:
                 return self._end(Outcome.GAVE_UP, f"{step.label} failed from this very state "
                                  f"before and nothing new was learned since")
+            clock = self.executor.robot.clock
             outcome = self._execute(step, state)
             if outcome.status is StepStatus.FAILED:
                 self.failed.add(tried)
@@ -125,7 +126,10 @@ class SwitchingLoop:
                 self.result.found = outcome.reported
                 return self._end(Outcome.FOUND, outcome.detail)
             self.planner.plan = self.planner.plan[:index] + self.planner.plan[index + 1:]
-            state = self.builder.build()
+            before, state = state, self.builder.build()
+            if self.executor.robot.clock == clock and _signature(state) == tried[1]:
+                self._no_effect(step, before)
+                state = self.builder.build()  # without the withheld move
             settled = step.label if _search_rejected(step, outcome) else None
             result = self._monitor(state, outcome, settled)
             if result is not None:
@@ -139,6 +143,18 @@ class SwitchingLoop:
             if result is not None and not result.solved:
                 return self._end(Outcome.GAVE_UP, self._no_plan(result))
         return self._end(Outcome.TIMEOUT, f"{self.config.max_steps} steps executed")
+
+    def _no_effect(self, step: PlanStep, state: AvsState) -> None:
+        """The step took no time and left the belief state as it was: planned again from
+        that state it would do nothing again, as often as the CP asked (a move between two
+        places that ended where it began was replanned 85 times at one simulated instant).
+        Like a failed step it is evidence: never executed again from this state, and a move
+        is withheld from the plan's topology until something new is learned."""
+        self.failed.add((step.label, _signature(state)))
+        if step.name == "move":
+            self.executor.mind.move_failed(step.args[1])
+        self.trace.emit("belief", no_effect=step.label,
+                        reason="took no time and changed nothing the planner sees")
 
     def _fallback(self, result: PlanResult) -> PlanResult:
         """A search that ran out of time is retried with the fallback heuristic, greedier

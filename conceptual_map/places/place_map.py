@@ -84,6 +84,18 @@ class PlaceMap:
         here = (float(self._path[-1][0]), float(self._path[-1][1]))
         return self._refresh_placeholders(grid, here, time) + self._refresh_rooms(grid, time)
 
+    def arrive_at(self, place_id: str) -> None:
+        """The robot stands at `place_id` by its executor's own test (a move to it ended
+        within arrival distance). Passing by only makes a place current within half the
+        place spacing of it, so a robot that stopped short of that, or never moved because
+        it already stood close enough, would still be "at" the place it left: the move to
+        the new one then succeeds in no time and leaves the planner's state as it was."""
+        if place_id not in self.places:
+            raise MapError(f"PlaceMap.arrive_at: no place {place_id!r}")
+        if place_id != self.current_place:
+            self._connect(self.current_place, place_id, traversed=True)
+            self._arrive(place_id)
+
     def room_of(self, place_id: str) -> str | None:
         """The room holding a place (or, for a placeholder, holding its attached place)."""
         if place_id in self.placeholders:

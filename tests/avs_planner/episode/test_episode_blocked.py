@@ -10,7 +10,7 @@ from avs_planner.episode import Episode, EpisodeSpec
 from avs_planner.episode.executor import Executor
 from avs_planner.episode.loop import SwitchingLoop, _signature
 from avs_planner.episode.mind import Mind
-from avs_planner.episode.outcome import StepStatus
+from avs_planner.episode.outcome import StepOutcome, StepStatus
 from avs_planner.episode.robot import load_spec, open_world
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.trace import Trace
@@ -140,6 +140,33 @@ def test_no_failed_action_is_repeated_from_an_unchanged_state(corridor) -> None:
     result = loop.run()
     assert result.outcome.value == "gave_up", result.reason
     assert executed and len(executed) == len(set(executed))
+    assert mind.failed_moves
+
+
+def test_a_move_that_takes_no_time_and_changes_nothing_is_not_planned_again(corridor) -> None:  # noqa: ANN001
+    """The base "arrives" without moving (the drive ends at once): the step took no time and
+    the belief state is unchanged, so the same move from the same state would do nothing
+    again. It is withheld, like a failed move, instead of replanned at the same instant."""
+    mind, builder, executor = corridor
+    executor.drive_to = lambda goal, stop=None: StepOutcome(StepStatus.DONE)
+    executor.look_around = lambda: None  # arrived at a placeholder: nothing new either
+    executed: list[tuple[str, int]] = []
+    events: list[dict] = []
+    trace = Trace(lambda: executor.robot.clock, None, None)
+    trace.subscribe(events.append)
+    loop = SwitchingLoop(builder, executor, trace)
+    run = loop._execute
+
+    def record(step, state):  # noqa: ANN001, ANN202
+        executed.append((step.label, _signature(state)))
+        return run(step, state)
+
+    loop._execute = record
+    result = loop.run()
+    assert result.outcome.value == "gave_up", result.reason
+    assert executed and len(executed) == len(set(executed))
+    no_effect = [e["no_effect"] for e in events if e.get("no_effect")]
+    assert no_effect and all(label.startswith("(move") for label in no_effect)
     assert mind.failed_moves
 
 
