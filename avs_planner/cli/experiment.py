@@ -2,7 +2,8 @@
 
 `run` executes every episode of a campaign not yet done in --out (so a stopped campaign
 continues where it stopped), on a local process pool or a Ray cluster, with a progress line on
-stderr, and writes results.csv. `report` turns that into a Markdown report with plots.
+stderr, and writes results.csv (noting the git commit it ran at). `report` turns that into a
+Markdown report with plots. `list` shows the built-in campaigns, the held-out ones included.
 Exit codes: 0 ok (failed episodes are recorded, not fatal), 1 bad input, 130 interrupted.
 """
 
@@ -40,7 +41,8 @@ def _register_run(sub: Any) -> None:
                      "machine, or of the Ray cluster)")
     run.add_argument("--address", help="Ray cluster address (default: start Ray locally)")
     run.add_argument("--retry-failed", action="store_true",
-                     help="run again the episodes recorded as crashed, timed out or failed")
+                     help="run again the episodes recorded as crashed, timed out, failed or "
+                     "cut by the wall-clock budget (status wall_cut)")
     run.add_argument("--limit", type=int, help="run at most N episodes now, then stop")
     run.add_argument("--json", action="store_true", help="print the final counts as JSON")
     run.set_defaults(func=run_campaign_command)

@@ -23,6 +23,9 @@ from avs_planner.experiment.values import Where, parse_seeds, positive_number
 
 CAMPAIGN_DIR = Path(__file__).parent / "campaigns"
 DEFAULT_STRATEGY = "switching"
+# The evaluation-only seeds (docs/experiments.md, "Held-out seeds"): nothing is tuned on them.
+HELDOUT_WORLD_SEEDS_FROM = 10000  # generated building seeds from here on
+HELDOUT_FIG3_NOISE_SEEDS = range(100, 120)  # sensor-noise seeds of Fig. 3 a-f
 _TOP_KEYS = {"name", "description", "worlds", "scenarios", "targets", "strategies", "robots",
              "seeds", "time_budget_s", "wall_budget_s"}
 _STRATEGY_KEYS = {"name", "label", "options"}

@@ -4,40 +4,74 @@ CSV because every tool reads it (pandas, R, a spreadsheet, `csv` in the standard
 it needs no new dependency, and a 5,000-run campaign is a few hundred kilobytes; Parquet's
 column compression and types buy nothing at that size. Lists from the summary (CP time per
 plan, DT time per decision) become totals, counts and medians; the full lists stay in each
-run's summary.json.
+run's summary.json. Keys a summary may or may not carry (the DT's confirmations and
+rejections, the map-quality scores in `map_score`) leave their cells empty when absent.
+
+A run's `status` is the campaign's view of it: `ok`; `wall_cut` when the episode ended
+because its wall-clock budget ran out (a loaded machine, not the strategy: its numbers are not
+comparable, and `--retry-failed` runs it again); `error`, `crashed` or `timeout` (killed past
+its hard deadline) when it failed.
 """
 
 from __future__ import annotations
 
 import csv
+import math
 import statistics
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
 RESULTS_FILE = "results.csv"
+WALL_CUT = "wall_cut"
+WALL_CUT_REASON = "wall time budget"  # how the episode loop and strategies word that stop
+MAP_SCORE_KEYS = ("rooms_true", "rooms_matched", "merges", "splits", "category_accuracy",
+                  "entered_area_m2")
 KEY_COLUMNS = ["run_id", "scenario", "world", "group", "target", "expected", "strategy",
                "robot", "seed"]
 VALUE_COLUMNS = ["status", "error", "outcome", "reason", "correct", "success",
                  "correct_give_up", "false_report", "found_label", "sim_time_s", "distance_m",
                  "plans", "replans", "cp_calls", "cp_time_s", "cp_s_per_plan", "dt_calls",
-                 "dt_decisions", "dt_time_s", "dt_s_per_action", "views_processed",
-                 "episode_s", "wall_s", "overhead_s", "backend"]
+                 "dt_decisions", "dt_time_s", "dt_s_per_action", "dt_confirmed",
+                 "dt_rejected", "views_processed",
+                 *(f"map_{k}" for k in MAP_SCORE_KEYS),
+                 "episode_s", "wall_s", "overhead_s", "backend", "commit"]
 COLUMNS = KEY_COLUMNS + VALUE_COLUMNS
-_INTS = {"seed", "plans", "replans", "cp_calls", "dt_calls", "dt_decisions", "views_processed"}
+_INTS = {"seed", "plans", "replans", "cp_calls", "dt_calls", "dt_decisions", "dt_confirmed",
+         "dt_rejected", "views_processed"}
 _BOOLS = {"correct", "success", "correct_give_up", "false_report"}
 _TEXT = {"run_id", "scenario", "world", "group", "target", "expected", "strategy", "robot",
-         "status", "error", "outcome", "reason", "found_label", "backend"}
+         "status", "error", "outcome", "reason", "found_label", "backend", "commit"}
+
+
+def is_wall_cut(outcome: Any, reason: Any) -> bool:
+    """The episode stopped because its wall-clock budget was spent (not its simulated one)."""
+    return outcome == "timeout" and WALL_CUT_REASON in str(reason or "")
+
+
+def run_status(status: str, summary: Any) -> str:
+    """The status to record for a run the worker reported as `status` with `summary`:
+    `wall_cut` for an `ok` episode that the wall-clock budget cut short."""
+    if status == "ok" and isinstance(summary, Mapping) and is_wall_cut(
+            summary.get("outcome"), summary.get("reason")):
+        return WALL_CUT
+    return status
 
 
 def row(record: Mapping[str, Any]) -> dict[str, Any]:
-    """One table row from a run record (see runner.py); episode columns empty if it failed."""
+    """One table row from a run record (see runner.py); episode columns empty if it failed.
+
+    A wall-cut run keeps its episode's numbers (how far it got) but no verdict: `correct`,
+    `success`, `correct_give_up` and `false_report` stay empty."""
     out: dict[str, Any] = {k: record.get(k) for k in KEY_COLUMNS}
     out.update({k: record.get(k) for k in ("status", "error", "episode_s", "wall_s",
-                                           "overhead_s", "backend")})
+                                           "overhead_s", "backend", "commit")})
     summary = record.get("summary")
-    if record.get("status") == "ok" and isinstance(summary, Mapping):
+    status = record.get("status")
+    if status in ("ok", WALL_CUT) and isinstance(summary, Mapping):
         out.update(_summary_columns(summary, record.get("expected") or ""))
+        if status == WALL_CUT:
+            out.update(correct=None, success=None, correct_give_up=None, false_report=None)
     return out
 
 
@@ -56,8 +90,29 @@ def _summary_columns(s: Mapping[str, Any], expected: str) -> dict[str, Any]:
         "plans": s.get("plans"), "replans": s.get("replans"), "cp_calls": len(cp),
         "cp_time_s": round(sum(cp), 4), "cp_s_per_plan": _mean(cp),
         "dt_calls": s.get("dt_calls"), "dt_decisions": len(dt), "dt_time_s": round(sum(dt), 4),
-        "dt_s_per_action": _mean(dt), "views_processed": s.get("views_processed"),
+        "dt_s_per_action": _mean(dt), "dt_confirmed": _count(s.get("dt_confirmed")),
+        "dt_rejected": _count(s.get("dt_rejected")), "views_processed": s.get("views_processed"),
+        **_map_score(s.get("map_score")),
     }
+
+
+def _count(value: Any) -> int | None:
+    """A count from the summary (a number, or a list of decisions), else None."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, int | float):
+        return int(value)
+    if isinstance(value, list):
+        return len(value)
+    return None
+
+
+def _map_score(score: Any) -> dict[str, Any]:
+    """The map-quality scores as `map_*` columns; absent or non-numeric ones stay empty."""
+    score = score if isinstance(score, Mapping) else {}
+    return {f"map_{k}": (v if isinstance(v, int | float) and not isinstance(v, bool)
+                         and math.isfinite(v) else None)
+            for k, v in ((k, score.get(k)) for k in MAP_SCORE_KEYS)}
 
 
 def _mean(values: list[float]) -> float | None:

@@ -3,8 +3,10 @@
 DIR holds `campaign.json` (what ran there), `runs/<run-id>/` (the episode's summary.json,
 trace.jsonl, trajectory.png and our `record.json`: status, error, timing, the spec) and
 `results.csv` (one row per run, rebuilt whenever the runner stops). A run counts as done when
-its record exists for the same episode spec; crashed, timed-out and failed runs are done too
-(recorded with their error) unless `retry_failed` asks for them again.
+its record exists for the same episode spec; crashed, timed-out, failed and wall-cut runs (an
+episode whose wall-clock budget ran out: see results.py) are done too (recorded with their
+error) unless `retry_failed` asks for them again. Each invocation notes in campaign.json when
+it ran and at which git commit (provenance.py); each record carries the commit too.
 """
 
 from __future__ import annotations
@@ -20,7 +22,8 @@ from typing import Any
 from avs_planner.experiment.backends import Backend, Job, Record, make_backend
 from avs_planner.experiment.campaign import Campaign, RunSpec
 from avs_planner.experiment.errors import CampaignError
-from avs_planner.experiment.results import RESULTS_FILE, write_results
+from avs_planner.experiment.provenance import describe, git_state
+from avs_planner.experiment.results import RESULTS_FILE, run_status, write_results
 from avs_planner.experiment.worker import DEFAULT_RUNNER
 
 RECORD_FILE = "record.json"
@@ -90,6 +93,8 @@ def run_campaign(campaign: Campaign, options: RunOptions,
 
 def _run(campaign: Campaign, runs: list[RunSpec], options: RunOptions, backend: Backend,
          on_progress: Callable[[Progress], None] | None) -> CampaignResult:
+    started = time.strftime("%Y-%m-%dT%H:%M:%S%z")
+    git = git_state()
     meta = _claim(options.out, campaign, len(runs))
     records = load_records(options.out, runs)
     todo = [run for run in runs if not _done(records.get(run.run_id), options.retry_failed)]
@@ -103,7 +108,7 @@ def _run(campaign: Campaign, runs: list[RunSpec], options: RunOptions, backend: 
     table = _Table(options.out, runs, records)
 
     def on_done(job: Job, record: Record) -> None:
-        record = _write_record(job, record, backend.name)
+        record = _write_record(job, record, backend.name, describe(git))
         table.add(record)
         progress.done += 1
         progress.failed += record["status"] != "ok"
@@ -118,7 +123,7 @@ def _run(campaign: Campaign, runs: list[RunSpec], options: RunOptions, backend: 
         backend.run(jobs, on_done)
     finally:
         results = table.write()
-        _log_invocation(options.out, meta, progress, backend)
+        _log_invocation(options.out, meta, progress, backend, started, git)
     return CampaignResult(progress, results, time.monotonic() - progress.started,
                           backend.name, backend.slots)
 
@@ -152,6 +157,8 @@ def load_records(out: Path, runs: list[RunSpec]) -> dict[str, Record]:
     for run in runs:
         record = _read_record(run_dir(out, run) / RECORD_FILE)
         if record is not None and record.get("spec") == _jsonable(run.episode):
+            # a record written before wall cuts had their own status says `ok`
+            record["status"] = run_status(record["status"], record.get("summary"))
             records[run.run_id] = record
     return records
 
@@ -165,10 +172,15 @@ def _deadline(run: RunSpec, options: RunOptions) -> float:
     return budget + max(options.kill_margin_s, 0.1 * budget)
 
 
-def _write_record(job: Job, record: Record, backend: str) -> Record:
+def _write_record(job: Job, record: Record, backend: str, commit: str = "unknown") -> Record:
     episode_s = record.get("episode_s")
-    full = {"run_id": job.run.run_id, **job.run.columns(), "status": record["status"],
-            "error": record.get("error"), "backend": backend, "host": socket.gethostname(),
+    summary = record.get("summary")
+    status = run_status(record["status"], summary)
+    error = record.get("error")
+    if status != record["status"] and error is None:
+        error = f"cut by the wall-clock budget: {summary.get('reason')}"
+    full = {"run_id": job.run.run_id, **job.run.columns(), "status": status,
+            "error": error, "backend": backend, "host": socket.gethostname(), "commit": commit,
             "wall_s": _round(record.get("wall_s")), "episode_s": _round(episode_s),
             "overhead_s": _round(record["wall_s"] - episode_s if episode_s is not None
                                  and record.get("wall_s") is not None else None),
@@ -224,11 +236,13 @@ def _write_meta(out: Path, meta: dict[str, Any]) -> None:
         raise CampaignError(f"cannot write to {out}: {exc}") from None
 
 
-def _log_invocation(out: Path, meta: dict[str, Any], progress: Progress, backend: Backend
-                    ) -> None:
-    """What this `run` did, for the report: backend, workers, runs, wall time."""
+def _log_invocation(out: Path, meta: dict[str, Any], progress: Progress, backend: Backend,
+                    started: str, git: dict[str, Any]) -> None:
+    """What this `run` did, for the report: when, at which commit, backend, workers, runs,
+    wall time."""
     meta["invocations"].append({
-        "finished": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "backend": backend.name,
+        "started": started, "finished": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        "commit": git["commit"], "dirty": git["dirty"], "backend": backend.name,
         "workers": backend.slots, "ran": progress.ran, "failed": progress.failed,
         "wall_s": round(time.monotonic() - progress.started, 1)})
     _write_meta(out, meta)

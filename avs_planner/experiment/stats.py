@@ -21,14 +21,21 @@ class Interval:
 
 
 def wilson(successes: int, n: int, z: float = Z95) -> Interval | None:
-    """The Wilson score interval for a binomial rate (good at small n and near 0 or 1)."""
+    """The Wilson score interval for a binomial rate (good at small n and near 0 or 1).
+
+    In exact arithmetic the interval lies in [0, 1] and holds the observed rate; in floating
+    point its ends at 0/n and n/n come out a rounding error off (e.g. 0.9999999999999999 for
+    10/10), so they are clamped into [0, 1] and around the estimate: error bars drawn from
+    `estimate - low` and `high - estimate` are never negative."""
     if n <= 0:
         return None
     p = successes / n
     denominator = 1 + z * z / n
     centre = (p + z * z / (2 * n)) / denominator
     half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denominator
-    return Interval(p, max(0.0, centre - half), min(1.0, centre + half))
+    low = min(max(0.0, centre - half), p)
+    high = max(min(1.0, centre + half), p)
+    return Interval(p, low, high)
 
 
 def quantile(values: Sequence[float], q: float) -> float | None:
@@ -49,15 +56,15 @@ def median(values: Sequence[float]) -> float | None:
 def bootstrap(values: Sequence[float], statistic: Callable[[Sequence[float]], float] = statistics
               .fmean, resamples: int = 2000, seed: int = 0, level: float = 0.95
               ) -> Interval | None:
-    """A percentile bootstrap interval for `statistic` of `values` (e.g. paired differences).
+    """A percentile bootstrap interval for `statistic` of `values` (e.g. paired differences,
+    or `median` of paired ratios).
 
     Seeded, so the same table gives the same report."""
     if not values:
         return None
     rng = random.Random(seed)
     n = len(values)
-    estimates = sorted(statistic([values[rng.randrange(n)] for _ in range(n)])
-                       for _ in range(resamples))
+    estimates = sorted(statistic(rng.choices(values, k=n)) for _ in range(resamples))
     tail = (1 - level) / 2
     return Interval(statistic(values), quantile(estimates, tail) or 0.0,
                     quantile(estimates, 1 - tail) or 0.0)

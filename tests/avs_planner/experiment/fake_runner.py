@@ -59,3 +59,25 @@ def crash_1_raise_2_hang_3(spec: dict[str, Any], emit: Any = None, should_stop: 
     if spec["seed"] == 3:
         time.sleep(60)
     return crash_on_seed_1(spec)
+
+
+def wall_cut_on_seed_1(spec: dict[str, Any], emit: Any = None, should_stop: Any = None
+                       ) -> dict[str, Any]:
+    """Seed 1 ends as the episode loop does when its wall-clock budget runs out."""
+    result = summary(spec)
+    if spec["seed"] == 1:
+        result.update(outcome="timeout", reason="wall time budget 300 s spent", object=None,
+                      correct=False)
+    return result
+
+
+def with_scores(spec: dict[str, Any], emit: Any = None, should_stop: Any = None
+                ) -> dict[str, Any]:
+    """Seed 0 carries map-quality scores and the DT's verdicts; other seeds do not."""
+    result = summary(spec)
+    if spec["seed"] == 0:
+        result.update(map_score={"rooms_true": 6, "rooms_matched": 5, "merges": 1,
+                                 "splits": 0, "category_accuracy": 0.75,
+                                 "entered_area_m2": 40.5, "extra": "ignored"},
+                      dt_confirmed=1, dt_rejected=[{"label": "table"}, {"label": "desk"}])
+    return result

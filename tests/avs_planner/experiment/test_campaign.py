@@ -8,7 +8,11 @@ import pytest
 
 from avs_planner.experiment import CampaignError, load_campaign
 from avs_planner.experiment import subjects as subjects_module
-from avs_planner.experiment.campaign import parse_campaign
+from avs_planner.experiment.campaign import (
+    HELDOUT_FIG3_NOISE_SEEDS,
+    HELDOUT_WORLD_SEEDS_FROM,
+    parse_campaign,
+)
 from avs_planner.experiment.report import PAPER_OUTCOME
 
 STRATEGIES = ["switching", "exhaustive", "most-likely-room"]  # registered in main
@@ -182,3 +186,70 @@ def test_the_built_in_generated_campaign_is_50_worlds_times_3_strategies(monkeyp
     assert len(runs) == 50 * 3 * 3
     assert {r.strategy.name for r in runs} == set(STRATEGIES)
     assert {r.subject.spec["generate"]["rooms"] for r in runs} == {6}
+
+
+def test_the_held_out_campaign_is_unseen_buildings_of_three_styles_by_both_robots(
+        monkeypatch):
+    calls = []
+
+    def fake(seed, style, rooms):
+        calls.append((seed, style, rooms))
+        return [("cup", True), ("book", True), ("stapler", False)]
+
+    monkeypatch.setattr(subjects_module, "generated_targets", fake)
+    runs = load_campaign("heldout").runs()
+    assert len(runs) == 3 * 6 * 3 * 3 * 2
+    assert sorted(calls) == sorted((seed, style, None) for style in ("office", "apartment",
+                                                                     "lab")
+                                   for seed in range(10000, 10006))
+    assert {r.subject.group for r in runs} == {"gen-office", "gen-apartment", "gen-lab"}
+    assert {r.robot for r in runs} == {"pioneer", "pr2"}
+    assert [s.name for s in load_campaign("heldout").strategies] == STRATEGIES
+    assert {r.seed for r in runs} == {100}
+    assert all(r.episode["generate"]["seed"] >= HELDOUT_WORLD_SEEDS_FROM for r in runs)
+    assert {r.subject.expected for r in runs} == {"found", "gave_up"}
+    assert {r.episode["robot"] for r in runs} == {"pioneer", "pr2"}
+
+
+def test_a_pr2_run_of_the_held_out_campaign_searches_the_world_generated_for_the_pr2():
+    pytest.importorskip("sim.generate", reason="the world generator is not in this build")
+    from avs_planner.episode.robot import generated_spec
+    from sim.generate import generate_world
+
+    campaign = load_campaign("heldout")
+    firsts = {}
+    for run in campaign.runs():
+        if run.robot == "pr2":
+            firsts.setdefault(run.subject.group, run)
+    assert len(firsts) == 3
+    for run in firsts.values():
+        gen = run.episode["generate"]
+        ours = generated_spec(gen, run.episode["robot"])
+        for_pr2 = generate_world(gen["seed"], gen["style"], gen["rooms"], robot="pr2").spec()
+        assert ours == for_pr2, run.run_id
+
+
+def test_the_held_out_fig3_campaign_is_a_to_f_over_the_held_out_noise_seeds():
+    runs = load_campaign("heldout-fig3").runs()
+    assert len(runs) == 6 * 20
+    assert {r.subject.scenario: r.subject.expected for r in runs} == PAPER_OUTCOME
+    assert sorted({r.seed for r in runs}) == list(HELDOUT_FIG3_NOISE_SEEDS)
+    assert {r.strategy.name for r in runs} == {"switching"}
+
+
+@pytest.mark.parametrize("name", ["seed003-fig3", "generated-50"])
+def test_development_campaigns_stay_off_the_held_out_seeds(name, monkeypatch):
+    monkeypatch.setattr(subjects_module, "generated_targets",
+                        lambda seed, style, rooms: [("cup", True)])
+    for run in load_campaign(name).runs():
+        assert run.episode.get("generate", {}).get("seed", 0) < HELDOUT_WORLD_SEEDS_FROM
+        if run.subject.scenario:
+            assert run.seed not in HELDOUT_FIG3_NOISE_SEEDS
+
+
+def test_built_in_campaigns_name_papers_by_title_not_by_seed_number():
+    from avs_planner.experiment.campaign import CAMPAIGN_DIR
+
+    for path in CAMPAIGN_DIR.glob("*.yaml"):
+        text = path.read_text(encoding="utf-8").lower()
+        assert "seed 003" not in text and "issue 34" not in text, path.name

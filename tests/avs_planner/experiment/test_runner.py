@@ -104,6 +104,72 @@ def test_an_episode_past_its_wall_budget_is_killed_and_recorded(tmp_path):
     assert rows["e-switching-s0"]["status"] == "ok"
 
 
+def test_an_episode_cut_by_its_wall_budget_is_recorded_as_such_and_retried(tmp_path):
+    result, _ = run(tmp_path, "wall_cut_on_seed_1", campaign={"seeds": "0-1"})
+    rows = {r["run_id"]: r for r in read_results(result.results)}
+    cut = rows["a-switching-s1"]
+    assert cut["status"] == "wall_cut" and result.progress.failed == 2
+    assert (cut["outcome"], cut["reason"]) == ("timeout", "wall time budget 300 s spent")
+    assert cut["success"] is None and cut["false_report"] is None  # no verdict on a cut run
+    assert cut["sim_time_s"] == 101.0  # how far it got
+    assert "wall-clock budget" in cut["error"]
+    assert rows["a-switching-s0"]["status"] == "ok"
+    record = json.loads((tmp_path / "runs" / "a-switching-s1" / "record.json").read_text())
+    assert record["status"] == "wall_cut"
+    again, _ = run(tmp_path, "wall_cut_on_seed_1", campaign={"seeds": "0-1"})
+    assert again.progress.ran == 0  # done, like any recorded failure...
+    retried, _ = run(tmp_path, "summary", campaign={"seeds": "0-1"}, retry_failed=True)
+    assert retried.progress.ran == 2 and retried.progress.failed == 0  # ...until retried
+    assert {r["status"] for r in read_results(retried.results)} == {"ok"}
+
+
+def test_an_old_record_of_a_wall_cut_episode_as_ok_is_retried(tmp_path):
+    run(tmp_path, "wall_cut_on_seed_1", campaign={"seeds": "0-1"})
+    path = tmp_path / "runs" / "e-switching-s1" / "record.json"
+    record = json.loads(path.read_text())
+    path.write_text(json.dumps({**record, "status": "ok"}))  # as written before wall_cut
+    result, _ = run(tmp_path, "summary", campaign={"seeds": "0-1"}, limit=0)
+    status = {r["run_id"]: r["status"] for r in read_results(result.results)}
+    assert status["e-switching-s1"] == "wall_cut"
+    retried, _ = run(tmp_path, "summary", campaign={"seeds": "0-1"}, retry_failed=True)
+    assert retried.progress.ran == 2
+
+
+def test_each_run_records_the_git_commit_it_ran_at(tmp_path, monkeypatch):
+    from avs_planner.experiment import runner as runner_module
+
+    monkeypatch.setattr(runner_module, "git_state",
+                        lambda: {"commit": "abc1234", "dirty": True})
+    result, _ = run(tmp_path, campaign={"seeds": "0"})
+    assert {r["commit"] for r in read_results(result.results)} == {"abc1234+dirty"}
+    invocation = json.loads((tmp_path / "campaign.json").read_text())["invocations"][0]
+    assert (invocation["commit"], invocation["dirty"]) == ("abc1234", True)
+    assert invocation["started"] <= invocation["finished"]
+
+
+def test_the_git_state_of_this_checkout_and_of_no_checkout(tmp_path):
+    from avs_planner.experiment.provenance import describe, git_state
+
+    assert git_state(tmp_path) == {"commit": "unknown", "dirty": None}
+    assert describe(git_state(tmp_path)) == "unknown"
+    here = git_state()
+    if here["commit"] != "unknown":  # a git checkout with git installed
+        assert len(here["commit"]) >= 7 and here["dirty"] in (True, False)
+    assert describe({"commit": "abc1234", "dirty": False}) == "abc1234"
+
+
+def test_map_scores_and_dt_verdicts_become_columns_when_the_summary_has_them(tmp_path):
+    result, _ = run(tmp_path, "with_scores", campaign={"seeds": "0-1"})
+    rows = {r["run_id"]: r for r in read_results(result.results)}
+    scored, plain = rows["a-switching-s0"], rows["a-switching-s1"]
+    assert (scored["map_rooms_true"], scored["map_rooms_matched"], scored["map_merges"],
+            scored["map_splits"]) == (6, 5, 1, 0)
+    assert (scored["map_category_accuracy"], scored["map_entered_area_m2"]) == (0.75, 40.5)
+    assert (scored["dt_confirmed"], scored["dt_rejected"]) == (1, 2)  # a count, or a list
+    assert all(plain[c] is None for c in ("map_rooms_true", "map_category_accuracy",
+                                          "dt_confirmed", "dt_rejected"))
+
+
 def test_a_directory_of_another_campaign_is_refused(tmp_path):
     (tmp_path / "campaign.json").write_text(json.dumps({"name": "other"}))
     with pytest.raises(CampaignError, match="holds campaign 'other', not 'tiny'"):
@@ -127,7 +193,7 @@ def test_a_record_that_cannot_be_written_stops_the_campaign_with_its_error(tmp_p
                                                                           monkeypatch):
     from avs_planner.experiment import runner as runner_module
 
-    def full_disk(job, record, backend):
+    def full_disk(job, record, *args):
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(runner_module, "_write_record", full_disk)
