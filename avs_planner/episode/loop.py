@@ -17,6 +17,7 @@ from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep, SearchOption
 from avs_planner.episode.executor import Executor
 from avs_planner.episode.outcome import Outcome, SearchResult, StepOutcome, StepStatus
 from avs_planner.episode.state_builder import AvsState, StateBuilder
+from avs_planner.episode.stopping import remaining
 from avs_planner.episode.trace import Trace
 
 
@@ -65,6 +66,9 @@ class LoopConfig:
     look_headings: int = 6
     # price moves and searches in the robot's own seconds (`BuilderConfig.seconds`)
     seconds: bool = False
+    # give up when no continuation is worth its cost against the building-level belief
+    # (`episode/stopping.py`), not only when no single plan reaches the threshold
+    stop_rule: bool = True
 
 
 class SwitchingLoop:
@@ -110,6 +114,9 @@ class SwitchingLoop:
             stop = self._budget_spent()
             if stop:
                 return self._end(Outcome.TIMEOUT, stop)
+            hopeless = self._hopeless()
+            if hopeless:
+                return self._end(Outcome.GAVE_UP, hopeless)
             index = next((i for i, s in enumerate(self.planner.plan) if not s.assumptive), None)
             if index is None:
                 return self._end(Outcome.GAVE_UP, "plan has no executable step")
@@ -183,8 +190,27 @@ class SwitchingLoop:
                               "best_probability": result.probability,
                               "best_cost": result.cost})
 
+    def _hopeless(self) -> str | None:
+        """Why going on is worse than giving up by the building-level belief
+        (`stopping.remaining`), or None while some continuation is worth its cost."""
+        if not self.config.stop_rule:
+            return None
+        belief = remaining(self.executor.mind, self.builder, self.executor.robot.pose[:2])
+        if belief.worth_going_on(self.config.reward):
+            return None
+        best = belief.best(self.config.reward)
+        self.trace.emit("belief", p_unsearched=round(belief.p, 5), options=len(belief.options),
+                        best=None if best is None else
+                        {"kind": best.kind, "name": best.name, "p": round(best.p, 5),
+                         "cost": round(best.cost, 2)},
+                        reward=self.config.reward)
+        return belief.describe(self.config.reward)
+
     def _no_plan(self, result: PlanResult) -> str:
         """Why the episode gives up, in words."""
+        hopeless = self._hopeless()
+        if hopeless:
+            return hopeless
         if result.extra.get("not_worth"):
             return (f"no plan is worth its cost: the best left finds the target with "
                     f"p={result.extra['best_probability']:.3g} at cost "
@@ -253,6 +279,8 @@ class SwitchingLoop:
                 result = self._plan_again("after exploring")
             if result.solved:
                 return result
+            if self._hopeless():
+                return result  # the caller gives up, naming the probability left
             if result.extra.get("not_worth") and self._explore_instead():
                 # nothing on the mapped part is worth searching, but exploring is worth
                 # more than the one chain of assumptions a plan puts on it (`_worth_it`)
@@ -398,6 +426,10 @@ class SwitchingLoop:
 
     def _end(self, outcome: Outcome, reason: str) -> SearchResult:
         if outcome is Outcome.GAVE_UP:
+            if self.config.stop_rule and "space not yet searched" not in reason:
+                left = remaining(self.executor.mind, self.builder,
+                                 self.executor.robot.pose[:2]).p
+                reason += f"; P(target in space not yet searched) = {left:.3g}"
             reason += self._cut_off()
         self.result.outcome, self.result.reason = outcome, reason
         self.trace.emit("done", outcome=outcome.value, reason=reason)

@@ -437,6 +437,10 @@ class StateBuilder:
         p = cmap.p_object_at_per_category(self.task.target, room)
         return float(np.max(p)) >= self.config.min_probability
 
+    def travel_speed(self) -> float:
+        """Metres per unit of move cost (the body's speed when costs are seconds, else 1)."""
+        return self._speed()
+
     def _speed(self) -> float:
         body = self.mind.body
         return body.linear_speed if self.config.seconds and body is not None else 1.0

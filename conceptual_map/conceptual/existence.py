@@ -203,6 +203,27 @@ class ObjectLedger:
             total = total + knowledge.room_lambda(support) * unseen * lam
         return total
 
+    def unsearched_lambda(self, label: str, room: str) -> np.ndarray:
+        """Per category, the expected count of `label` in `room` that no look has ruled out:
+        `unexplained_lambda` plus the related spaces of the room's known objects, each
+        thinned by the looks there."""
+        total = self.unexplained_lambda(label, room)
+        for space in self.sublocations(room, label):
+            total = total + self.location_lambda(label, space) * self.remaining(space, label)
+        return total
+
+    def fresh_room_lambda(self, label: str) -> np.ndarray:
+        """Per category, the expected count of `label` in a room nobody has looked at: its
+        floor and walls plus, for each support the knowledge lists, that support's count
+        times what one holds."""
+        self.require_label(label)
+        knowledge = self.knowledge
+        total = knowledge.room_lambda(label)
+        for (lab, _relation, support), lam in knowledge.relation_lambda.items():
+            if lab == label:
+                total = total + knowledge.room_lambda(support) * lam
+        return total
+
     def location_lambda(self, label: str, location: Location) -> np.ndarray:
         """Prior expected count of `label` at `location`, per category."""
         self.require_label(label)

@@ -26,6 +26,7 @@ from conceptual_map.conceptual.placeholders import (
     NO_NEW_ROOM,
     PlaceholderEvidence,
     PlaceholderPrediction,
+    p_label_beyond,
     predict,
 )
 from conceptual_map.knowledge import Knowledge, load_knowledge
@@ -291,6 +292,21 @@ class ConceptualMap:
         `label` already found do not count: this is about one more."""
         self.graph.require_room(room)
         return p_at_least_one(self.objects.unexplained_lambda(label, room))
+
+    def p_unsearched(self, label: str, room: str) -> float:
+        """P(at least one `label` in `room` where no look has ruled it out: the room, its
+        supports not found yet and its known objects' spaces), over the category belief.
+        The building-level stopping rule sums this over rooms and placeholders."""
+        self.graph.require_room(room)
+        lam = self.objects.unsearched_lambda(label, room)
+        return float(self.room_marginal(room) @ p_at_least_one(lam))
+
+    def p_beyond_placeholder(self, label: str, placeholder: str) -> float:
+        """P(at least one `label` in the new rooms a placeholder may lead to)
+        (`placeholders.p_label_beyond`: the exploration hypotheses and their categories)."""
+        evidence = self._placeholder(placeholder)
+        return p_label_beyond(self.knowledge, self.room_marginal(evidence.room), evidence,
+                              self.objects.fresh_room_lambda(label))
 
     def p_object_at_category(
         self, label: str, category: str, support_label: str | None = None, relation: str = "on"

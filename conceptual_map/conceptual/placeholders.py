@@ -135,3 +135,20 @@ def _two_rooms(knowledge: Knowledge, room_marginal: np.ndarray) -> tuple[np.ndar
     joint /= joint.sum()
     first, second = joint.sum(axis=1), joint.sum(axis=0)
     return first, first + second - np.diag(joint)
+
+
+def p_label_beyond(
+    knowledge: Knowledge, room_marginal: np.ndarray, evidence: PlaceholderEvidence,
+    room_lambda: np.ndarray,
+) -> float:
+    """P(at least one object in the new rooms behind the placeholder), where a new room of
+    category c holds Poisson(`room_lambda[c]`) of them: each hypothesis's rooms with their
+    category posterior (one room, or the chain N1 - N2 jointly), weighted as in `predict`."""
+    weights = hypothesis_weights(knowledge.placeholder, evidence)
+    none = np.exp(-np.asarray(room_lambda, dtype=float))
+    one = 1.0 - float(_one_room(knowledge, room_marginal) @ none)
+    phi, prior = knowledge.connectivity, knowledge.prior
+    joint = (prior * (room_marginal @ phi))[:, None] * phi * prior[None, :]
+    two = 1.0 - float(none @ (joint / joint.sum()) @ none)
+    by_rooms = {0: 0.0, 1: one, 2: two}
+    return sum(w * by_rooms[h.new_rooms] for h, w in weights.items())

@@ -1,0 +1,124 @@
+"""Knowing when to stop: a building-level belief that the target is still to be found.
+
+The switching planner's plans each carry one chain of assumptions, so "no plan above the
+threshold" says little about the building as a whole, and a plan that explores is never
+judged worth its cost (`SwitchingLoop._worth_it`): a robot looking for something that is not
+there explored every frontier and ran out of time. Here the conceptual map answers for the
+whole building: P(target in space not yet searched | everything seen), from its Poisson
+existence model over known rooms (their floors, supports not found yet, the spaces of known
+supports, all thinned by every look, glimpses included) and over what placeholders may lead
+to (the exploration hypotheses of Göbelbecker et al., "A Planning Approach to Active Visual
+Search in Large Environments").
+
+The stopping rule uses the paper's own objective c + R(1 - p): a continuation (search a known
+room, explore behind a placeholder) can at best find the target with the probability of the
+space it opens, and costs at least the way there and the cheapest search that could find the
+target in it. When no continuation has R * p > c, continuing is worse than giving up by the
+planner's own measure, whatever plan it would make; the give-up names the probability left.
+Costs are in the planner's units (`StateBuilder`: metres over the body's speed, search costs).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from avs_planner.episode.mind import Mind
+from avs_planner.episode.state_builder import StateBuilder
+from conceptual_map.metric.path_planning import PathQueryError, distance_field
+
+
+@dataclass(frozen=True)
+class Option:
+    """One way to go on: search a known room or explore behind a placeholder."""
+
+    kind: str  # "room" or "placeholder"
+    name: str
+    p: float  # P(the target is in the space it opens)
+    cost: float  # a lower bound on what it costs (planner units)
+
+    def value(self, reward: float) -> float:
+        return reward * self.p - self.cost
+
+
+@dataclass(frozen=True)
+class Remaining:
+    """The building-level belief: P(target in space not yet searched) and the options."""
+
+    p: float
+    options: tuple[Option, ...]
+
+    def best(self, reward: float) -> Option | None:
+        return max(self.options, key=lambda o: o.value(reward), default=None)
+
+    def worth_going_on(self, reward: float) -> bool:
+        best = self.best(reward)
+        return best is not None and best.value(reward) > 0.0
+
+    def describe(self, reward: float) -> str:
+        best = self.best(reward)
+        head = f"P(target in space not yet searched) = {self.p:.3g}"
+        if best is None:
+            return f"{head}; nothing is left to search or explore"
+        return (f"{head}; no continuation is worth its cost (reward {reward:g} x p < cost): "
+                f"the best, {best.kind} {best.name}, p = {best.p:.3g} at cost >= "
+                f"{best.cost:.0f}")
+
+
+def remaining(mind: Mind, builder: StateBuilder, here: tuple[float, float]) -> Remaining:
+    """The building-level belief for the builder's target, seen from the robot at `here`."""
+    label, cmap, pm = builder.task.target, mind.cmap, mind.place_map
+    try:
+        field_ = distance_field(mind.grid, here, mind.config.robot_radius)
+    except PathQueryError:
+        field_ = None
+    speed = builder.travel_speed()
+    search = _cheapest_searches(builder)
+    options: list[Option] = []
+    for rid, room in pm.rooms.items():
+        if not cmap.graph.has_room(rid):
+            continue
+        spots = [pm.places[p].position for p in room.places if p in pm.places]
+        p = cmap.p_unsearched(label, rid)
+        supported = bool(cmap.objects.sublocations(rid, label))
+        cost = _travel(mind, field_, here, spots) / speed + (search.known if supported
+                                                        else search.fresh)
+        options.append(Option("room", rid, p, cost))
+    tries, limit = mind.tried_placeholders, builder.config.max_placeholder_tries
+    for pid, ph in pm.placeholders.items():
+        if tries.get(pid, 0) >= limit or pid not in cmap.placeholders:
+            continue
+        p = cmap.p_beyond_placeholder(label, pid)
+        cost = _travel(mind, field_, here, [ph.position]) / speed + search.fresh
+        options.append(Option("placeholder", pid, p, cost))
+    none_left = math.prod(1.0 - o.p for o in options)
+    return Remaining(1.0 - none_left, tuple(options))
+
+
+@dataclass(frozen=True)
+class _Searches:
+    known: float  # the cheapest search that could find the target where a support is known
+    fresh: float  # ... where none is: search the room, or find a support and search it
+
+
+def _cheapest_searches(builder: StateBuilder) -> _Searches:
+    target = builder.task.target
+    in_room, on_support = builder.search_cost(target, "in"), builder.search_cost(target, "on")
+    supports = [builder.search_cost(s, "in") for s in builder.labels if s != target]
+    return _Searches(min(in_room, on_support),
+                     min(in_room, on_support + min(supports, default=math.inf)))
+
+
+def _travel(mind: Mind, field_, here: tuple[float, float],  # noqa: ANN001
+            spots: list[tuple[float, float]]) -> float:
+    """Metres from the robot to the nearest of `spots`: by grid path where the grid has one,
+    else the straight line (a lower bound, like every cost here: a squeeze or a door the
+    grid does not show yet may still lead there)."""
+    best = math.inf
+    for spot in spots:
+        cell = mind.grid.cell_of(spot)
+        if field_ is not None and mind.grid.contains(cell) and math.isfinite(field_[cell]):
+            best = min(best, float(field_[cell]))
+        else:
+            best = min(best, math.dist(here, spot))
+    return best if math.isfinite(best) else 0.0

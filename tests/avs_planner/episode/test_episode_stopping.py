@@ -1,0 +1,75 @@
+"""The building-level stopping rule (`episode/stopping.py`) on the office corridor's map."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avs_planner.episode.stopping import Option, Remaining, remaining
+from conceptual_map.conceptual.existence import ObjectLedger
+from conceptual_map.conceptual.placeholders import PlaceholderEvidence, p_label_beyond
+from conceptual_map.knowledge import load_knowledge
+
+
+def test_unsearched_rooms_and_placeholders_keep_the_search_going(corridor) -> None:  # noqa: ANN001
+    """After one look around the corridor: doors and frontiers may lead to a kitchen, so the
+    cereal box may well be in the building and exploring is worth its cost."""
+    mind, builder, executor = corridor
+    belief = remaining(mind, builder, executor.robot.pose[:2])
+    kinds = {o.kind for o in belief.options}
+    assert kinds == {"room", "placeholder"}
+    assert 0.3 < belief.p < 1.0
+    assert belief.worth_going_on(500.0)
+    best = belief.best(500.0)
+    assert best is not None and best.kind == "placeholder" and best.p > 0.1
+
+
+def test_a_building_searched_through_gives_up_naming_what_is_left(corridor) -> None:  # noqa: ANN001
+    """Every placeholder explored and every room looked through: the probability left is
+    small, no continuation is worth its cost, and the reason says how much is left."""
+    mind, builder, executor = corridor
+    for pid in mind.place_map.placeholders:
+        mind.tried_placeholders[pid] = builder.config.max_placeholder_tries
+    for rid in mind.place_map.rooms:
+        for label in builder.labels:
+            mind.cmap.observe_search(label, rid, coverage=1.0, p_detect=0.95)
+        for space in mind.cmap.objects.sublocations(rid, builder.task.target):
+            mind.cmap.observe_search(builder.task.target, space, coverage=1.0, p_detect=0.95)
+    belief = remaining(mind, builder, executor.robot.pose[:2])
+    assert {o.kind for o in belief.options} == {"room"}
+    assert belief.p < 0.1
+    assert not belief.worth_going_on(500.0)
+    text = belief.describe(500.0)
+    assert "P(target in space not yet searched)" in text
+    assert "no continuation is worth its cost" in text
+    # a much larger reward makes the same small chance worth a look again
+    assert belief.worth_going_on(1e6)
+
+
+def test_the_rule_weighs_probability_against_cost() -> None:
+    options = (Option("room", "room1", 0.05, 30.0), Option("placeholder", "placeholder1", 0.2,
+                                                            120.0))
+    belief = Remaining(0.24, options)
+    assert not belief.worth_going_on(500.0)  # 25 < 30 and 100 < 120
+    assert belief.best(500.0).name == "room1"
+    assert belief.worth_going_on(700.0)  # 140 > 120
+    assert not Remaining(0.0, ()).worth_going_on(500.0)
+    assert "nothing is left" in Remaining(0.0, ()).describe(500.0)
+
+
+def test_p_beyond_a_placeholder_follows_its_hypotheses() -> None:
+    """No open space and no door: nothing behind it. A door: at least one new room, whose
+    chance to hold a cereal box is its category posterior against the fresh-room lambda."""
+    knowledge = load_knowledge()
+    ledger = ObjectLedger(knowledge)
+    lam = ledger.fresh_room_lambda("cerealbox")
+    marginal = np.full(len(knowledge.categories), 1.0 / len(knowledge.categories))
+    closed = p_label_beyond(knowledge, marginal, PlaceholderEvidence("r", 0.0, 0.0), lam)
+    door = p_label_beyond(knowledge, marginal, PlaceholderEvidence("r", 0.0, 1.0), lam)
+    assert closed == pytest.approx(0.0)
+    assert 0.0 < door < 1.0
+    # more rooms cannot make it less likely; a label no room holds is never behind it
+    zero = p_label_beyond(knowledge, marginal, PlaceholderEvidence("r", 0.0, 1.0), lam * 0.0)
+    assert zero == pytest.approx(0.0)
+    ledger.record_search("cerealbox", "r", coverage=1.0, p_detect=1.0)  # not a fresh room
+    assert np.all(ledger.fresh_room_lambda("cerealbox") == lam)
