@@ -19,7 +19,20 @@ class Settings(BaseSettings):
 
     model_config = SettingsConfigDict(env_prefix="AVS_", extra="ignore")
 
-    api_key: str | None = Field(None, description="required in X-API-Key on mutating calls")
+    api_key: str | None = Field(None, description="an admin key, required in X-API-Key (the "
+                                "original single-key setting; see also api_keys, keys_file)")
+    api_keys: str | None = Field(
+        None, description="more keys, 'NAME:ROLE:KEY' separated by commas or spaces; ROLE is "
+        "read, submit or admin")
+    keys_file: Path | None = Field(
+        None, description="a YAML or JSON file of keys: {keys: [{name, role, key or "
+        "key_sha256, max_queued, max_plan_jobs}]}")
+    open_reads: bool = Field(False, description="with keys set, let GET calls without a key "
+                             "read every task (as before keys had roles)")
+    key_max_queued: int = Field(4, ge=0, description="queued tasks per non-admin key (its "
+                                "entry may say otherwise); 0: no limit")
+    key_max_plan_jobs: int = Field(2, ge=0, description="plan/check jobs in flight per "
+                                   "non-admin key; 0: no limit")
     host: str = "127.0.0.1"
     port: int = Field(8000, ge=0, le=65535)
     data_dir: Path = Path(".avs-data")
@@ -91,7 +104,7 @@ class Settings(BaseSettings):
 
     def is_open(self) -> bool:
         """True when no API key is configured (then the service must stay on loopback)."""
-        return not self.api_key
+        return not (self.api_key or (self.api_keys or "").strip() or self.keys_file)
 
 
 def is_loopback(host: str) -> bool:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 import re
+import sqlite3
 import threading
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
@@ -17,13 +18,14 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from api import lock
 from api.config import Settings
 from api.docs import add_docs
+from api.limits import bounded, short
 from api.manager import TaskManager
 from api.middleware import BodyLimitMiddleware
 from api.pages import add_pages
 from api.plan_jobs import PlanJobs
 from api.routes import domains, misc, plans, tasks
-from api.security import RateLimiter
-from api.store import TaskStore
+from api.security import KeyRing, RateLimiter
+from api.store import StorageError, TaskStore
 from api.worlds import default_worlds_dir
 from avs_planner import __version__
 
@@ -34,8 +36,10 @@ _BODY_PARSE_ERROR = "There was an error parsing the body"  # FastAPI's 400 for u
 
 def create_app(settings: Settings | None = None) -> FastAPI:
     """A ready-to-serve app; its lifespan locks the data dir, opens the store and starts the
-    worker processes. `app.state.draining` (set on a stop signal) ends open event streams."""
+    worker processes. `app.state.draining` (set on a stop signal) ends open event streams.
+    `KeySettingsError` when the key settings are wrong."""
     settings = settings or Settings()
+    keys = KeyRing.from_settings(settings)
     if settings.worlds_dir is None:
         settings = settings.model_copy(update={"worlds_dir": default_worlds_dir()})
 
@@ -47,7 +51,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         manager.start()
         app.state.manager = manager
         app.state.plan_jobs = PlanJobs(manager, settings.plan_results_kept)
-        _log_access_mode(settings)
+        _log_access_mode(settings, keys)
         try:
             yield
         finally:
@@ -65,6 +69,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     app.add_middleware(BodyLimitMiddleware, max_bytes=settings.max_body_bytes)
     app.state.settings = settings
+    app.state.keys = keys
     app.state.draining = threading.Event()
     app.state.rate_limiter = RateLimiter(settings.rate_limit_per_minute, settings.rate_limit_burst)
     for module in (tasks, plans, domains, misc):
@@ -75,21 +80,29 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     return app
 
 
-def _log_access_mode(settings: Settings) -> None:
-    if settings.is_open():
+def _log_access_mode(settings: Settings, keys: KeyRing) -> None:
+    if keys.open:
         log.warning(
-            "AVS_API_KEY is not set: mutating calls need no key, so the service must only listen "
-            "on a loopback address (here %s)", settings.host,
+            "no API keys are set (AVS_API_KEY, AVS_API_KEYS, AVS_KEYS_FILE): calls need no "
+            "key, so the service must only listen on a loopback address (here %s)",
+            settings.host,
         )
-    else:
-        log.info("API key required in X-API-Key for POST and DELETE calls")
+        return
+    roles = ", ".join(f"{k.name} ({k.role.label})" for k in keys.keys)
+    reads = "open to anyone (AVS_OPEN_READS)" if keys.open_reads else "need a key too"
+    log.info("%d API key(s) in X-API-Key: %s; reads %s", len(keys.keys), roles, reads)
 
 
 def _add_error_handlers(app: FastAPI) -> None:
+    """Every error is JSON with a bounded `detail`: validation errors keep only type, loc and
+    msg (never the input, which may be huge), each string cut to a short excerpt."""
+
     @app.exception_handler(RequestValidationError)
     async def validation_error(request: Request, exc: RequestValidationError) -> JSONResponse:
-        errors = [{k: v for k, v in e.items() if k in ("type", "loc", "msg")} for e in exc.errors()]
-        return JSONResponse({"detail": errors}, status.HTTP_422_UNPROCESSABLE_CONTENT)
+        errors = [{"type": e.get("type"), "loc": [short(str(x), 64) if isinstance(x, str)
+                                                  else x for x in e.get("loc", ())],
+                   "msg": short(str(e.get("msg", "")))} for e in exc.errors()]
+        return JSONResponse({"detail": bounded(errors)}, status.HTTP_422_UNPROCESSABLE_CONTENT)
 
     @app.exception_handler(StarletteHTTPException)
     async def http_error(request: Request, exc: StarletteHTTPException) -> Response:
@@ -99,7 +112,24 @@ def _add_error_handlers(app: FastAPI) -> None:
             detail = [{"type": "json_invalid", "loc": ["body"],
                        "msg": "the body is not valid JSON text (UTF-8)"}]
             return JSONResponse({"detail": detail}, status.HTTP_422_UNPROCESSABLE_CONTENT)
+        exc.detail = bounded(exc.detail)
         return await http_exception_handler(request, exc)
+
+    @app.exception_handler(StorageError)
+    @app.exception_handler(sqlite3.Error)
+    async def storage_error(request: Request, exc: Exception) -> JSONResponse:
+        log.error("%s %s: storage error: %s", request.method, request.url.path, exc)
+        message = str(exc) if isinstance(exc, StorageError) else f"storage error: {exc}"
+        return JSONResponse(
+            {"detail": short(f"{message}; retry later (see /v1/health)")},
+            status.HTTP_503_SERVICE_UNAVAILABLE, headers={"Retry-After": "10"})
+
+    @app.exception_handler(Exception)
+    async def internal_error(request: Request, exc: Exception) -> JSONResponse:
+        # a bug: logged with its traceback by the server; the client gets JSON, not text
+        return JSONResponse(
+            {"detail": short(f"internal error ({type(exc).__name__}); the service log has "
+                             "the details")}, status.HTTP_500_INTERNAL_SERVER_ERROR)
 
 
 def _method_not_allowed(request: Request) -> Response:

@@ -2,6 +2,12 @@
 
 Also runs the synchronous plan/check jobs in their own small pool so that long episodes never
 block a knowledge engineer's request.
+
+Storage faults are survived without a restart: a task whose events cannot be written is
+stopped and failed with the reason; a task that cannot be claimed stays queued; writes that
+failed (a final state, a state event) wait in order. A supervisor thread retries them (and
+probes the store) every `SUPERVISE_S`, runs the waiting tasks once writes work again, and
+restarts any worker slot thread that died.
 """
 
 from __future__ import annotations
@@ -11,14 +17,17 @@ import logging
 import threading
 import time
 import uuid
+from collections import Counter, deque
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from api.config import Settings
+from api.limits import short, without_file_options
 from api.schemas import TaskState
-from api.store import TaskRecord, TaskStore
+from api.security import Caller
+from api.store import StorageError, TaskRecord, TaskStore
 from api.worker_process import PRELOAD_JOBS, resolve
 from api.workers import Job, JobOutcome, JobResult, WorkerPool
 
@@ -40,8 +49,16 @@ _JOB_STATES = {
 TaskChecker = Callable[[dict[str, Any], Path | None], list[Any]]  # -> [FieldProblem(field, msg)]
 
 
+SUPERVISE_S = 0.5  # how often failed writes are retried and worker threads checked
+MAX_ERROR = 2000  # characters of a task's `error`
+
+
 class QueueFullError(Exception):
     """No room for another job; the client should retry later (HTTP 503)."""
+
+
+class QuotaError(Exception):
+    """The caller's key has used its quota of queued tasks or plan jobs (HTTP 429)."""
 
 
 class IdempotencyConflictError(Exception):
@@ -87,6 +104,13 @@ class TaskManager:
         self._lock = threading.Lock()
         self.task_checker: TaskChecker | None = None
         self.record = settings.records()
+        self._failures: dict[str, str] = {}  # task id -> why its storage failed (it is stopped)
+        self._pending: deque[Callable[[], Any]] = deque()  # writes waiting for the store
+        self._pending_lock = threading.Lock()
+        self._deferred: set[str] = set()  # queued tasks whose start could not be recorded
+        self._plan_jobs: Counter[str] = Counter()  # owner -> plan/check jobs in flight
+        self._stopping = threading.Event()
+        self._supervisor: threading.Thread | None = None
 
     # -- life cycle -------------------------------------------------------------------------
 
@@ -99,10 +123,16 @@ class TaskManager:
         self.jobs.start()
         for task_id in self.store.ids_in_state(TaskState.QUEUED):
             self._enqueue(task_id)
+        self._supervisor = threading.Thread(target=self._supervise, name="avs-supervisor",
+                                            daemon=True)
+        self._supervisor.start()
 
     def stop(self) -> None:
+        self._stopping.set()
         self.episodes.stop()
         self.jobs.stop()
+        if self._supervisor is not None:
+            self._supervisor.join(timeout=5)
 
     def _recover(self) -> None:
         for task_id in self.store.ids_in_state(TaskState.RUNNING):
@@ -120,8 +150,11 @@ class TaskManager:
     # -- tasks ------------------------------------------------------------------------------
 
     def submit(
-        self, request: dict[str, Any], owner: str, idempotency_key: str | None, request_hash: str
+        self, request: dict[str, Any], caller: Caller, idempotency_key: str | None,
+        request_hash: str,
     ) -> Submission:
+        """Queue a task; `StorageError` when the store cannot take it (nothing is queued)."""
+        owner = caller.owner
         with self._lock:
             if idempotency_key is not None:
                 earlier = self.store.find_by_key(owner, idempotency_key)
@@ -131,6 +164,10 @@ class TaskManager:
                     return Submission(earlier, replayed=True)
             if self.store.count_state(TaskState.QUEUED) >= self.settings.queue_size:
                 raise QueueFullError(f"{self.settings.queue_size} tasks already queued")
+            quota = caller.max_queued
+            if quota and self.store.count_state(TaskState.QUEUED, owner) >= quota:
+                raise QuotaError(f"key {caller.name!r} already has {quota} queued tasks, its "
+                                 "quota; retry when one has started")
             task_id = uuid.uuid4().hex
             self.store.insert(task_id, request, owner, idempotency_key, request_hash)
         self._state_event(task_id, TaskState.QUEUED)
@@ -156,43 +193,89 @@ class TaskManager:
         return self.store.get(task_id)
 
     def _enqueue(self, task_id: str) -> None:
-        task = self.store.get(task_id)
-        if task is None:
-            return
         cancel = self._cancels.setdefault(task_id, threading.Event())
         output_dir = str((self.settings.tasks_dir / task_id).resolve()) + "/"
         job = Job(
             kind="episode",
-            payload=self._episode_spec(task),
+            payload={},  # filled in when it starts (`_claim`)
             time_limit_s=self.settings.task_time_limit_s,
-            on_start=lambda: self._claim(task_id),
-            on_event=lambda event: self.store.add_event(task_id, _relative(event, output_dir)),
+            on_event=lambda event: self._record_event(task_id, _relative(event, output_dir),
+                                                      cancel),
             cancel=cancel,
         )
+        job.on_start = lambda: self._claim(task_id, job)
         future = self.episodes.submit(job)
         future.add_done_callback(lambda f: self._finished(task_id, f.result()))
 
     def _episode_spec(self, task: TaskRecord) -> dict[str, Any]:
+        """What the episode runner gets: the request (less any option naming a file, which
+        tasks stored by older versions may hold; with `strict_labels`), its id and its own
+        output folder."""
         output_dir = self.settings.tasks_dir / task.id
         output_dir.mkdir(parents=True, exist_ok=True)
-        spec = {**task.request, "task_id": task.id, "output_dir": str(output_dir.resolve())}
+        request = dict(task.request)
+        if isinstance(request.get("strategy_options"), dict):
+            request["strategy_options"] = without_file_options(request["strategy_options"])
+        request["strict_labels"] = bool(request.get("strict_labels"))  # false: an unknown
+        # target label is searched for with an uninformed prior (tasks stored before the
+        # field existed lack it)
+        spec = {**request, "task_id": task.id, "output_dir": str(output_dir.resolve())}
         if self.record:
             spec["record"] = True
         return spec
 
-    def _claim(self, task_id: str) -> bool:
-        if not self.store.claim(task_id):
+    def _claim(self, task_id: str, job: Job) -> bool:
+        """queued -> running and the job's spec; False skips the job: the task is no longer
+        queued, or the store cannot record the start (it waits, queued, for the store)."""
+        try:
+            if not self.store.claim(task_id):
+                return False
+        except StorageError as exc:
+            log.warning("task %s cannot start now (%s); it waits for the store", task_id, exc)
+            self._deferred.add(task_id)
             return False
         task = self.store.get(task_id)
-        attempt = task.attempts if task is not None else 1
-        self._state_event(task_id, TaskState.RUNNING, attempt=attempt)
+        if task is None:
+            return False
+        try:
+            job.payload = self._episode_spec(task)
+        except OSError as exc:
+            error = f"storage error: cannot create the task's folder: {exc.strerror or exc}"
+            self._write(lambda: self._finish(task_id, TaskState.FAILED, None, error))
+            return False
+        self._state_event(task_id, TaskState.RUNNING, attempt=task.attempts)
         return True
 
+    def _record_event(self, task_id: str, event: dict[str, Any],
+                      cancel: threading.Event) -> None:
+        """Store an episode's event; when the store fails, stop the episode (its task fails
+        with the reason) rather than run on unrecorded."""
+        if task_id in self._failures:
+            return
+        try:
+            self.store.add_event(task_id, event)
+        except StorageError as exc:
+            log.error("task %s: %s; stopping its episode", task_id, exc)
+            self._failures[task_id] = (f"{exc}: the episode's events could not be recorded, so "
+                                       "it was stopped")
+            cancel.set()
+
     def _finished(self, task_id: str, result: JobResult) -> None:
-        self._cancels.pop(task_id, None)
-        if result.outcome in (JobOutcome.SHUTDOWN, JobOutcome.SKIPPED):
-            return  # left 'running'; the next start accounts for it (fail or requeue)
-        state, summary, error = _task_outcome(result)
+        try:
+            self._cancels.pop(task_id, None)
+            failure = self._failures.pop(task_id, None)
+            if result.outcome in (JobOutcome.SHUTDOWN, JobOutcome.SKIPPED):
+                return  # left 'running' (the next start accounts for it) or still queued
+            if failure is not None:
+                state, summary, error = TaskState.FAILED, None, failure
+            else:
+                state, summary, error = _task_outcome(result)
+            self._write(lambda: self._finish(task_id, state, summary, error))
+        except Exception:  # noqa: BLE001 - a future's callback must not fail silently
+            log.exception("recording the end of task %s failed", task_id)
+
+    def _finish(self, task_id: str, state: TaskState, summary: dict[str, Any] | None,
+                error: str | None) -> None:
         if self.store.finish(task_id, state, summary, error):
             self._state_event(task_id, state, error)
 
@@ -203,7 +286,80 @@ class TaskManager:
             event["message"] = message
         if attempt is not None:
             event["attempt"] = attempt  # 2, 3, ...: a requeued task's events after this are new
-        self.store.add_event(task_id, event)
+        self._write(lambda: self.store.add_event(task_id, event))
+
+    # -- storage faults -------------------------------------------------------------------------
+
+    def _write(self, write: Callable[[], Any]) -> None:
+        """Do a store write now, or (when the store fails, or earlier writes wait) later, in
+        order, once the store takes writes again."""
+        with self._pending_lock:
+            if self._pending:
+                self._pending.append(write)
+                return
+        try:
+            write()
+        except StorageError as exc:
+            log.warning("a write waits for the store: %s", exc)
+            with self._pending_lock:
+                self._pending.append(write)
+
+    def _flush(self) -> bool:
+        """Do the waiting writes in order; False when the store still fails."""
+        while True:
+            with self._pending_lock:
+                if not self._pending:
+                    return True
+                write = self._pending[0]
+            try:
+                write()
+            except StorageError:
+                return False
+            except Exception:  # noqa: BLE001 - a bad write must not block the others
+                log.exception("a waiting write failed")
+            with self._pending_lock:
+                self._pending.popleft()
+
+    def degraded(self) -> str | None:
+        """Why the service cannot record work now, or None when it can."""
+        error = self.store.write_error
+        with self._pending_lock:
+            waiting = len(self._pending)
+        if error is None and not waiting:
+            return None
+        reason = error or "storage recovered; catching up"
+        if waiting:
+            reason += f" ({waiting} write(s) waiting)"
+        if self._deferred:
+            reason += f"; {len(self._deferred)} queued task(s) wait for it"
+        return reason
+
+    def _supervise(self) -> None:
+        while not self._stopping.wait(SUPERVISE_S):
+            try:
+                self.supervise_once()
+            except Exception:  # noqa: BLE001 - the supervisor must outlive any one fault
+                log.exception("supervisor check failed")
+
+    def supervise_once(self) -> None:
+        """Revive dead worker threads; retry waiting writes (or probe a failing store); once
+        writes work, queue again the tasks that could not start."""
+        self.episodes.revive()
+        self.jobs.revive()
+        with self._pending_lock:
+            waiting = bool(self._pending)
+        if waiting:
+            if not self._flush():
+                return
+        elif self.store.write_error is not None and not self.store.probe():
+            return
+        if self._deferred:
+            log.info("the store takes writes again: %d waiting task(s) queued again",
+                     len(self._deferred))
+            deferred, self._deferred = self._deferred, set()
+            for task_id in self.store.ids_in_state(TaskState.QUEUED):
+                if task_id in deferred:
+                    self._enqueue(task_id)
 
     # -- plans and checks ---------------------------------------------------------------------
 
@@ -211,6 +367,22 @@ class TaskManager:
         """`QueueFullError` when the plan/check queue is full."""
         if self.jobs.pending() >= self.settings.plan_queue_size:
             raise QueueFullError(f"{self.settings.plan_queue_size} plan/check jobs waiting")
+
+    def take_plan_slot(self, caller: Caller) -> None:
+        """Count a plan/check job against the caller's quota (`QuotaError` when used up);
+        give it back with `free_plan_slot`."""
+        with self._lock:
+            quota = caller.max_plan_jobs
+            if quota and self._plan_jobs[caller.owner] >= quota:
+                raise QuotaError(f"key {caller.name!r} already has {quota} plan/check jobs in "
+                                 "flight, its quota; retry when one has ended")
+            self._plan_jobs[caller.owner] += 1
+
+    def free_plan_slot(self, owner: str) -> None:
+        with self._lock:
+            self._plan_jobs[owner] -= 1
+            if self._plan_jobs[owner] <= 0:
+                del self._plan_jobs[owner]
 
     async def run_job(
         self, kind: str, payload: dict[str, Any],
@@ -270,9 +442,11 @@ def _task_outcome(result: JobResult) -> tuple[TaskState, dict[str, Any] | None, 
         error = result.error
         if result.error_type:
             error = f"{result.error_type}: {error}"
-        return _JOB_STATES.get(result.outcome, TaskState.FAILED), None, error
+        return (_JOB_STATES.get(result.outcome, TaskState.FAILED), None,
+                short(error, MAX_ERROR) if error else error)
     value = result.value
     outcome = value.get("outcome") if isinstance(value, dict) else None
     if outcome not in _EPISODE_OUTCOMES:
-        return TaskState.FAILED, None, f"episode runner returned no known outcome: {outcome!r}"
+        return TaskState.FAILED, None, short(f"episode runner returned no known outcome: "
+                                             f"{outcome!r}", MAX_ERROR)
     return _EPISODE_OUTCOMES[outcome], value, None

@@ -15,10 +15,16 @@ from dataclasses import dataclass, field
 
 from fastapi import HTTPException
 
+from api.limits import bounded
 from api.manager import TaskManager
 from api.schemas import JobError, PlanJobPublic, PlanJobState, PlanPublic
+from api.security import Caller
 
 PlanCall = Callable[[Callable[[], bool]], Awaitable[PlanPublic]]
+
+
+class NotCancellable(Exception):  # noqa: N818 - mirrors the task manager's NotCancellableError
+    """The plan job already ended (HTTP 409)."""
 
 
 @dataclass
@@ -45,28 +51,35 @@ class PlanJobs:
         self.kept = kept
         self._records: OrderedDict[str, _Record] = OrderedDict()
 
-    def start(self, owner: str, plan: PlanCall) -> PlanJobPublic:
-        """Queue `plan` (a coroutine factory given an on-start hook); `QueueFullError` if full."""
+    def start(self, caller: Caller, plan: PlanCall) -> PlanJobPublic:
+        """Queue `plan` (a coroutine factory given an on-start hook); `QueueFullError` if full,
+        `QuotaError` when the caller's key has its quota of plan jobs in flight."""
         self.manager.check_job_room()
-        record = _Record(uuid.uuid4().hex, owner, time.time())
+        self.manager.take_plan_slot(caller)
+        record = _Record(uuid.uuid4().hex, caller.owner, time.time())
         self._records[record.id] = record
         record.task = asyncio.get_running_loop().create_task(self._run(record, plan))
         self._forget_old()
         return record.public()
 
-    def get(self, job_id: str) -> PlanJobPublic | None:
+    def _visible(self, job_id: str, caller: Caller) -> _Record | None:
         record = self._records.get(job_id)
+        return record if record is not None and caller.may_see(record.owner) else None
+
+    def get(self, job_id: str, caller: Caller) -> PlanJobPublic | None:
+        """The job, if there is one the caller may see (its own; an admin key any)."""
+        record = self._visible(job_id, caller)
         return record.public() if record is not None else None
 
-    def cancel(self, job_id: str) -> PlanJobPublic | None:
-        """Cancel a live job (its worker is killed); a finished one is returned unchanged."""
-        record = self._records.get(job_id)
+    def cancel(self, job_id: str, caller: Caller) -> PlanJobPublic | None:
+        """Cancel a live job (its worker is killed); `NotCancellable` when it already ended."""
+        record = self._visible(job_id, caller)
         if record is None:
             return None
-        if record.task is not None and not record.task.done():
-            record.task.cancel()
-            self._end(record, PlanJobState.CANCELLED, error=JobError(status=409,
-                                                                     detail="cancelled"))
+        if record.finished_at is not None or record.task is None or record.task.done():
+            raise NotCancellable(f"plan job {job_id} already ended ({record.state.value})")
+        record.task.cancel()
+        self._end(record, PlanJobState.CANCELLED, error=JobError(status=409, detail="cancelled"))
         return record.public()
 
     async def _run(self, record: _Record, plan: PlanCall) -> None:
@@ -78,7 +91,11 @@ class PlanJobs:
             result = await plan(started)
         except HTTPException as exc:
             state = PlanJobState.CANCELLED if exc.status_code == 409 else PlanJobState.FAILED
-            self._end(record, state, error=JobError(status=exc.status_code, detail=exc.detail))
+            self._end(record, state, error=JobError(status=exc.status_code,
+                                                    detail=bounded(exc.detail)))
+        except Exception as exc:  # noqa: BLE001 - a job must end, whatever went wrong
+            self._end(record, PlanJobState.FAILED, error=JobError(
+                status=500, detail=bounded(f"internal error: {type(exc).__name__}: {exc}")))
         else:
             self._end(record, PlanJobState.SUCCEEDED, result=result)
 
@@ -88,6 +105,7 @@ class PlanJobs:
             return
         record.state, record.result, record.error = state, result, error
         record.finished_at = time.time()
+        self.manager.free_plan_slot(record.owner)
 
     def _forget_old(self) -> None:
         finished = [r.id for r in self._records.values() if r.finished_at is not None]

@@ -5,11 +5,45 @@ from __future__ import annotations
 from enum import StrEnum
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    StringConstraints,
+    field_validator,
+    model_validator,
+)
+
+from api.limits import (
+    flatten_strings,
+    json_problem,
+    load_yaml,
+    looks_like_path,
+    pddl_problem,
+    yaml_problem,
+)
 
 NAME_PATTERN = r"^[A-Za-z][A-Za-z0-9_-]{0,63}$"
 MAX_TEXT = 500_000
 OptionValue = bool | int | float | Annotated[str, Field(max_length=200)] | None
+OptionName = Annotated[str, StringConstraints(pattern=NAME_PATTERN)]
+# "exactly one of world / world_file / generate" for clients reading the schema (a present
+# null counts as absent, as the service reads it)
+_ONE_WORLD = {"oneOf": [
+    {"required": [name], "properties": {name: {"not": {"type": "null"}}}}
+    for name in ("world", "world_file", "generate")
+]}
+
+
+def world_file_problem(text: str) -> str | None:
+    """Why an inline world file cannot be a world (too costly to read, not YAML, not a
+    mapping), or None. Read with bounded alias expansion, size and depth."""
+    problem = yaml_problem(text, "world_file")
+    if problem:
+        return problem
+    if not isinstance(load_yaml(text), dict):
+        return "world_file must be a YAML mapping (name, size, rooms, ...)"
+    return None
 
 
 class TaskState(StrEnum):
@@ -45,16 +79,19 @@ class GeneratedWorld(BaseModel):
 class TaskCreate(BaseModel):
     """Find `target` (a label) [in a room of `category`] in a world, with a robot.
 
-    Checked at submission against the knowledge base (target, category), the world (start
-    room, start pose free and inside a room) and the strategy registry: 422 naming the field."""
+    Give exactly one of `world`, `world_file` and `generate`, and at most one of `start` and
+    `start_room`. Checked at submission against the knowledge base (category; target when
+    `strict_labels`), the world (start room, start pose free and inside a room) and the
+    strategy registry: 422 naming the field."""
 
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, json_schema_extra=_ONE_WORLD)
 
     target: str = Field(pattern=NAME_PATTERN, examples=["cerealbox"])
     category: str | None = Field(None, pattern=NAME_PATTERN, examples=["kitchen"])
     world: str | None = Field(None, pattern=NAME_PATTERN, description="a built-in world name")
     world_file: str | None = Field(
-        None, max_length=MAX_TEXT, description="an inline world file (YAML text)"
+        None, max_length=MAX_TEXT, description="an inline world file (YAML text; at most 64 "
+        "aliases, 50,000 nodes with aliases expanded, 20 levels deep)"
     )
     generate: GeneratedWorld | None = Field(
         None, description="a generated building (see `avs world generate`)",
@@ -70,8 +107,10 @@ class TaskCreate(BaseModel):
     time_budget_s: float = Field(600.0, gt=0, le=86_400, description="simulated seconds")
     strategy: str = Field("switching", pattern=NAME_PATTERN,
                           description="search strategy (GET /v1/strategies lists them)")
-    strategy_options: dict[str, OptionValue] = Field(
-        default_factory=dict, max_length=50, description="the strategy's options by name")
+    strategy_options: dict[OptionName, OptionValue] = Field(
+        default_factory=dict, max_length=50, description="the strategy's options by name; "
+        "options naming files (e.g. qsr's learn_file) and values that look like file paths "
+        "are refused (422): the service reads and writes no file a request names")
     qsr: list[dict[str, Any]] | dict[str, Any] | None = Field(
         None, description="QSR descriptions of where the target is (strategies qsr, "
         "supporting-planes, random and the switching planner's cones): a list in the format of "
@@ -80,6 +119,30 @@ class TaskCreate(BaseModel):
         "conceptual_map/qsr/README.md. Default: the built-in QSR knowledge",
         examples=[[{"target": "cup", "relations": ["right", "close"], "of": "keyboard",
                     "count": 1}]])
+    strict_labels: bool = Field(
+        False, description="refuse a target label the knowledge base does not know (422 at "
+        "submission); default: such a label is searched for with an uninformed prior")
+
+    @field_validator("world_file")
+    @classmethod
+    def _bounded_world_file(cls, text: str | None) -> str | None:
+        problem = world_file_problem(text) if text is not None else None
+        if problem:
+            raise ValueError(problem)
+        return text
+
+    @field_validator("qsr")
+    @classmethod
+    def _bounded_qsr(cls, value: Any) -> Any:
+        if value is None:
+            return value
+        problem = json_problem(value, "qsr")
+        if problem:
+            raise ValueError(problem)
+        if any(looks_like_path(text) for text in flatten_strings(value)):
+            raise ValueError("qsr holds a value that looks like a file path; descriptions are "
+                             "given inline, the service reads no file a request names")
+        return value
 
     @model_validator(mode="after")
     def _one_world(self) -> TaskCreate:
@@ -119,6 +182,14 @@ class PlanCreate(BaseModel):
 
     domain: str = Field(min_length=1, max_length=MAX_TEXT)
     problem: str = Field(min_length=1, max_length=MAX_TEXT)
+
+    @field_validator("domain", "problem")
+    @classmethod
+    def _bounded_pddl(cls, text: str) -> str:
+        problem = pddl_problem(text, "the text")
+        if problem:
+            raise ValueError(problem)
+        return text
     reward: float | None = Field(None, gt=0, description="R in c(pi) + R(1 - p(pi))")
     weight: float | None = Field(None, ge=1, le=100)
     timeout_s: float | None = Field(None, gt=0, le=3600)
@@ -193,6 +264,23 @@ class DomainCheckCreate(BaseModel):
     domain: str = Field(min_length=1, max_length=MAX_TEXT)
     problems: list[str] = Field(default_factory=list, max_length=50)
 
+    @field_validator("domain")
+    @classmethod
+    def _bounded_domain(cls, text: str) -> str:
+        problem = pddl_problem(text, "the text")
+        if problem:
+            raise ValueError(problem)
+        return text
+
+    @field_validator("problems")
+    @classmethod
+    def _bounded_problems(cls, texts: list[str]) -> list[str]:
+        for i, text in enumerate(texts):
+            problem = pddl_problem(text, f"problems[{i}]")
+            if problem:
+                raise ValueError(problem)
+        return texts
+
 
 class DomainCheckPublic(BaseModel):
     ok: bool
@@ -223,7 +311,11 @@ class StrategiesPublic(BaseModel):
 
 
 class Health(BaseModel):
-    status: Literal["ok"]
+    """`degraded` (still 200): the store refuses writes (e.g. the disk is full); `reason` says
+    why. Reads work; submissions get 503 until writes succeed again, then it is `ok`."""
+
+    status: Literal["ok", "degraded"]
+    reason: str | None = None
     version: str
     workers: int
     queued: int

@@ -1,4 +1,9 @@
-"""SQLite (WAL) store for tasks, their event streams and results; safe to share across threads."""
+"""SQLite (WAL) store for tasks, their event streams and results; safe to share across threads.
+
+A write that fails (`database or disk is full`, an I/O error) raises `StorageError` and leaves
+the store *degraded* (`write_error` says why) until a write succeeds again; `probe()` tries a
+tiny one, so the service notices when space is back even while nothing else writes.
+"""
 
 from __future__ import annotations
 
@@ -38,7 +43,12 @@ CREATE TABLE IF NOT EXISTS events (
     data TEXT NOT NULL,
     PRIMARY KEY (task_id, seq)
 );
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT);
 """
+
+
+class StorageError(Exception):
+    """A write to the store failed (e.g. the disk is full); the message says why."""
 
 
 @dataclass(frozen=True)
@@ -77,6 +87,8 @@ class TaskStore:
         self._conn.executescript(_SCHEMA)
         _migrate(self._conn)
         self._lock = threading.Lock()
+        self.write_error: str | None = None  # why the last write failed; None once one works
+        self.write_error_since: float | None = None
 
     def close(self) -> None:
         with self._lock:
@@ -84,14 +96,61 @@ class TaskStore:
 
     @contextmanager
     def _tx(self) -> Iterator[sqlite3.Connection]:
+        """A write transaction; a failing write raises `StorageError` and marks the store
+        degraded, a successful one clears that."""
         with self._lock:
-            self._conn.execute("BEGIN IMMEDIATE")
+            try:
+                self._conn.execute("BEGIN IMMEDIATE")
+            except sqlite3.Error as exc:
+                raise self._failed(exc) from exc
             try:
                 yield self._conn
-            except BaseException:
-                self._conn.execute("ROLLBACK")
+                self._conn.execute("COMMIT")
+            except BaseException as exc:
+                self._rollback()
+                if isinstance(exc, sqlite3.Error):
+                    raise self._failed(exc) from exc
                 raise
-            self._conn.execute("COMMIT")
+            if self.write_error is not None:
+                self.write_error = self.write_error_since = None
+
+    def _rollback(self) -> None:
+        try:
+            self._conn.execute("ROLLBACK")
+        except sqlite3.Error:
+            pass  # SQLite rolled back itself (e.g. after SQLITE_FULL), or nothing was open
+
+    def _failed(self, exc: sqlite3.Error) -> StorageError:
+        message = f"storage error: {exc}"
+        if self.write_error is None:
+            self.write_error_since = time.time()
+        self.write_error = message
+        return StorageError(message)
+
+    def probe(self) -> bool:
+        """Try a tiny write; True (and no longer degraded) when it worked."""
+        try:
+            with self._tx() as db:
+                db.execute("INSERT OR REPLACE INTO meta (key, value) VALUES ('probe', ?)",
+                           (str(time.time()),))
+        except StorageError:
+            return False
+        return True
+
+    def check(self) -> str | None:
+        """Why the database file is damaged (SQLite's quick_check, then reading every row),
+        or None; for start-up, before any task is touched."""
+        with self._lock:
+            try:
+                rows = self._conn.execute("PRAGMA quick_check").fetchall()
+                if rows != [("ok",)]:
+                    return "; ".join(str(r[0]) for r in rows[:3])
+                for table in ("tasks", "events"):
+                    for _ in self._conn.execute(f"SELECT * FROM {table}"):  # noqa: S608
+                        pass
+            except sqlite3.DatabaseError as exc:
+                return str(exc)
+        return None
 
     def insert(
         self, task_id: str, request: dict[str, Any], owner: str,
@@ -123,10 +182,18 @@ class TaskStore:
         return _decode(row) if row is not None else None
 
     def page(
-        self, state: TaskState | None, limit: int, offset: int
+        self, state: TaskState | None, limit: int, offset: int, owner: str | None = None
     ) -> tuple[list[TaskRecord], int]:
-        """A page of tasks, newest first, and how many match in all."""
-        where, args = (" WHERE t.state=?", (state.value,)) if state else ("", ())
+        """A page of tasks (of `owner`, if given), newest first, and how many match in all."""
+        clauses, values = [], []
+        if state:
+            clauses.append("t.state=?")
+            values.append(state.value)
+        if owner is not None:
+            clauses.append("t.owner=?")
+            values.append(owner)
+        where = " WHERE " + " AND ".join(clauses) if clauses else ""
+        args = tuple(values)
         with self._lock:
             rows = self._conn.execute(
                 _SELECT + where + " ORDER BY t.created_at DESC, t.id LIMIT ? OFFSET ?",
@@ -135,10 +202,12 @@ class TaskStore:
             count = self._conn.execute(f"SELECT count(*) FROM tasks t{where}", args).fetchone()
         return [_decode(r) for r in rows], int(count[0])
 
-    def count_state(self, state: TaskState) -> int:
+    def count_state(self, state: TaskState, owner: str | None = None) -> int:
+        sql, args = "SELECT count(*) FROM tasks WHERE state=?", (state.value,)
+        if owner is not None:
+            sql, args = sql + " AND owner=?", (*args, owner)
         with self._lock:
-            row = self._conn.execute("SELECT count(*) FROM tasks WHERE state=?", (state.value,))
-            return int(row.fetchone()[0])
+            return int(self._conn.execute(sql, args).fetchone()[0])
 
     def ids_in_state(self, state: TaskState) -> list[str]:
         with self._lock:

@@ -158,7 +158,12 @@ class _Slot:
             if job.cancel.is_set():  # cancelled while it waited: never started
                 job.future.set_result(JobResult(JobOutcome.CANCELLED, error="cancelled"))
                 continue
-            if not job.on_start():
+            try:
+                started = job.on_start()
+            except Exception:  # noqa: BLE001 - e.g. the store failed: skip it, keep serving
+                log.exception("worker slot %s: starting a job failed", self.index)
+                started = False
+            if not started:
                 job.future.set_result(JobResult(JobOutcome.SKIPPED))
                 continue
             try:
@@ -208,9 +213,26 @@ class WorkerPool:
 
     def start(self) -> None:
         for slot in self._slots:
-            thread = threading.Thread(target=slot.loop, name=f"avs-{self.name}-slot", daemon=True)
-            thread.start()
-            self._threads.append(thread)
+            self._threads.append(self._thread(slot))
+
+    def _thread(self, slot: _Slot) -> threading.Thread:
+        thread = threading.Thread(target=slot.loop, name=f"avs-{self.name}-slot", daemon=True)
+        thread.start()
+        return thread
+
+    def revive(self) -> int:
+        """Start a fresh thread for every slot whose thread died (a bug: it is logged), so the
+        pool keeps serving without a restart; returns how many were revived."""
+        if self.stopping.is_set() or not self._threads:
+            return 0
+        revived = 0
+        for i, thread in enumerate(self._threads):
+            if not thread.is_alive():
+                log.error("worker slot %s of %s had stopped; starting it again", i, self.name)
+                self._slots[i].kill()
+                self._threads[i] = self._thread(self._slots[i])
+                revived += 1
+        return revived
 
     def submit(self, job: Job) -> Future[JobResult]:
         self.jobs.put(job)

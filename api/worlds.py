@@ -49,15 +49,3 @@ def _room_names(path: Path) -> list[str]:
         return []
     return [str(r["name"]) for r in rooms if isinstance(r, dict) and "name" in r]
 
-
-def world_file_problem(text: str) -> str | None:
-    """Why an inline world file cannot be a world (not YAML, not a mapping), or None."""
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        return f"world_file is not valid YAML{where}: {getattr(exc, 'problem', exc)}"
-    if not isinstance(data, dict):
-        return "world_file must be a YAML mapping (name, size, rooms, ...)"
-    return None

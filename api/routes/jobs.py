@@ -7,11 +7,17 @@ from typing import Any
 
 from fastapi import HTTPException, status
 
-from api.manager import ClientGoneError, QueueFullError, StoppingError, TaskManager
+from api.limits import short
+from api.manager import ClientGoneError, QueueFullError, QuotaError, StoppingError, TaskManager
 from api.workers import JobOutcome
 
 UNAVAILABLE = "JobUnavailableError"
 CLIENT_CLOSED = 499  # nginx's code for "the client closed the request"; nobody receives it
+
+
+def over_quota(exc: QuotaError) -> HTTPException:
+    return HTTPException(status.HTTP_429_TOO_MANY_REQUESTS, detail=str(exc),
+                         headers={"Retry-After": "5"})
 
 
 def queue_full(exc: QueueFullError) -> HTTPException:
@@ -44,12 +50,15 @@ async def run_job(
     if result.outcome is JobOutcome.CANCELLED:
         raise HTTPException(status.HTTP_409_CONFLICT, detail=f"{kind} cancelled")
     if result.outcome is JobOutcome.TIMEOUT:
-        raise HTTPException(status.HTTP_504_GATEWAY_TIMEOUT, detail=f"{kind}: {result.error}")
+        raise HTTPException(status.HTTP_504_GATEWAY_TIMEOUT,
+                            detail=short(f"{kind}: {result.error}"))
     if result.error_type in (UNAVAILABLE, "MemoryError") or result.outcome is JobOutcome.SHUTDOWN:
-        raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE, detail=f"{kind}: {result.error}")
+        raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE,
+                            detail=short(f"{kind}: {result.error}"))
     raise HTTPException(
         status.HTTP_500_INTERNAL_SERVER_ERROR,
-        detail=f"{kind} failed: {result.error_type or result.outcome.value}: {result.error}",
+        detail=short(f"{kind} failed: {result.error_type or result.outcome.value}: "
+                     f"{result.error}"),
     )
 
 
@@ -59,11 +68,11 @@ def pddl_422(errors: list[dict[str, Any]]) -> HTTPException:
         {
             "type": "pddl_error",
             "loc": ["body", _field(e.get("file", ""))],
-            "msg": e.get("message", ""),
+            "msg": short(str(e.get("message", ""))),
             "line": e.get("line"),
             "column": e.get("column"),
         }
-        for e in errors
+        for e in errors[:50]
     ]
     return HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, detail=detail)
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sqlite3
+
 from fastapi import APIRouter, HTTPException, status
 
 from api.deps import ManagerDep, SettingsDep
@@ -30,11 +32,20 @@ def read_strategies() -> StrategiesPublic:
 
 @router.get("/health", responses={503: {"model": Message, "description": "not ready"}})
 async def read_health(manager: ManagerDep, settings: SettingsDep) -> Health:
-    """200 once the service is up and its workers are started; 503 if they are not."""
+    """200 once the service is up and its workers are started; 503 if they are not. While its
+    store refuses writes (e.g. the disk is full) it is still 200 with status `degraded` and
+    the `reason`: reads work, new work is refused (503) until writes succeed again. No key
+    is needed."""
     if not (manager.episodes.alive() and manager.jobs.alive()):
         raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE, detail="workers not running")
-    queued, running = manager.counts()
+    reason = manager.degraded()
+    try:
+        queued, running = manager.counts()
+    except sqlite3.Error as exc:  # the store cannot even be read
+        queued = running = 0
+        reason = reason or f"storage error: {exc}"
     return Health(
-        status="ok", version=__version__, workers=manager.episodes.size, queued=queued,
-        running=running, open_access=settings.is_open(),
+        status="degraded" if reason else "ok", reason=reason, version=__version__,
+        workers=manager.episodes.size, queued=queued, running=running,
+        open_access=settings.is_open(),
     )

@@ -8,10 +8,11 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, HTTPException, Path, Query, Request, Response, status
 
-from api.deps import ManagerDep, SettingsDep, WriteAccess
-from api.manager import QueueFullError, TaskManager
-from api.plan_jobs import PlanJobs
-from api.routes.jobs import pddl_422, queue_full, run_job
+from api.deps import ManagerDep, ReadAccess, SettingsDep, WriteAccess
+from api.limits import MAX_ERRORS, short
+from api.manager import QueueFullError, QuotaError, TaskManager
+from api.plan_jobs import NotCancellable, PlanJobs
+from api.routes.jobs import over_quota, pddl_422, queue_full, run_job
 from api.schemas import TOO_LARGE, Message, PlanCreate, PlanJobPublic, PlanPublic
 
 router = APIRouter(prefix="/plans", tags=["plans"])
@@ -19,7 +20,8 @@ router = APIRouter(prefix="/plans", tags=["plans"])
 PLANNER_SHARE = 0.8  # of the job's wall-clock limit; the rest is reading and grounding
 JobId = Annotated[str, Path(max_length=64, description="a plan job id")]
 _ERRORS: dict[int | str, dict[str, Any]] = {
-    401: {"model": Message}, 429: {"model": Message}, 503: {"model": Message},
+    401: {"model": Message}, 403: {"model": Message}, 429: {"model": Message},
+    503: {"model": Message},
 }
 
 
@@ -40,7 +42,9 @@ async def _plan(manager: TaskManager, payload: dict[str, Any], request: Request 
     if value.get("status") == "unsupported":
         detail = f"the planner cannot handle this problem: {value.get('message')}"
         raise HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, detail=detail)
-    return PlanPublic.model_validate(value)
+    warnings = [{**w, "message": short(str(w.get("message", "")))}
+                for w in value.get("warnings") or []][:MAX_ERRORS]
+    return PlanPublic.model_validate({**value, "warnings": warnings})
 
 
 @router.post(
@@ -52,7 +56,7 @@ async def _plan(manager: TaskManager, payload: dict[str, Any], request: Request 
     },
 )
 async def create_plan(
-    body: PlanCreate, owner: WriteAccess, manager: ManagerDep, settings: SettingsDep,
+    body: PlanCreate, caller: WriteAccess, manager: ManagerDep, settings: SettingsDep,
     request: Request, response: Response,
     wait: Annotated[bool, Query(description="false: answer 202 at once with a job to poll "
                                             "at /v1/plans/{id}")] = True,
@@ -65,31 +69,46 @@ async def create_plan(
     `error`, with the status the waiting call would have had) appears at `GET /v1/plans/{id}`."""
     payload = _payload(body, settings)
     if wait:
-        return await _plan(manager, payload, request)
+        try:
+            manager.take_plan_slot(caller)
+        except QuotaError as exc:
+            raise over_quota(exc) from exc
+        try:
+            return await _plan(manager, payload, request)
+        finally:
+            manager.free_plan_slot(caller.owner)
     jobs: PlanJobs = request.app.state.plan_jobs
     try:
-        job = jobs.start(owner, lambda started: _plan(manager, payload, on_start=started))
+        job = jobs.start(caller, lambda started: _plan(manager, payload, on_start=started))
     except QueueFullError as exc:
         raise queue_full(exc) from exc
+    except QuotaError as exc:
+        raise over_quota(exc) from exc
     response.status_code = status.HTTP_202_ACCEPTED
     response.headers["Location"] = f"/v1/plans/{job.id}"
     return job
 
 
-@router.get("/{job_id}", responses={404: {"model": Message}})
-async def read_plan_job(job_id: JobId, request: Request) -> PlanJobPublic:
-    """An asynchronous plan job: its state, then its `result` or `error`."""
-    job = request.app.state.plan_jobs.get(job_id)
+@router.get("/{job_id}", responses={401: {"model": Message}, 404: {"model": Message}})
+async def read_plan_job(job_id: JobId, caller: ReadAccess, request: Request) -> PlanJobPublic:
+    """An asynchronous plan job: its state, then its `result` or `error` (a key reads its own
+    jobs; an admin key any)."""
+    job = request.app.state.plan_jobs.get(job_id, caller)
     if job is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, detail=f"no plan job with id {job_id}")
     return job
 
 
-@router.delete("/{job_id}", responses={**_ERRORS, 404: {"model": Message}})
-async def cancel_plan_job(job_id: JobId, owner: WriteAccess, request: Request) -> PlanJobPublic:
-    """Cancel an asynchronous plan job (its worker is freed at once); an ended job is returned
-    as it is."""
-    job = request.app.state.plan_jobs.cancel(job_id)
+@router.delete("/{job_id}",
+               responses={**_ERRORS, 404: {"model": Message}, 409: {"model": Message}})
+async def cancel_plan_job(job_id: JobId, caller: WriteAccess, request: Request
+                          ) -> PlanJobPublic:
+    """Cancel an asynchronous plan job (its worker is freed at once); 409 when it already
+    ended (as for tasks): its result stays readable until newer jobs push it out."""
+    try:
+        job = request.app.state.plan_jobs.cancel(job_id, caller)
+    except NotCancellable as exc:
+        raise HTTPException(status.HTTP_409_CONFLICT, detail=str(exc)) from exc
     if job is None:
         raise HTTPException(status.HTTP_404_NOT_FOUND, detail=f"no plan job with id {job_id}")
     return job

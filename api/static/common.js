@@ -83,6 +83,32 @@ const AVS = (() => {
     }
   }
 
+  // a link to a file of the API: plain when no key is set; with a key, a click fetches it
+  // with the key in X-API-Key and opens (or saves) the result, since a link sends no header
+  function fileLink(path, attrs, filename) {
+    const link = el("a", { ...attrs, href: path });
+    link.addEventListener("click", async (event) => {
+      if (!apiKey()) return;
+      event.preventDefault();
+      const response = await api(path);
+      if (!response.ok) {
+        if (response.status === 401) askForKey("enter the service's API key to open this file");
+        return;
+      }
+      const url = URL.createObjectURL(await response.blob());
+      if (filename) {
+        const save = el("a", { href: url, download: filename });
+        document.body.append(save);
+        save.click();
+        save.remove();
+      } else {
+        window.open(url, "_blank", "noopener");
+      }
+      setTimeout(() => URL.revokeObjectURL(url), 60000);
+    });
+    return link;
+  }
+
   function askForKey(message) {
     const form = document.getElementById("key-form");
     const status = document.getElementById("key-status");
@@ -204,5 +230,6 @@ const AVS = (() => {
     return new Date(seconds * 1000).toLocaleString();
   }
 
-  return { api, json, el, detailText, setupKey, askForKey, followEvents, TERMINAL, shortId, when };
+  return { api, json, el, detailText, setupKey, askForKey, fileLink, followEvents, TERMINAL, shortId,
+    when };
 })();

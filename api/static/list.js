@@ -104,6 +104,11 @@
     const state = $("state-filter").value;
     const query = state ? `?state=${encodeURIComponent(state)}&limit=100` : "?limit=100";
     const answer = await json(`/v1/tasks${query}`);
+    if (answer.status === 401) {
+      $("task-count").textContent = "this service needs an API key to list tasks: enter it above";
+      AVS.askForKey("enter the service's API key to see tasks");
+      return;
+    }
     if (!answer.ok) {
       $("task-count").textContent = `cannot list tasks: ${AVS.detailText(answer.body, answer.status)}`;
       return;
@@ -126,7 +131,7 @@
   }
 
   document.addEventListener("DOMContentLoaded", async () => {
-    AVS.setupKey();
+    AVS.setupKey(refresh);
     $("f-world").addEventListener("change", fillRooms);
     $("submit-form").addEventListener("submit", submit);
     $("state-filter").addEventListener("change", refresh);

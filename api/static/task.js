@@ -281,11 +281,11 @@
     }
     const files = [];
     if (["succeeded", "gave_up", "timeout"].includes(state)) {
-      files.push(el("li", {}, el("a", { href: `${base}/trajectory.png`, target: "_blank", text: "trajectory.png" })));
+      files.push(el("li", {}, AVS.fileLink(`${base}/trajectory.png`, { target: "_blank", text: "trajectory.png" })));
     }
     const recording = await AVS.api(`${base}/recording.rrd`, { method: "HEAD" });
     if (recording.ok) {
-      files.push(el("li", {}, el("a", { href: `${base}/recording.rrd`, id: "recording-link", text: "Rerun recording (recording.rrd)" }),
+      files.push(el("li", {}, AVS.fileLink(`${base}/recording.rrd`, { id: "recording-link", text: "Rerun recording (recording.rrd)" }, `${taskId}.rrd`),
         " open it with the Rerun viewer"));
     }
     $("files").replaceChildren(...files);
@@ -655,7 +655,10 @@
   }
 
   document.addEventListener("DOMContentLoaded", async () => {
-    AVS.setupKey();
+    let needsKey = false;
+    AVS.setupKey(() => {
+      if (needsKey) window.location.reload(); // the key given: read the task again
+    });
     $("task-id").textContent = taskId;
     document.title = `avs-planner: task ${AVS.shortId(taskId)}`;
     $("cancel").addEventListener("click", cancel);
@@ -664,6 +667,10 @@
     });
     window.addEventListener("resize", scheduleDraw);
     const answer = await json(base);
+    if (answer.status === 401) {
+      needsKey = true;
+      AVS.askForKey("enter the service's API key to see this task");
+    }
     if (!answer.ok) {
       state = "unknown";
       renderState();

@@ -49,6 +49,16 @@ def run(spec: dict[str, Any], emit: Any, should_stop: Any) -> dict[str, Any]:
             if should_stop():
                 return {"outcome": "gave_up", "stopped": True}
             time.sleep(0.02)
+    if behaviour == "echo":  # what the episode runner was given
+        return {"outcome": "found", "spec": spec}
+    if behaviour == "drip":  # an event every 0.05 s until stopped (storage fault tests)
+        deadline = time.monotonic() + 30
+        step = 3
+        while time.monotonic() < deadline and not should_stop():
+            emit({"t": float(step), "wall": 0.0, "type": "observation", "step": step})
+            step += 1
+            time.sleep(0.05)
+        return {"outcome": "gave_up", "stopped": True}
     if behaviour == "ticker":  # a steady stream of events, for the SSE tests
         for i in range(20):
             emit({"t": float(3 + i), "wall": 0.0, "type": "observation", "step": 3 + i})

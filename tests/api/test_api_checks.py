@@ -41,7 +41,7 @@ def _loc(client: TestClient, **fields: Any) -> list[list[Any]]:
 
 
 @pytest.mark.parametrize(("fields", "loc"), [
-    ({"target": "unicorn"}, ["body", "target"]),
+    ({"target": "unicorn", "strict_labels": True}, ["body", "target"]),
     ({"category": "attic"}, ["body", "category"]),
     ({"start_room": "ballroom"}, ["body", "start_room"]),
     ({"start": [100.0, 100.0, 0.0]}, ["body", "start"]),  # off the map
@@ -67,8 +67,22 @@ def test_non_finite_start_is_422_not_stored_as_null(client: TestClient) -> None:
 
 
 def test_every_problem_is_reported_at_once(client: TestClient) -> None:
-    locs = _loc(client, target="unicorn", category="attic", start_room="ballroom")
+    locs = _loc(client, target="unicorn", category="attic", start_room="ballroom",
+                strict_labels=True)
     assert {"target", "category", "start_room"} <= {loc[-1] for loc in locs}
+
+
+def test_an_unknown_label_is_searched_for_unless_strict(client: TestClient) -> None:
+    """Without `strict_labels` the episode searches for a label the knowledge base lacks
+    (with an uninformed prior); the flag reaches the episode only when set."""
+    accepted = client.post("/v1/tasks", json={**GOOD, "target": "unicorn"})
+    assert accepted.status_code == 202, accepted.text
+    assert accepted.json()["request"]["strict_labels"] is False
+    strict = client.post("/v1/tasks", json={**GOOD, "target": "unicorn", "strict_labels": True})
+    assert strict.status_code == 422
+    assert "unknown object label 'unicorn'" in strict.json()["detail"][0]["msg"]
+    still = client.post("/v1/tasks", json={**GOOD, "target": "unicorn", "category": "attic"})
+    assert [d["loc"] for d in still.json()["detail"]] == [["body", "category"]]
 
 
 def test_inline_world_is_checked_too(client: TestClient) -> None:

@@ -14,7 +14,7 @@ BODY = {"target": "quick", "world": "office"}
 UNKNOWN = "0" * 32
 
 
-def test_api_key_required_on_mutating_calls_only(make_settings: Make) -> None:
+def test_api_key_required_on_every_task_call(make_settings: Make) -> None:
     with TestClient(create_app(make_settings(api_key="s3cret"))) as client:
         missing = client.post("/v1/tasks", json=BODY)
         assert missing.status_code == 401 and "X-API-Key" in missing.json()["detail"]
@@ -24,8 +24,21 @@ def test_api_key_required_on_mutating_calls_only(make_settings: Make) -> None:
         assert client.post("/v1/plans", json={"domain": "x", "problem": "y"}).status_code == 401
         ok = client.post("/v1/tasks", json=BODY, headers={"X-API-Key": "s3cret"})
         assert ok.status_code == 202
-        assert client.get(f"/v1/tasks/{ok.json()['id']}").status_code == 200
+        task = f"/v1/tasks/{ok.json()['id']}"
+        for path in (task, f"{task}/events", "/v1/tasks", f"/v1/plans/{UNKNOWN}"):
+            assert client.get(path).status_code == 401, path  # reads need the key too
+        assert client.get(task, headers={"X-API-Key": "s3cret"}).status_code == 200
+        for path in ("/v1/health", "/v1/worlds", "/v1/strategies"):  # no one's data
+            assert client.get(path).status_code == 200, path
         assert client.get("/v1/health").json()["open_access"] is False
+
+
+def test_open_reads_setting_opens_gets_only(make_settings: Make) -> None:
+    with TestClient(create_app(make_settings(api_key="s3cret", open_reads=True))) as client:
+        ok = client.post("/v1/tasks", json=BODY, headers={"X-API-Key": "s3cret"})
+        assert client.get(f"/v1/tasks/{ok.json()['id']}").status_code == 200
+        assert client.get("/v1/tasks").json()["count"] == 1
+        assert client.post("/v1/tasks", json=BODY).status_code == 401
 
 
 def test_rate_limit_per_key(make_settings: Make) -> None:

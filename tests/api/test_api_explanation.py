@@ -41,13 +41,15 @@ def test_no_explanation_is_a_404_that_says_why(client: TestClient, wait_for: Wai
     assert response.status_code == 404 and "left no trace" in response.json()["detail"]
 
 
-def test_reading_an_explanation_needs_no_key_like_every_read(
+def test_reading_an_explanation_needs_the_key_like_every_read(
         make_settings: Callable[..., Settings], wait_for: Wait) -> None:
-    with TestClient(create_app(make_settings(api_key="s3cret"))) as client:
-        task = client.post("/v1/tasks", json={"target": "explained", "world": "office"},
-                           headers={"X-API-Key": "s3cret"}).json()
+    app = create_app(make_settings(api_key="s3cret"))
+    with TestClient(app, headers={"X-API-Key": "s3cret"}) as client:
+        task = client.post("/v1/tasks", json={"target": "explained", "world": "office"}).json()
         wait_for(client, task["id"], {"gave_up", "failed"})
         assert client.get(f"/v1/tasks/{task['id']}/explanation").status_code == 200
+        anonymous = client.get(f"/v1/tasks/{task['id']}/explanation", headers={"X-API-Key": ""})
+        assert anonymous.status_code == 401
 
 
 def test_the_recording_of_an_ended_task(make_settings: Callable[..., Settings],

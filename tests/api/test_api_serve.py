@@ -43,7 +43,7 @@ def test_bad_settings_are_bad_input() -> None:
 def test_cli_maps_serve_errors_to_exit_1(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    monkeypatch.setattr(serve, "_serve", lambda settings, level: pytest.fail("must not serve"))
+    monkeypatch.setattr(serve, "_serve", lambda *args: pytest.fail("must not serve"))
     assert main(["serve", "--port", "-1"]) == EXIT_BAD_INPUT
     assert "port" in capsys.readouterr().err
 
@@ -126,20 +126,18 @@ def test_unusable_data_dir_is_bad_input(tmp_path: Path) -> None:
     blocker.write_text("not a directory")
     with pytest.raises(serve.ServeError, match="cannot use data dir"):
         serve.run(_args("--data-dir", str(blocker / "data")))
-    (tmp_path / "data").mkdir()
-    (tmp_path / "data" / "avs.sqlite3").write_text("this is not a database, just text " * 100)
-    with pytest.raises(serve.ServeError, match="cannot use data dir"):
-        serve.run(_args("--data-dir", str(tmp_path / "data")))
 
 
 def test_busy_port_is_bad_input_before_the_app_starts(tmp_path: Path) -> None:
-    """Exit 1 with a message (not uvicorn's 3, which the CLI uses for timeouts)."""
+    """Exit 1 with a message (not uvicorn's 3, which the CLI uses for timeouts), and a fresh
+    data dir is left as it was: not created, no lock file, no store."""
     with socket.socket() as taken:
         taken.bind(("127.0.0.1", 0))
         taken.listen()
         port = taken.getsockname()[1]
         with pytest.raises(serve.ServeError, match="cannot listen on 127.0.0.1"):
             serve.run(_args("--port", str(port), "--data-dir", str(tmp_path / "data")))
+    assert not (tmp_path / "data").exists()
 
 
 def test_data_dir_held_by_another_process_exits_5(tmp_path: Path) -> None:
