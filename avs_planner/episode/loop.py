@@ -412,7 +412,14 @@ class SwitchingLoop:
                         assumptive=[i for i, s in enumerate(result.plan) if s.assumptive],
                         probability=round(result.probability, 5), cost=round(result.cost, 2),
                         planning_time_s=round(result.planning_time_s, 4),
-                        expanded=result.expanded)
+                        expanded=result.expanded, p_unsearched=self._p_unsearched())
+
+    def _p_unsearched(self) -> float | None:
+        """The building-level belief that the target is still to be found (for the trace)."""
+        if not self.config.stop_rule:
+            return None
+        mind, pose = self.executor.mind, self.executor.robot.pose
+        return round(remaining(mind, self.builder, pose[:2]).p, 5)
 
     def _budget_spent(self) -> str | None:
         cfg = self.config
@@ -426,9 +433,8 @@ class SwitchingLoop:
 
     def _end(self, outcome: Outcome, reason: str) -> SearchResult:
         if outcome is Outcome.GAVE_UP:
-            if self.config.stop_rule and "space not yet searched" not in reason:
-                left = remaining(self.executor.mind, self.builder,
-                                 self.executor.robot.pose[:2]).p
+            left = self._p_unsearched()
+            if left is not None and "space not yet searched" not in reason:
                 reason += f"; P(target in space not yet searched) = {left:.3g}"
             reason += self._cut_off()
         self.result.outcome, self.result.reason = outcome, reason
