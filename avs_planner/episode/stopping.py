@@ -10,11 +10,14 @@ supports, all thinned by every look, glimpses included) and over what placeholde
 to (the exploration hypotheses of Göbelbecker et al., "A Planning Approach to Active Visual
 Search in Large Environments").
 
-The stopping rule uses the paper's own objective c + R(1 - p): a continuation (search a known
-room, explore behind a placeholder) can at best find the target with the probability of the
-space it opens, and costs at least the way there and the cheapest search that could find the
-target in it. When no continuation has R * p > c, continuing is worse than giving up by the
+The stopping rule uses the paper's own objective c + R(1 - p): any continuation finds the
+target with at most the probability left, P, and costs at least the cheapest first step (the
+way to the nearest room or placeholder left plus the cheapest search that could find the
+target there). When R * P is not more than that, going on is worse than giving up by the
 planner's own measure, whatever plan it would make; the give-up names the probability left.
+The test is on the whole of P, not option by option: exploring reveals several rooms at once,
+and ten placeholders of p = 0.09 each are worth going on for although none alone is (a
+first version judged each alone and gave up 9 s into an apartment with P = 0.59 left).
 Costs are in the planner's units (`StateBuilder`: metres over the body's speed, search costs).
 """
 
@@ -49,20 +52,26 @@ class Remaining:
     options: tuple[Option, ...]
 
     def best(self, reward: float) -> Option | None:
+        """The option worth most on its own (for traces)."""
         return max(self.options, key=lambda o: o.value(reward), default=None)
 
+    def cheapest(self) -> Option | None:
+        return min(self.options, key=lambda o: o.cost, default=None)
+
     def worth_going_on(self, reward: float) -> bool:
-        best = self.best(reward)
-        return best is not None and best.value(reward) > 0.0
+        """Some continuation may be worth more than giving up: R * P exceeds the cost of
+        the cheapest first step (an upper bound on any continuation's value)."""
+        cheapest = self.cheapest()
+        return cheapest is not None and reward * self.p > cheapest.cost
 
     def describe(self, reward: float) -> str:
-        best = self.best(reward)
+        cheapest = self.cheapest()
         head = f"P(target in space not yet searched) = {self.p:.3g}"
-        if best is None:
+        if cheapest is None:
             return f"{head}; nothing is left to search or explore"
-        return (f"{head}; no continuation is worth its cost (reward {reward:g} x p < cost): "
-                f"the best, {best.kind} {best.name}, p = {best.p:.3g} at cost >= "
-                f"{best.cost:.0f}")
+        return (f"{head}; no continuation is worth its cost: reward {reward:g} x P is less "
+                f"than the cheapest next step ({cheapest.kind} {cheapest.name}, cost >= "
+                f"{cheapest.cost:.0f})")
 
 
 def remaining(mind: Mind, builder: StateBuilder, here: tuple[float, float]) -> Remaining:

@@ -46,13 +46,19 @@ def test_a_building_searched_through_gives_up_naming_what_is_left(corridor) -> N
     assert belief.worth_going_on(1e6)
 
 
-def test_the_rule_weighs_probability_against_cost() -> None:
-    options = (Option("room", "room1", 0.05, 30.0), Option("placeholder", "placeholder1", 0.2,
+def test_the_rule_weighs_all_that_is_left_against_the_cheapest_step() -> None:
+    """Ten placeholders of p = 0.09 are worth exploring although none alone is: the rule
+    weighs R x P (all that is left) against the cheapest next step."""
+    spread = tuple(Option("placeholder", f"placeholder{k}", 0.09, 53.0) for k in range(10))
+    p = 1.0 - (1.0 - 0.09) ** 10
+    assert all(o.value(500.0) < 0 for o in spread)
+    assert Remaining(p, spread).worth_going_on(500.0)
+    options = (Option("room", "room1", 0.05, 30.0), Option("placeholder", "placeholder1", 0.01,
                                                             120.0))
-    belief = Remaining(0.24, options)
-    assert not belief.worth_going_on(500.0)  # 25 < 30 and 100 < 120
-    assert belief.best(500.0).name == "room1"
-    assert belief.worth_going_on(700.0)  # 140 > 120
+    belief = Remaining(0.06, options)
+    assert not belief.worth_going_on(500.0)  # 30 = 500 x 0.06 is not more than 30
+    assert belief.cheapest().name == "room1" and "room room1" in belief.describe(500.0)
+    assert belief.worth_going_on(600.0)
     assert not Remaining(0.0, ()).worth_going_on(500.0)
     assert "nothing is left" in Remaining(0.0, ()).describe(500.0)
 
