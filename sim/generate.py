@@ -48,7 +48,7 @@ class GeneratedWorld:
     surprise: float = 0.25  # the share asked for
 
     def yaml(self) -> str:
-        """The world file as YAML text (the format of ARCHITECTURE.md), headed by its command."""
+        """The world file as YAML text (docs/architecture.md's format), headed by its command."""
         command = (f"avs world generate --seed {self.seed} --style {self.style} --rooms "
                    f"{len(self.data['rooms']) - 1} --surprise {self.surprise!r} --robot "
                    f"{self.data['robot']['model']}")
@@ -144,7 +144,7 @@ def _start(rng: np.random.Generator, layout: Layout,
 
 def world_data(name: str, layout: Layout, pieces: list[Piece], objects: list[SmallObject],
                robot: str, start: tuple[float, float, float]) -> dict[str, Any]:
-    """The world-file mapping (ARCHITECTURE.md's format) of a generated building."""
+    """The world-file mapping (docs/architecture.md's format) of a generated building."""
     return {
         "name": name,
         "size": list(layout.size),

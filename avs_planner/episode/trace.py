@@ -1,4 +1,4 @@
-"""The episode's trace (one JSON event per line) and its summary (ARCHITECTURE.md fields)."""
+"""The episode's trace (one JSON event per line) and its summary (docs/architecture.md fields)."""
 
 from __future__ import annotations
 
