@@ -29,7 +29,12 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--style", default="office", help="generated world style "
                         "(office, apartment, lab; default office)")
     parser.add_argument("--rooms", type=int, help="generated world: number of rooms")
-    parser.add_argument("--target", help="object label to find, e.g. cerealbox")
+    parser.add_argument("--target", help="object label to find, e.g. cerealbox; a label the "
+                        "knowledge does not list is searched for with its uninformed prior "
+                        "(see domains/README.md), with a warning in the trace")
+    parser.add_argument("--strict-labels", action="store_true", help="refuse a target label "
+                        "the knowledge does not list (exit 1) instead of searching for it with "
+                        "the uninformed prior")
     parser.add_argument("--scenario", help="a seed run a-f (or a scenario YAML path); "
                         "other options override it")
     parser.add_argument("--category", help="only an object in a room of this category")
@@ -70,7 +75,8 @@ def run(args: argparse.Namespace) -> int:
         if args.scenario:
             base = load_scenario(args.scenario).spec
         spec = _spec(args, base)
-        EpisodeSpec.from_dict(spec)  # bad options or QSR descriptions: exit 1 before the run
+        checked = EpisodeSpec.from_dict(spec)  # bad options or QSR descriptions: exit 1
+        _check_label(checked)  # before the run, as a label refused with --strict-labels
     except (EpisodeError, ValueError) as exc:
         print(f"avs: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -82,6 +88,15 @@ def run(args: argparse.Namespace) -> int:
     else:
         _print_summary(summary, Path(args.out))
     return _EXIT.get(summary["outcome"], EXIT_TIMEOUT)
+
+
+def _check_label(spec: Any) -> None:
+    """With `--strict-labels`, a target the knowledge does not list is bad input."""
+    if spec.strict_labels:
+        from avs_planner.episode.runner import target_knowledge
+        from conceptual_map.knowledge import load_knowledge
+
+        target_knowledge(load_knowledge(), spec.target, strict=True)
 
 
 def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
@@ -104,6 +119,8 @@ def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
         spec["strategy"] = args.strategy
     if args.pre_explore:
         spec["pre_explore"] = True
+    if args.strict_labels:
+        spec["strict_labels"] = True
     if args.option:
         spec["strategy_options"] = dict(_option(text) for text in args.option)
     if args.qsr:
@@ -181,7 +198,9 @@ def _print_summary(summary: dict[str, Any], out: Path) -> None:
     cp = summary["cp_time_s"]
     print(f"{summary['target']}: {found} ({summary['reason']})")
     print(f"  simulated {summary['sim_time_s']:.1f} s, drove {summary['distance_m']:.1f} m, "
-          f"{summary['plans']} plans (CP {sum(cp):.2f} s), {summary['dt_calls']} DT searches, "
+          f"{summary['plans']} plans (CP {sum(cp):.2f} s), {summary['dt_calls']} DT searches "
+          f"({summary.get('dt_confirmed', 0)} confirmed, {summary.get('dt_rejected', 0)} "
+          f"rejected), "
           f"{summary['views_processed']} views, wall {summary['wall_time_s']:.1f} s")
     files = [out / name for name in ("trace.jsonl", "summary.json", "explanation.json",
                                       "trajectory.png", "recording.rrd")

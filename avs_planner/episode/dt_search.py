@@ -4,18 +4,30 @@ MOVE actions drive to a cone's pose and point the head; PROCESSVIEWCONE looks tw
 detection counts when both frames agree; when they split, a third frame decides); a
 confirmation becomes a known object, every search (confirmed or rejected) thins the conceptual
 map's unseen count there by the coverage of the cones looked through.
+
+The session is the seed's DT (Göbelbecker et al., §2): its MOVE costs are the robot's own
+driving times along the paths it would drive (`PathLengths`: `plan_path` on its grid, as the
+executor drives, never straight lines through walls), computed once per session; cones no path
+reaches are left out. Its terminal penalties are the CP's goal reward R
+(`ExecutorConfig.miss_penalty`, which the switching strategy sets from `LoopConfig.reward`).
+A search of a support looks on it and in it, as the knowledge lists the label there
+(`viewcones.support_relations`).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from avs_planner.dt import DTRewards, DTSession, DTStatus, SearchBudget
+from avs_planner.dt import DTRewards, DTSession, DTStatus, SearchBudget, TravelCosts, ViewCone
 from avs_planner.dt.domain import REJECT, ActionKind
 from avs_planner.episode.driving import TARGET_SEEN
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
-from avs_planner.episode.viewcones import ConeSet
+from avs_planner.episode.viewcones import ConeSet, support_relations, support_spaces
+from conceptual_map.errors import MapError
+from conceptual_map.metric import plan_path
 
 if TYPE_CHECKING:
     from avs_planner.episode.executor import Executor
@@ -34,12 +46,15 @@ class ViewConeSearch:
         made = self.ex.cones_now(label, relation, location)
         if made is None or not made.cones:
             return StepOutcome(StepStatus.FAILED, "no view cones for this search")
+        made, travel = self._reachable(made)
+        if not made.cones:
+            return StepOutcome(StepStatus.FAILED, "no view cone of this search is reachable")
         self.ex.stats.dt_calls += 1
+        reward = self.ex.config.miss_penalty  # R, the CP's goal reward (`LoopConfig.reward`)
         session = DTSession(made.cones, self.ex.config.detector, self.ex.robot.pose,
-                            policy=self.ex.config.dt_policy,
+                            travel_costs=travel, policy=self.ex.config.dt_policy,
                             budget=SearchBudget(num_sims=self.ex.config.dt_sims),
-                            rewards=DTRewards(self.ex.config.miss_penalty,
-                                              self.ex.config.miss_penalty),
+                            rewards=DTRewards(reward, reward),
                             seed=self.ex.seed + self.ex.stats.dt_calls)
         self.ex.dt_session = session  # the running session, for observers (the recorder)
         interrupted = False
@@ -70,6 +85,26 @@ class ViewConeSearch:
                      result=result.status.value, probability=round(result.probability, 4),
                      steps=len(result.trace), cones=len(made.cones))
         return self._conclude(result, label, relation, location, made, interrupted)
+
+    def _reachable(self, made: ConeSet) -> tuple[ConeSet, TravelCosts]:
+        """The cones the robot has a path to, and the DT's travel costs between them: driving
+        time along the robot's paths (`PathLengths`) plus the turn. A cone no path reaches
+        from the robot is left out (its share of the location stays unsearched); two cones
+        with no path between them are priced through the robot's pose."""
+        lengths = PathLengths(self.ex)
+        here = self.ex.robot.pose
+        keep = [c for c in made.cones if math.isfinite(lengths(here[:2], c.pose[:2]))]
+        if len(keep) < len(made.cones):
+            self.ex.emit("belief", unreachable_cones=[c.id for c in made.cones
+                                                      if c not in keep])
+            made = replace(made, cones=tuple(keep))
+        return made, travel_costs(here, made.cones, lengths, *self._speeds())
+
+    def _speeds(self) -> tuple[float, float]:
+        """(m/s, rad/s) the robot's body drives and turns at (the time model's defaults
+        without a body)."""
+        body = self.ex.mind.body
+        return (body.linear_speed, body.angular_speed) if body is not None else (0.5, 1.0)
 
     def _look(self, label: str, relation: str, location: str) -> SeenLike | None:
         """PROCESSVIEWCONE: a detection in the searched location, seen twice. When the
@@ -119,10 +154,15 @@ class ViewConeSearch:
         return matches[0] if matches else None
 
     def _inside(self, seen: SeenLike, relation: str, location: str) -> bool:
-        if relation == "on":
-            support = self.ex.mind.objects[location]
+        if relation == "on":  # a support: on its top, or inside it where the knowledge
+            support = self.ex.mind.objects[location]  # puts the label
             top = 2.0 * support.position[2]
             low, high = self.ex.config.above_support
+            relations = support_relations(self.ex.mind, seen.label, support.label)
+            if "in" in relations:
+                low = -top  # down to the floor: a cup in a shelf
+            if "on" not in relations:
+                high = 0.0
             reach = self.ex.config.support_radius
             near = math.dist(seen.position[:2], support.position[:2]) <= reach
             return near and top + low <= seen.position[2] <= top + high
@@ -130,6 +170,15 @@ class ViewConeSearch:
             return False
         return not self.ex.known_near(seen)  # not a desk it found before
 
+
+    def _searched(self, label: str, relation: str, location: str, coverage: float) -> None:
+        """The looks thin `label`'s unseen count at the location: a room, or every space of a
+        support the search looked at (on it, in it)."""
+        if relation != "on":
+            self.ex.mind.searched(label, relation, location, coverage, 1.0)
+            return
+        for space in support_spaces(self.ex.mind, label, location):
+            self.ex.mind.cmap.observe_search(label, space, min(1.0, coverage), 1.0)
 
     def _conclude(self, result, label: str, relation: str, location: str,  # noqa: ANN001
                   made: ConeSet, interrupted: bool = False) -> StepOutcome:
@@ -152,12 +201,12 @@ class ViewConeSearch:
                 # Poisson thinning: whatever was found, the cones looked through leave
                 # Poisson(lambda (1 - share seen)) of `label` unseen there, so a second
                 # desk stays as likely as before only in the part not looked at
-                self.ex.mind.searched(label, relation, location, coverage, 1.0)
+                self._searched(label, relation, location, coverage)
             atoms = {("label-of", obj.id, label), ("detected", obj.id),
                      ("related", obj.id, relation, location)}
             return StepOutcome(StepStatus.DONE, f"confirmed {obj.id}", {obj.id: atoms})
         if coverage > 0.0:
-            self.ex.mind.searched(label, relation, location, coverage, 1.0)
+            self._searched(label, relation, location, coverage)
         if interrupted:  # not a failed search: it stopped because the target turned up
             return StepOutcome(StepStatus.DONE, TARGET_SEEN)
         if relation == "on":
@@ -168,3 +217,56 @@ class ViewConeSearch:
             self.ex.builder.failed_in[key] = self.ex.builder.failed_in.get(key, 0) + 1
         return StepOutcome(StepStatus.DONE, "rejected" if coverage > 0 else
                            "rejected without looking")
+
+
+class PathLengths:
+    """Lengths (m) of the paths the robot would drive between two points, as the executor
+    plans them (`plan_path` on its grid keeping its planning radius, else the executor's
+    squeeze: a slimmer margin, then unknown cells); inf where there is none. Memoised: one
+    instance serves one DT session (the grid does not change while its costs are made)."""
+
+    def __init__(self, executor: Executor):
+        self.ex = executor
+        self._memo: dict[tuple[tuple[float, float], tuple[float, float]], float] = {}
+
+    def __call__(self, a: Sequence[float], b: Sequence[float]) -> float:
+        pa, pb = (round(a[0], 3), round(a[1], 3)), (round(b[0], 3), round(b[1], 3))
+        key = (pa, pb) if pa <= pb else (pb, pa)
+        if key not in self._memo:
+            self._memo[key] = self._length(*key)
+        return self._memo[key]
+
+    def _length(self, a: tuple[float, float], b: tuple[float, float]) -> float:
+        if math.dist(a, b) < 1e-9:
+            return 0.0
+        mind = self.ex.mind
+        try:
+            path = plan_path(mind.grid, a, b, mind.config.robot_radius)
+        except MapError:
+            path = None
+        if path is None or not path.found:
+            path = self.ex._squeeze(a, b)
+        return path.length if path.found else math.inf
+
+
+def travel_costs(start: Sequence[float], cones: Sequence[ViewCone], length: PathLengths,
+                 speed: float, turn_speed: float) -> TravelCosts:
+    """The DT's MOVE costs (s): driving time along `length` plus the turn to the cone's
+    heading; a pair of cones with no path between them is priced through `start` (both are
+    reachable from there)."""
+    def cost(a: Sequence[float], b: Sequence[float], metres: float) -> float:
+        return metres / speed + abs(math.remainder(b[2] - a[2], math.tau)) / turn_speed
+
+    poses = [c.pose for c in cones]
+    from_start = [length(start[:2], p[:2]) for p in poses]
+    rows = []
+    for i, a in enumerate(poses):
+        row = []
+        for j, b in enumerate(poses):
+            metres = length(a[:2], b[:2])
+            if not math.isfinite(metres):
+                metres = from_start[i] + from_start[j]
+            row.append(cost(a, b, metres))
+        rows.append(row)
+    return TravelCosts.from_lists([cost(start, p, m) for p, m in zip(poses, from_start,
+                                                                      strict=True)], rows)

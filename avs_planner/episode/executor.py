@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import Any
 
 from avs_planner.cp.search import PlanStep
@@ -22,7 +23,14 @@ from avs_planner.episode.glimpses import Glimpses
 from avs_planner.episode.mind import KnownObject, Mind
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
 from avs_planner.episode.state_builder import AvsState, StateBuilder
-from avs_planner.episode.viewcones import CameraModel, ConeSet, room_cones, support_cones
+from avs_planner.episode.viewcones import (
+    CameraModel,
+    ConeSet,
+    p_at_support,
+    room_cones,
+    support_cones,
+    support_relations,
+)
 from conceptual_map.conceptual.errors import ConceptualError
 from conceptual_map.metric import distance_field
 
@@ -51,7 +59,9 @@ class ExecutorConfig:
     # a leg the base refuses becomes a keep-out disc and the path is planned again around
     # it, up to this many times per move; then the move fails and the CP plans around it
     detours: int = 2
-    miss_penalty: float = 500.0  # s of robot time: the CP's goal reward R
+    # s of robot time: the CP's goal reward R, the DT's terminal penalties; the switching
+    # strategy sets it from `LoopConfig.reward` (one R per episode)
+    miss_penalty: float = 500.0
     support_radius: float = 0.9  # m: a detection this near a support is "on" it
     same_object: float = 1.0  # m: a detection this near a known object of its label is it
     above_support: tuple[float, float] = (-0.15, 0.45)  # m around the support's top
@@ -461,11 +471,12 @@ class Executor(Driving):
             support = self.mind.objects.get(location)
             if support is None:
                 return StepOutcome(StepStatus.FAILED, f"{location} is not a known object")
-            if p is None:
-                p = self.mind.cmap.p_object_at(label, ("on", location))
+            if p is None:  # on it and in it, where the knowledge puts the label
+                p = p_at_support(self.mind, label, location)
             made = (self.support_views is None and self.qsr_cones
                     and self.qsr_cones.support_cones(label, support, p, key)) or \
-                (self.support_views or support_cones)(self.mind, support, p, self.camera, key)
+                (self.support_views or partial(support_cones, relations=support_relations(
+                    self.mind, label, support.label)))(self.mind, support, p, self.camera, key)
         else:
             if location not in self.mind.place_map.rooms:
                 return StepOutcome(StepStatus.FAILED, f"{location} is not a known room")
@@ -484,10 +495,12 @@ class Executor(Driving):
         return StepOutcome(StepStatus.DONE, f"{len(made.cones)} cones")
 
     def location_belief(self, label: str, relation: str, location: str) -> float:
-        """The map's P(ObjectAt) of the location itself (not its supports)."""
-        where = ("on", location) if relation == "on" else location
+        """The map's P(ObjectAt) of the location itself (not its supports; a support's
+        spaces the knowledge puts the label in: on it, in it)."""
         try:
-            return self.mind.cmap.p_object_at(label, where, include_sublocations=False)
+            if relation == "on":
+                return p_at_support(self.mind, label, location)
+            return self.mind.cmap.p_object_at(label, location, include_sublocations=False)
         except ConceptualError:  # a location the map no longer has: no rescaling
             return 0.0
 

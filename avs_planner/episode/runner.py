@@ -30,7 +30,7 @@ from avs_planner.episode.snapshots import MapSnapshots
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.trace import Trace, write_summary
 from avs_planner.episode.viewcones import CameraModel
-from conceptual_map.knowledge import load_knowledge
+from conceptual_map.knowledge import Knowledge, load_knowledge
 
 Emit = Callable[[dict[str, Any]], None]
 
@@ -41,7 +41,7 @@ REPORT_TOLERANCE = 0.5
 
 _KEYS = {"target", "category", "world", "world_file", "robot", "start_room", "start", "seed",
          "time_budget_s", "wall_budget_s", "task_id", "output_dir", "pre_explore", "dt_policy",
-         "strategy", "strategy_options", "generate", "qsr", "record", "view"}
+         "strategy", "strategy_options", "generate", "qsr", "record", "view", "strict_labels"}
 
 
 @dataclass(frozen=True)
@@ -67,6 +67,9 @@ class EpisodeSpec:
     qsr: Any = field(default=None, repr=False)  # QsrKnowledge with the task's descriptions
     record: bool = False  # write recording.rrd in output_dir (needs the viewer extra)
     view: bool = False  # stream the recording to a Rerun viewer spawned for it
+    # a target the knowledge does not list is refused (else it is searched for with the
+    # knowledge's uninformed prior, `Knowledge.with_label`, and a `warning` event)
+    strict_labels: bool = False
 
     @classmethod
     def from_dict(cls, spec: Mapping[str, Any]) -> EpisodeSpec:
@@ -101,8 +104,16 @@ class EpisodeSpec:
             output_dir=spec.get("output_dir"), pre_explore=bool(spec.get("pre_explore")),
             dt_policy=str(spec.get("dt_policy") or "pouct"), strategy=strategy.name,
             strategy_options=options, generate=generate, world_text=spec.get("world_file"),
-            qsr=qsr_descriptions(spec.get("qsr")), **_recording(spec),
+            qsr=qsr_descriptions(spec.get("qsr")), strict_labels=_flag(spec, "strict_labels"),
+            **_recording(spec),
         )
+
+
+def _flag(spec: Mapping[str, Any], key: str) -> bool:
+    value = spec.get(key, False)
+    if not isinstance(value, bool):
+        raise EpisodeError(f"episode spec: {key!r} must be true or false, got {value!r}")
+    return value
 
 
 def _recording(spec: Mapping[str, Any]) -> dict[str, bool]:
@@ -165,6 +176,25 @@ def _number(value: Any, key: str) -> float:
     return number
 
 
+def target_knowledge(knowledge: Knowledge, target: str, strict: bool = False
+                     ) -> tuple[Knowledge, list[dict[str, Any]]]:
+    """The knowledge an episode searching for `target` plans with, and the warnings to trace:
+    a label it does not list gets its uninformed prior (`Knowledge.with_label`) and a warning
+    naming it; with `strict`, EpisodeError instead."""
+    if target in knowledge.labels:
+        return knowledge, []
+    if strict:
+        raise EpisodeError(f"unknown target label {target!r}; the knowledge knows "
+                           f"{', '.join(sorted(knowledge.labels))}")
+    model = knowledge.unknown
+    return knowledge.with_label(target), [{
+        "source": "knowledge", "label": target,
+        "detail": f"the knowledge ({knowledge.source}) has no priors for label {target!r}: "
+                  f"searching with its uninformed prior ({model.rate:g} expected per room of "
+                  f"any category, {model.room_share:g} of it in the room, the rest on "
+                  f"{', '.join(model.supports)})"}]
+
+
 def run_episode(spec: Mapping[str, Any], emit: Emit | None = None,
                 should_stop: Callable[[], bool] | None = None) -> dict[str, Any]:
     """Run one episode; returns the summary dict (also written to `output_dir`)."""
@@ -180,7 +210,8 @@ class Episode:
         self.spec = spec
         self.out = Path(spec.output_dir) if spec.output_dir else None
         self.world_spec = self._world_spec()
-        knowledge = load_knowledge()
+        knowledge, self.warnings = target_knowledge(load_knowledge(), spec.target,
+                                                    spec.strict_labels)
         check_categories(self.world_spec, knowledge.categories)
         self.robot: SimRobot = open_world(self.world_spec, spec.seed, knowledge.categories)
         self.mind = Mind.for_body(self.robot.body(), knowledge)  # its own body, not the world
@@ -253,6 +284,8 @@ class Episode:
             self.trace.emit("start", target=self.spec.target, world=self.world_spec.name,
                             robot=self.robot.model, pose=list(self.robot.pose),
                             seed=self.spec.seed, strategy=self.spec.strategy)
+            for warning in self.warnings:
+                self.trace.emit("warning", **warning)
             start_clock, start_distance = self._pre_explore()
             result = self._strategy().load()(self.context)
             summary = self.summary(result, start_clock, start_distance)
@@ -308,12 +341,19 @@ class Episode:
             "plans": result.plans, "replans": result.replans,
             "cp_time_s": [round(t, 4) for t in result.cp_times],
             "dt_calls": stats.dt_calls,
+            **self._dt_results(),
             "dt_decision_time_s": [round(t, 4) for t in stats.dt_decisions],
             "views_processed": stats.views, "seed": self.spec.seed,
             "world": self.world_spec.name, "robot": self.robot.model,
             "strategy": self.spec.strategy, "details": result.details,
             "wall_time_s": round(self.trace.wall, 2),
         }
+
+    def _dt_results(self) -> dict[str, int]:
+        """`dt_confirmed` / `dt_rejected`: the DT sessions of the episode by their result
+        (the trace's `dt` events)."""
+        results = [e.get("result") for e in self.trace.events if e["type"] == "dt"]
+        return {f"dt_{status}": results.count(status) for status in ("confirmed", "rejected")}
 
     def _truth_of(self, sid: int | None, position: tuple[float, float, float]) -> str | None:
         """The world entry a report names (scoring only: the robot never sees this). The

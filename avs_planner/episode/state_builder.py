@@ -17,8 +17,9 @@ from avs_planner.cp.task import Atom, WorldState
 from avs_planner.episode.domain import build_problem, planning_problem
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.mind import Mind
+from avs_planner.episode.viewcones import p_at_support, support_spaces
 from avs_planner.pddl import ProbabilisticProblem
-from conceptual_map.conceptual import RelatedSpace, p_at_least_one
+from conceptual_map.conceptual import p_at_least_one
 
 RELATIONS = ("in", "on")
 
@@ -130,10 +131,13 @@ class StateBuilder:
         self.revision = 0
 
     def _supports(self) -> list[str]:
+        """The target's support labels by their largest lambda (on them and in them: the
+        planner's `on` search of a support looks at both, `viewcones.support_relations`)."""
         knowledge = self.mind.cmap.knowledge
+        target = self.task.target
         ranked = sorted(
-            ((float(lam.max()), support) for (label, rel, support), lam
-             in knowledge.relation_lambda.items() if label == self.task.target and rel == "on"),
+            ((float(knowledge.support_lambda(target, support).max()), support)
+             for support in knowledge.support_relations(target)),
             reverse=True,
         )
         return [s for _, s in ranked[: self.config.max_supports]]
@@ -153,7 +157,7 @@ class StateBuilder:
         category beliefs (lambda of the relation times lambda of the support per room)."""
         cmap = self.mind.cmap
         knowledge = cmap.knowledge
-        per_category = (knowledge.relation_lambda_of(self.task.target, "on", support)
+        per_category = (knowledge.support_lambda(self.task.target, support)
                         * knowledge.room_lambda(support))
         rooms = [r for r in self.mind.place_map.rooms if cmap.graph.has_room(r)]
         return float(sum(cmap.room_marginal(r) @ per_category for r in rooms))
@@ -343,9 +347,9 @@ class StateBuilder:
     def _support_useful(self, support: str, category: str) -> bool:
         """Finding `support` in a room of `category` helps only if the target may be on it."""
         knowledge = self.mind.cmap.knowledge
-        if (self.task.target, "on", support) not in knowledge.relation_lambda:
+        if support not in knowledge.support_relations(self.task.target):
             return False
-        lam = knowledge.relation_lambda_of(self.task.target, "on", support)
+        lam = knowledge.support_lambda(self.task.target, support)
         p = float(p_at_least_one(lam[knowledge.category_index(category)]))
         return p >= self.config.min_probability
 
@@ -389,13 +393,12 @@ class StateBuilder:
         planner's threshold: the `p-obj-on` numbers are per support label and category, so
         this instance's own evidence reaches the planner as "settled"."""
         cmap = self.mind.cmap
-        if (label, "on", self.mind.objects[oid].label) not in cmap.knowledge.relation_lambda:
+        if self.mind.objects[oid].label not in cmap.knowledge.support_relations(label):
             return False
-        where = RelatedSpace("on", oid)
-        if cmap.objects.remaining(where, label) >= 1.0:
+        if all(cmap.objects.remaining(where, label) >= 1.0
+               for where in support_spaces(self.mind, label, oid)):
             return False
-        p = cmap.p_object_at(label, where, include_sublocations=False)
-        return p < self.config.min_probability
+        return p_at_support(self.mind, label, oid) < self.config.min_probability
 
     def _find_on(self, objects: list[str], values: dict[Atom, float]) -> None:
         """`p-find-on L S`: the chance a search on S finds the L the plan assumed there. The
@@ -414,17 +417,17 @@ class StateBuilder:
         averaged over the room's category belief (1 when nothing has looked at it)."""
         cmap = self.mind.cmap
         obj = self.mind.objects[oid]
-        if (label, "on", obj.label) not in cmap.knowledge.relation_lambda:
+        if obj.label not in cmap.knowledge.support_relations(label):
             return 1.0
-        where = RelatedSpace("on", oid)
-        if cmap.objects.remaining(where, label) >= 1.0 or not cmap.graph.has_room(obj.room):
+        if all(cmap.objects.remaining(where, label) >= 1.0
+               for where in support_spaces(self.mind, label, oid)) \
+                or not cmap.graph.has_room(obj.room):
             return 1.0
-        lam = cmap.knowledge.relation_lambda_of(label, "on", obj.label)
+        lam = cmap.knowledge.support_lambda(label, obj.label)
         prior = float(cmap.room_marginal(obj.room) @ p_at_least_one(lam))
         if prior <= 0.0:
             return 1.0
-        now = cmap.p_object_at(label, where, include_sublocations=False)
-        return min(1.0, now / prior)
+        return min(1.0, p_at_support(self.mind, label, oid) / prior)
 
     def could_hold(self, room: str) -> bool:
         """Under some category, the target may still be in `room` (on its known supports
@@ -482,10 +485,11 @@ class StateBuilder:
             for k, rel in enumerate(RELATIONS):
                 values[("search-cost", label, rel)] = self.search_cost(label, rel)
                 values[("p-detect", label, rel)] = detect[k]
+            supports = knowledge.support_relations(label)
             for support in self.labels:
-                lam = knowledge.relation_lambda_of(label, "on", support)
-                listed = (label, "on", support) in knowledge.relation_lambda
-                p = p_at_least_one(lam) if listed else np.zeros(len(knowledge.categories))
+                # on it and in it (`support_lambda`: zeros where the knowledge lists neither)
+                p = p_at_least_one(knowledge.support_lambda(label, support)) \
+                    if support in supports else np.zeros(len(knowledge.categories))
                 for c in self._current_categories:
                     k = knowledge.category_index(c)
                     values[("p-obj-on", label, support, c)] = self._restrict(c, self._prune(p[k]))

@@ -2,8 +2,10 @@
 
 The HTTP service calls `check_task` at submission, so a task that could never run (unknown
 label, category, start room, a start pose in a wall or outside the map, a bad strategy option)
-is refused at once instead of taking a queue slot and a worker. This is wiring, so it may read
-the world file through `sim`; it never builds a physics world.
+is refused at once instead of taking a queue slot and a worker. A target label the knowledge
+does not list is refused unless the task sets `strict_labels: false` (the episode then searches
+for it with the knowledge's uninformed prior; `EpisodeSpec.strict_labels` defaults to false).
+This is wiring, so it may read the world file through `sim`; it never builds a physics world.
 """
 
 from __future__ import annotations
@@ -75,8 +77,17 @@ def _check_strategy(task: Mapping[str, Any]) -> list[FieldProblem]:
 
 def _check_labels(task: Mapping[str, Any], knowledge: Knowledge) -> list[FieldProblem]:
     problems = []
-    if task.get("target") not in knowledge.labels:
-        problems.append(FieldProblem("target", f"unknown object label {task.get('target')!r}; "
+    target = task.get("target")
+    # a task that does not say (the service's schema has no `strict_labels` yet) is checked
+    # strictly, as before; `strict_labels: false` accepts a label the knowledge does not
+    # list (the episode searches for it with the uninformed prior, `Knowledge.with_label`)
+    strict = task.get("strict_labels", True)
+    if not isinstance(strict, bool):
+        problems.append(FieldProblem("strict_labels", f"must be true or false, got {strict!r}"))
+    if not isinstance(target, str) or not target:
+        problems.append(FieldProblem("target", "an object label is required"))
+    elif strict is not False and target not in knowledge.labels:
+        problems.append(FieldProblem("target", f"unknown object label {target!r}; "
                                      f"the knowledge base knows {_listed(knowledge.labels)}"))
     category = task.get("category")
     if category is not None and category not in knowledge.categories:

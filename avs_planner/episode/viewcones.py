@@ -3,7 +3,10 @@
 In a room, views stand at the room's places and look in eight directions; the occupied and
 unknown cells near the room's places are where objects (and their supports) may be, and a
 greedy covering set keeps the views that add the most such cells, each weighted by the share
-it adds of P(ObjectAt). On a support, views stand around it, facing it, head tilted at its top.
+it adds of P(ObjectAt). On a support, views stand around it, facing it, head tilted at where
+the knowledge puts the label there: its top (`on`), its inside (`in`: a cup in a shelf), or
+between the two when it lists both (`support_relations`); a search of a support looks for the
+label on it and in it.
 """
 
 from __future__ import annotations
@@ -15,7 +18,10 @@ import numpy as np
 
 from avs_planner.dt import ViewCone
 from avs_planner.episode.mind import KnownObject, Mind
+from conceptual_map.conceptual import RelatedSpace
 from conceptual_map.metric import CellState
+
+ABOVE_TOP = 0.3  # m above a support's top where an object on it is looked for
 
 
 @dataclass(frozen=True)
@@ -67,13 +73,55 @@ def room_cones(mind: Mind, room: str, label: str, p_total: float, camera: Camera
     return ConeSet(cones, coverage, p_total)
 
 
+def support_relations(mind: Mind, label: str, support_label: str) -> tuple[str, ...]:
+    """Where a search of a `support_label` looks for `label`: the relations the knowledge
+    lists for the pair (`on` its top, `in` it), in `RELATIONS` order; `("on",)` when it lists
+    none (the planner's support search is `on`)."""
+    return mind.cmap.knowledge.support_relations(label).get(support_label) or ("on",)
+
+
+def support_spaces(mind: Mind, label: str, oid: str) -> list[RelatedSpace]:
+    """The related spaces of the known object `oid` a search of it for `label` looks at
+    (`on` it for an object the mind no longer knows: the conceptual map then says so)."""
+    obj = mind.objects.get(oid)
+    relations = support_relations(mind, label, obj.label) if obj is not None else ("on",)
+    return [RelatedSpace(r, oid) for r in relations]
+
+
+def p_at_support(mind: Mind, label: str, oid: str) -> float:
+    """P(at least one `label` on or in the known object `oid`, where the knowledge lists it),
+    after the looks so far: the Poisson lambdas left in its spaces add up under each room
+    category before the category belief averages them (one space: the conceptual map's
+    `p_object_at` of it)."""
+    cmap = mind.cmap
+    spaces = support_spaces(mind, label, oid)
+    per_space = [cmap.p_object_at_per_category(label, space, include_sublocations=False)
+                 for space in spaces]
+    if len(per_space) == 1:
+        return cmap.p_object_at(label, spaces[0], include_sublocations=False)
+    lam = sum(-np.log1p(-np.clip(p, 0.0, 1.0 - 1e-12)) for p in per_space)
+    room = cmap.objects.objects[oid].room
+    return float(cmap.room_marginal(room) @ (1.0 - np.exp(-lam)))
+
+
+def aim_height(top: float, relations: tuple[str, ...]) -> float:
+    """The height a view of a support with its top at `top` aims at: the top itself for
+    `on` alone; with `in`, the middle of the band the label may be in (from half the
+    support's height up to its top, and up to `ABOVE_TOP` above it if also `on`)."""
+    if "in" not in relations:
+        return top
+    high = top + ABOVE_TOP if "on" in relations else top
+    return (top / 2.0 + high) / 2.0
+
+
 def support_cones(mind: Mind, support: KnownObject, p_total: float, camera: CameraModel,
                   key: str, distances: tuple[float, ...] = (0.9, 1.2, 1.5),
-                  max_cones: int = 4) -> ConeSet:
-    """Views around a known support from traversable standpoints, facing its top; the
-    nearest standpoint per direction, then the most spread-out directions."""
+                  max_cones: int = 4, relations: tuple[str, ...] = ("on",)) -> ConeSet:
+    """Views around a known support from traversable standpoints, facing its top (inside
+    it, or between, by `relations`: `support_relations`); the nearest standpoint per
+    direction, then the most spread-out directions."""
     sx, sy = support.position[:2]
-    top = max(0.3, min(2.0 * support.position[2], camera.height - 0.1))
+    top = max(0.3, min(aim_height(2.0 * support.position[2], relations), camera.height - 0.1))
     free = mind.grid.traversable(mind.config.robot_radius)
     stands = []
     for k in range(12):

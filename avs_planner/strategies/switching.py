@@ -12,6 +12,8 @@ weighting in a comparison (the extra labels change the detector's noise draws)."
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.loop import LoopConfig, SwitchingLoop
 from avs_planner.episode.outcome import SearchResult
@@ -35,6 +37,8 @@ def run(ctx: SearchContext) -> SearchResult:
             qsr.weighting = mode == "on"
     config = LoopConfig(time_budget_s=ctx.time_budget_s, wall_budget_s=ctx.wall_budget_s,
                         dump_dir=ctx.dump_dir, **options)
+    # one goal reward R per episode: the CP's objective and the DT's terminal penalties
+    ctx.executor.config = replace(ctx.executor.config, miss_penalty=config.reward)
     loop = SwitchingLoop(ctx.builder, ctx.executor, ctx.trace, config, ctx.should_stop)
     loop.start_clock = ctx.start_clock
     return loop.run()

@@ -1,7 +1,13 @@
 """Default commonsense knowledge (YAML data) and its validating loader."""
 
 from conceptual_map.knowledge.loader import DEFAULT_KNOWLEDGE_PATH, load_knowledge, parse_knowledge
-from conceptual_map.knowledge.model import RELATIONS, Knowledge, PlaceholderModel, PropertyModel
+from conceptual_map.knowledge.model import (
+    RELATIONS,
+    Knowledge,
+    PlaceholderModel,
+    PropertyModel,
+    UnknownLabelModel,
+)
 
 __all__ = [
     "DEFAULT_KNOWLEDGE_PATH",
@@ -9,6 +15,7 @@ __all__ = [
     "Knowledge",
     "PlaceholderModel",
     "PropertyModel",
+    "UnknownLabelModel",
     "load_knowledge",
     "parse_knowledge",
 ]

@@ -16,7 +16,13 @@ import numpy as np
 import yaml
 
 from conceptual_map.errors import KnowledgeError
-from conceptual_map.knowledge.model import RELATIONS, Knowledge, PlaceholderModel, PropertyModel
+from conceptual_map.knowledge.model import (
+    RELATIONS,
+    Knowledge,
+    PlaceholderModel,
+    PropertyModel,
+    UnknownLabelModel,
+)
 
 DEFAULT_KNOWLEDGE_PATH = Path(__file__).with_name("default.yaml")
 _ROW_TOLERANCE = 1e-6
@@ -111,7 +117,7 @@ def parse_knowledge(data: Any, source: str = "<knowledge>") -> Knowledge:
     root = reader.mapping(data, "top level")
     _check_keys(reader, root, "top level", required={"categories", "properties", "connectivity",
                                                     "objects", "relations", "placeholders"},
-                optional={"version"})
+                optional={"version", "unknown_labels"})
     categories, prior = _categories(reader, root["categories"])
     object_lambda, default_object = _objects(reader, root["objects"], categories)
     relation_lambda, default_relation = _relations(
@@ -128,6 +134,7 @@ def parse_knowledge(data: Any, source: str = "<knowledge>") -> Knowledge:
         relation_lambda=MappingProxyType(relation_lambda),
         default_relation_lambda=default_relation,
         placeholder=_placeholder(reader, root["placeholders"]),
+        unknown=_unknown_labels(reader, root.get("unknown_labels"), frozenset(object_lambda)),
     )
 
 
@@ -268,4 +275,27 @@ def _placeholder(reader: _Reader, value: Any) -> PlaceholderModel:
         p_room_leads_on=reader.number(
             spec["p_room_leads_on"], "placeholders.p_room_leads_on", 0.0, 1.0
         ),
+    )
+
+
+def _unknown_labels(reader: _Reader, value: Any, labels: frozenset[str]) -> UnknownLabelModel:
+    """The uninformed prior of labels the file does not list; `UnknownLabelModel`'s defaults
+    where the section (or a key of it) is left out."""
+    if value is None:
+        return UnknownLabelModel()
+    spec = reader.mapping(value, "unknown_labels")
+    _check_keys(reader, spec, "unknown_labels", set(), {"rate", "room_share", "supports"})
+    default = UnknownLabelModel()
+    supports = default.supports
+    if "supports" in spec:
+        supports = reader.names(spec["supports"], "unknown_labels.supports")
+        for name in supports:
+            if name not in labels:
+                raise reader.fail("unknown_labels.supports",
+                                  f"{name!r} has no entry under objects.lambda")
+    return UnknownLabelModel(
+        rate=reader.positive(spec.get("rate", default.rate), "unknown_labels.rate"),
+        room_share=reader.number(spec.get("room_share", default.room_share),
+                                 "unknown_labels.room_share", 0.0, 1.0),
+        supports=supports,
     )

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 
 import numpy as np
@@ -34,6 +34,21 @@ class PlaceholderModel:
 
 
 @dataclass(frozen=True)
+class UnknownLabelModel:
+    """The uninformed prior of a label the knowledge does not list (`Knowledge.with_label`).
+
+    `rate`: expected number of the label in a room, the same for every room category (an
+    unknown label says nothing about which rooms hold it). `room_share` of it lies directly in
+    the room; the rest is shared evenly by the support instances a room of that category is
+    expected to hold (each `supports` label's room lambda), `on` them.
+    """
+
+    rate: float = 0.5
+    room_share: float = 0.5
+    supports: tuple[str, ...] = ("table", "counter", "desk", "shelf")
+
+
+@dataclass(frozen=True)
 class Knowledge:
     """Category priors, property likelihoods, phi_rc and Poisson lambdas for the chain graph."""
 
@@ -47,6 +62,7 @@ class Knowledge:
     relation_lambda: MappingProxyType[tuple[str, str, str], np.ndarray]
     default_relation_lambda: float
     placeholder: PlaceholderModel
+    unknown: UnknownLabelModel = field(default_factory=UnknownLabelModel)
     _category_index: dict[str, int] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
@@ -64,6 +80,28 @@ class Knowledge:
         except KeyError:
             raise KeyError(f"unknown room category {category!r}") from None
 
+    def with_label(self, label: str) -> Knowledge:
+        """This knowledge, plus `label` with the uninformed prior of `unknown` if it is not
+        listed (unchanged if it is): `rate` expected per room in every category, `room_share`
+        of it directly in the room, the rest spread evenly over the expected instances of the
+        `unknown.supports` labels the knowledge lists (one lambda per support instance and
+        category, the same for every support label)."""
+        if label in self.object_lambda:
+            return self
+        model, n = self.unknown, len(self.categories)
+        supports = [s for s in model.supports if s in self.object_lambda and s != label]
+        direct = model.rate * (model.room_share if supports else 1.0)
+        relations = dict(self.relation_lambda)
+        if supports:
+            expected = sum(self.object_lambda[s] for s in supports)  # supports per room
+            per_support = np.divide(model.rate - direct, expected, out=np.zeros(n),
+                                    where=expected > 0)
+            for support in supports:
+                relations[(label, "on", support)] = per_support.copy()
+        return replace(self, object_lambda=MappingProxyType(
+            {**self.object_lambda, label: np.full(n, direct)}),
+            relation_lambda=MappingProxyType(relations), _category_index={})
+
     def room_lambda(self, label: str) -> np.ndarray:
         """Expected count of `label` directly in a room, per category (KeyError if unknown)."""
         try:
@@ -79,6 +117,23 @@ class Knowledge:
             raise KeyError(f"unknown relation {relation!r} (expected one of {RELATIONS})")
         default = np.full(len(self.categories), self.default_relation_lambda)
         return self.relation_lambda.get((label, relation, support), default)
+
+    def support_relations(self, label: str) -> dict[str, tuple[str, ...]]:
+        """Support label -> the relations (`on`, `in`) the knowledge lists for `label` with it:
+        where a search of a support looks (on its top, inside it)."""
+        out: dict[str, tuple[str, ...]] = {}
+        for lab, relation, support in self.relation_lambda:
+            if lab == label:
+                out[support] = (*out.get(support, ()), relation)
+        return {s: tuple(r for r in RELATIONS if r in rels) for s, rels in out.items()}
+
+    def support_lambda(self, label: str, support: str) -> np.ndarray:
+        """Expected count of `label` at one `support` instance (on it and in it: the listed
+        relations summed), per category; zeros if the knowledge lists neither."""
+        total = np.zeros(len(self.categories))
+        for relation in self.support_relations(label).get(support, ()):
+            total = total + self.relation_lambda[(label, relation, support)]
+        return total
 
     def total_room_lambda(self, label: str) -> np.ndarray:
         """Expected count of `label` anywhere in a room: direct plus on/in expected supports.

@@ -15,7 +15,7 @@ from avs_planner.episode import EpisodeError, run_episode
     [
         (["--target", "cerealbox", "--start", "1,2"], "expected x,y,yaw"),
         (["--target", "cerealbox", "--world", "no_such_world"], "no_such_world"),
-        (["--target", "unicorn"], "unknown target label 'unicorn'"),
+        (["--target", "unicorn", "--strict-labels"], "unknown target label 'unicorn'"),
         (["--world", "office"], "--target LABEL"),
         (["--target", "cerealbox", "--start-room", "attic"], "attic"),
         (["--scenario", "z"], "unknown scenario 'z'"),

@@ -1,0 +1,59 @@
+"""The uninformed prior of a label the knowledge does not list, and support relations (on and
+in) of a label."""
+
+import numpy as np
+import pytest
+import yaml
+
+from conceptual_map.conceptual import ConceptualMap
+from conceptual_map.errors import KnowledgeError
+from conceptual_map.knowledge import DEFAULT_KNOWLEDGE_PATH, UnknownLabelModel, load_knowledge
+from conceptual_map.knowledge.loader import KnowledgeYamlLoader
+
+
+def test_an_unknown_label_gets_the_same_rate_in_every_category_spread_over_supports():
+    knowledge = load_knowledge()
+    assert "bottle" not in knowledge.labels
+    model = knowledge.unknown
+    assert model == UnknownLabelModel(rate=0.5, room_share=0.5,
+                                      supports=("table", "counter", "desk", "shelf"))
+    with_bottle = knowledge.with_label("bottle")
+    assert "bottle" in with_bottle.labels and "bottle" not in knowledge.labels
+    np.testing.assert_allclose(with_bottle.room_lambda("bottle"), 0.25)
+    np.testing.assert_allclose(with_bottle.total_room_lambda("bottle"), 0.5)  # uninformed
+    on_table = with_bottle.relation_lambda_of("bottle", "on", "table")
+    for support in model.supports:  # one lambda per support instance, whatever its label
+        np.testing.assert_array_equal(with_bottle.relation_lambda_of("bottle", "on", support),
+                                      on_table)
+    assert with_bottle.category_index("office") == knowledge.category_index("office")
+    assert knowledge.with_label("cup") is knowledge  # listed: unchanged
+    cmap = ConceptualMap(with_bottle)  # the conceptual map takes it as any label
+    cmap.graph.add_room("r")
+    assert cmap.p_object_at("bottle", "r") == pytest.approx(1 - np.exp(-0.25))
+
+
+def test_the_knowledge_file_sets_the_uninformed_prior(tmp_path):
+    data = yaml.load(DEFAULT_KNOWLEDGE_PATH.read_text(), Loader=KnowledgeYamlLoader)
+    data["unknown_labels"] = {"rate": 1.0, "room_share": 1.0}
+    path = tmp_path / "mine.yaml"
+    path.write_text(yaml.safe_dump(data))
+    knowledge = load_knowledge(path).with_label("bottle")
+    np.testing.assert_allclose(knowledge.room_lambda("bottle"), 1.0)
+    data["unknown_labels"] = {"supports": ["spaceship"]}
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(KnowledgeError, match="unknown_labels.supports"):
+        load_knowledge(path)
+    data["unknown_labels"] = {"rate": 0.0}
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(KnowledgeError, match="unknown_labels.rate"):
+        load_knowledge(path)
+
+
+def test_support_relations_list_in_as_well_as_on():
+    knowledge = load_knowledge()
+    relations = knowledge.support_relations("cup")
+    assert relations["shelf"] == ("in",) and relations["table"] == ("on",)
+    kitchen = knowledge.category_index("kitchen")
+    assert knowledge.support_lambda("cup", "shelf")[kitchen] == pytest.approx(1.5)
+    assert knowledge.support_lambda("cerealbox", "shelf")[kitchen] == pytest.approx(0.6)
+    assert not knowledge.support_lambda("cup", "sofa").any()
