@@ -347,7 +347,16 @@ class Episode:
             "world": self.world_spec.name, "robot": self.robot.model,
             "strategy": self.spec.strategy, "details": result.details,
             "wall_time_s": round(self.trace.wall, 2),
+            **self._map_score(),
         }
+
+    def _map_score(self) -> dict[str, Any]:
+        """{"map_score": ...}: the mind's rooms scored against the world file's (the harness
+        holds both; `map_score.py`); empty when the mind has no rooms."""
+        from avs_planner.episode.map_score import map_score
+
+        score = map_score(self.world_spec, self.mind, self.executor.stats.path)
+        return {} if score is None else {"map_score": score}
 
     def _dt_results(self) -> dict[str, int]:
         """`dt_confirmed` / `dt_rejected`: the DT sessions of the episode by their result

@@ -26,7 +26,7 @@ from conceptual_map.places.model import (
     Placeholder,
     Room,
 )
-from conceptual_map.places.rooms import free_regions, place_groups, room_geometry
+from conceptual_map.places.rooms import free_regions, place_groups, room_extents, room_geometry
 from conceptual_map.places.tracking import match_by_distance, match_by_overlap
 from conceptual_map.places.unvisited import unvisited_regions
 
@@ -50,6 +50,7 @@ class PlaceMap:
         self._path: list[np.ndarray] = []
         self._counters: dict[str, int] = {}
         self._door_revision = 0  # edges remember which revision of the doors they were checked at
+        self._extents: tuple | None = None  # (key, owner, room ids, free regions): room_extents
 
     # ---- public API -------------------------------------------------------------------------
 
@@ -104,6 +105,51 @@ class PlaceMap:
             if place_id in room.places:
                 return room.id
         return None
+
+    def room_extents(self, grid: OccupancyGrid) -> tuple[np.ndarray, list[str]]:
+        """Each known free cell's room (`rooms.room_extents`): the free space, split at the
+        doors, that the room's places stand in; 0 where no room holds a cell."""
+        owner, ids, _ = self._room_extents(grid)
+        return owner, ids
+
+    def _room_extents(self, grid: OccupancyGrid) -> tuple[np.ndarray, list[str], np.ndarray]:
+        """`room_extents` and the free regions they are made of, cached until the grid, the
+        doors or the rooms change."""
+        key = (id(grid), grid.version, self._door_revision,
+               tuple(sorted((rid, room.places) for rid, room in self.rooms.items())))
+        if self._extents is None or self._extents[0] != key:
+            labels = free_regions(grid, [d.ends for d in self.doors.values()])
+            members = {rid: [self.places[p].position for p in sorted(room.places)
+                             if p in self.places] for rid, room in self.rooms.items()}
+            owner, ids = room_extents(grid, labels, members)
+            self._extents = (key, owner, ids, labels)
+        return self._extents[1], self._extents[2], self._extents[3]
+
+    def room_at(self, grid: OccupancyGrid, point: tuple[float, float],
+                reach: float = 1.0) -> str | None:
+        """The room a point of the floor plan is in: the room holding the free cell nearest
+        to it within `reach` m (an object seen stands on occupied cells: a table, a shelf;
+        the floor around it tells the room). None when that free space is no room's: beyond
+        a door, in a room seen but not entered (an object seen there is not evidence about
+        the room the robot looked from). With no free cell that near (the map around the
+        point not seen yet), the room of the nearest place, as before any extent is known."""
+        if not self.rooms:
+            return None
+        owner, ids, labels = self._room_extents(grid)
+        cell = grid.to_cell(np.asarray([point], dtype=float))[0]
+        r = int(np.ceil(reach / grid.resolution))
+        lo = np.maximum(cell - r, 0)
+        hi = np.minimum(cell + r + 1, owner.shape)
+        if np.all(hi > lo):
+            candidates = np.argwhere(labels[lo[0]:hi[0], lo[1]:hi[1]] > 0)
+            if len(candidates):
+                d = np.linalg.norm(candidates + lo - cell, axis=1)
+                if d.min() * grid.resolution <= reach:
+                    i, j = candidates[int(np.argmin(d))] + lo
+                    k = int(owner[i, j])
+                    return ids[k - 1] if k else None
+        place, _ = self._nearest_place(np.asarray(point, dtype=float))
+        return self.room_of(place) if place is not None else None
 
     def room_links(self) -> dict[str, tuple[str, str]]:
         """Door id -> the two rooms it joins (room connectivity for the conceptual map)."""

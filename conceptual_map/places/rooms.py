@@ -5,6 +5,8 @@ Geometry (area, elongation) feeds the conceptual map's size and shape properties
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
+
 import networkx as nx
 import numpy as np
 from scipy import ndimage
@@ -66,3 +68,61 @@ def room_geometry(
     variances = np.linalg.eigvalsh(np.cov(coords.T))
     low = max(float(variances[0]), 1e-9)
     return area, float(np.sqrt(max(float(variances[-1]), low) / low))
+
+
+def room_extents(
+    grid: OccupancyGrid,
+    labels: np.ndarray,
+    rooms: Mapping[str, Sequence[tuple[float, float]]],
+    snap: float = 0.3,
+) -> tuple[np.ndarray, list[str]]:
+    """Which room each known free cell belongs to: the free regions (`free_regions`) its
+    places stand in, as for a room's area. Returns an int array over the grid (k + 1 for the
+    k-th of the returned sorted room ids, 0 for a cell no room holds: not free, or free space
+    no place stands in, such as a room seen through a door but not entered). A region several
+    rooms' places stand in (a door the free space leaks around) goes cell by cell to the room
+    of the nearest of those places. A place on no free region (e.g. in a doorway, where the
+    regions are cut) stands in the region of the nearest free cell within `snap` metres."""
+    ids = sorted(rooms)
+    owner = np.zeros(labels.shape, dtype=np.int32)
+    claims: dict[int, list[tuple[int, tuple[float, float]]]] = {}
+    for k, rid in enumerate(ids, start=1):
+        for position in rooms[rid]:
+            label = _region_at(grid, labels, position, snap)
+            if label:
+                claims.setdefault(label, []).append((k, position))
+    for label, claim in claims.items():
+        mask = labels == label
+        owners = {k for k, _ in claim}
+        if len(owners) == 1:
+            owner[mask] = owners.pop()
+            continue
+        cells = np.argwhere(mask)
+        centres = grid.to_world(cells)
+        points = np.asarray([p for _, p in claim], dtype=float)
+        nearest = np.linalg.norm(centres[:, None, :] - points[None, :, :], axis=2).argmin(axis=1)
+        owner[cells[:, 0], cells[:, 1]] = np.asarray([k for k, _ in claim])[nearest]
+    return owner, ids
+
+
+def _region_at(
+    grid: OccupancyGrid, labels: np.ndarray, position: tuple[float, float], snap: float
+) -> int:
+    """The free region at `position`, or of the nearest free cell within `snap` m (0: none)."""
+    cell = grid.to_cell(np.asarray([position], dtype=float))[0]
+    if not grid.inside(cell[None, :])[0]:
+        return 0
+    if labels[cell[0], cell[1]]:
+        return int(labels[cell[0], cell[1]])
+    r = int(np.ceil(snap / grid.resolution))
+    lo = np.maximum(cell - r, 0)
+    hi = np.minimum(cell + r + 1, labels.shape)
+    window = labels[lo[0]:hi[0], lo[1]:hi[1]]
+    found = np.argwhere(window > 0)
+    if len(found) == 0:
+        return 0
+    d = np.linalg.norm(found + lo - cell, axis=1)
+    if d.min() * grid.resolution > snap:
+        return 0
+    best = found[d.argmin()]
+    return int(window[best[0], best[1]])
