@@ -22,6 +22,7 @@ explanation has: what was searched, what was seen, and why the search ended.
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict
 from pathlib import Path
@@ -37,10 +38,74 @@ from avs_planner.episode.explain_terms import (
     is_virtual,
     rounded,
     why_refuted,
+    with_article,
 )
 
 EXPLANATION_VERSION = 1
 FILE_NAME = "explanation.json"
+
+
+# m: a place this near where a placeholder stood is in the room behind it, once explored
+# (the place map drops a place every metre along the path: one lies within about a metre of
+# any spot the robot went to)
+BEHIND_REACH = 1.5
+# m: objects detected this near where a placeholder stood were found behind it (the open
+# space a placeholder stands for is the unknown within 3 m: `PlaceMapConfig`)
+FOUND_REACH = 3.0
+
+
+class MapState:
+    """The last value of each part of the trace's `map` events (`episode/snapshots.py`): the
+    places with their rooms, every placeholder's last position, the rooms' category beliefs,
+    the known objects, and when each room and object first appeared."""
+
+    def __init__(self) -> None:
+        self.places: dict[str, tuple[float, float, str | None]] = {}
+        self.placeholders: dict[str, tuple[float, float]] = {}  # last positions, kept
+        self.rooms: dict[str, dict[str, float]] = {}
+        self.objects: dict[str, tuple[str, float, float, str | None]] = {}
+        self.since: dict[str, float] = {}  # room or object id -> when it first appeared
+
+    def feed(self, event: Mapping[str, Any]) -> None:
+        t = float(event.get("t") or 0.0)
+        if isinstance(event.get("places"), list):
+            self.places = {str(p[0]): (float(p[1]), float(p[2]), p[3])
+                           for p in event["places"] if len(p) >= 4}
+        for p in event.get("placeholders") or []:
+            if len(p) >= 3:
+                self.placeholders[str(p[0])] = (float(p[1]), float(p[2]))
+        if isinstance(event.get("rooms"), Mapping):
+            self.rooms = {str(k): dict(v) for k, v in event["rooms"].items()
+                          if isinstance(v, Mapping)}
+            for rid in self.rooms:
+                self.since.setdefault(rid, t)
+        if isinstance(event.get("objects"), list):
+            self.objects = {str(o[0]): (str(o[1]), float(o[2]), float(o[3]), o[4])
+                            for o in event["objects"] if len(o) >= 5}
+            for oid in self.objects:
+                self.since.setdefault(oid, t)
+
+    def room_behind(self, placeholder: str) -> str | None:
+        """The room of the place nearest to where `placeholder` last stood, within
+        `BEHIND_REACH` m (None: no place there, the robot did not map that space)."""
+        at = self.placeholders.get(placeholder)
+        if at is None or not self.places:
+            return None
+        x, y, room = min(self.places.values(), key=lambda p: math.dist(p[:2], at))
+        return room if math.dist((x, y), at) <= BEHIND_REACH else None
+
+    def new_since(self, rid: str, t: float) -> bool:
+        return self.since.get(rid, math.inf) >= t
+
+    def found_near(self, placeholder: str, t: float
+                   ) -> list[tuple[str, str, float, float, str | None]]:
+        """Objects (id, label, x, y, room) that first appeared at `t` or later within
+        `FOUND_REACH` m of where `placeholder` last stood."""
+        at = self.placeholders.get(placeholder)
+        if at is None:
+            return []
+        return [(oid, lab, x, y, where) for oid, (lab, x, y, where) in self.objects.items()
+                if self.new_since(oid, t) and math.dist((x, y), at) <= FOUND_REACH]
 
 
 class ExplainError(ValueError):
@@ -71,6 +136,7 @@ class Ledger:
         self._monitor_evidence: str | None = None
         self.tail: list[str] = []  # what happened since the last plan that was found
         self.events = 0
+        self.seen = MapState()  # the robot's map as the trace's `map` events drew it
 
     # ---- feeding -----------------------------------------------------------------------------
 
@@ -87,6 +153,9 @@ class Ledger:
 
     def _on_start(self, event: Mapping[str, Any]) -> None:
         self.start = {k: event.get(k) for k in ("target", "world", "robot", "seed", "strategy")}
+
+    def _on_map(self, event: Mapping[str, Any]) -> None:
+        self.seen.feed(event)
 
     def _on_action(self, event: Mapping[str, Any]) -> None:
         if event.get("status") == "start" or not event.get("action"):
@@ -278,10 +347,56 @@ class Ledger:
             if verdict == "assumption_contradicted":
                 if entry.p_last != 0.0:
                     entry.history.append({"t": t, "p": 0.0, "source": "monitor"})
-                why = why_refuted(entry, detail or verdict, self.went_to)
-                self._close(entry, "refuted", t, why, evidence)
+                status, why = self._behind(entry, t, evidence) or (
+                    "refuted", why_refuted(entry, detail or verdict, self.went_to))
+                self._close(entry, status, t, why, evidence)
         self.replans.append(record)
         self._pending_replan = record
+
+    def _behind(self, entry: Assumption, t: Any, evidence: str) -> tuple[str, str] | None:
+        """A room hypothesis about a placeholder the robot mapped the space behind, judged
+        by what it found there: the objects it detected there since the hypothesis was made
+        (within `FOUND_REACH` of where the placeholder last stood), the room it mapped there
+        (the room of the place nearest that spot, else the room it put those objects in) and
+        that room's believed category. An object of an assumption resting on the hypothesis
+        found there makes that assumption come true, whatever the category. None when the
+        map shows nothing there (the placeholder vanished unvisited)."""
+        if entry.kind != "assume-leads-to-room" or entry.subject is None:
+            return None
+        since = float(entry.assumed_at or 0.0)
+        objects = self.seen.found_near(entry.subject, since)
+        room = self.seen.room_behind(entry.subject)
+        if room is None and objects:
+            rooms = [o[4] for o in objects if o[4] is not None]
+            room = max(set(rooms), key=rooms.count) if rooms else None
+        if room is None:
+            return None
+        sig = next((s for s, e in self.open.items() if e is entry), None)
+        for other_sig, other in list(self.open.items()):
+            if sig is None or sig not in other_sig[1] or other is entry \
+                    or not other.kind.startswith("assume-obj-exists") or not other.label:
+                continue
+            match = [o for o in objects if o[1] == other.label
+                     and float(self.seen.since[o[0]]) >= float(other.assumed_at or 0.0)]
+            if match:
+                oid, label, x, y, where = match[0]
+                self._close(other, "confirmed", t, f"{with_article(label)} was found there: "
+                            f"{oid} at ({x:.2f}, {y:.2f}), in {where}", evidence)
+        found = ""
+        if objects:
+            labels = list(dict.fromkeys(o[1] for o in objects))
+            found = " (found there: " + ", ".join(with_article(x) for x in labels) + ")"
+        mapped = (f"{entry.subject} was explored{found}: the space behind it is {room}"
+                  + ("" if self.seen.new_since(room, since)
+                     else ", a room mapped before it was assumed"))
+        belief = self.seen.rooms.get(room) or {}
+        if not belief:
+            return "refuted", f"{mapped}, which has no category belief yet"
+        top = max(belief, key=lambda k: float(belief[k]))
+        believed = f"believed {distribution_text(belief, 3)}"
+        if top == entry.category:
+            return "confirmed", f"{mapped}, {believed}"
+        return "refuted", f"{mapped}, {believed}: not {with_article(str(entry.category))}"
 
     def _on_done(self, event: Mapping[str, Any]) -> None:
         self.done = {"t": event.get("t"), "outcome": event.get("outcome"),
@@ -472,19 +587,26 @@ def write(path: Path, explanation: Mapping[str, Any]) -> None:
 
 
 def final_beliefs(mind: Any, target: str) -> dict[str, Any]:
-    """The mind's beliefs at the end of an episode: each room's category belief and P(target
-    in it), each placeholder's belief about what lies behind it."""
+    """The mind's beliefs at the end of an episode: each room of its place map with its most
+    probable category (`believed`, `p`), its likeliest categories, P(target in it) and the
+    objects known in it; each placeholder's belief about what lies behind it."""
     cmap, pm = mind.cmap, mind.place_map
     rooms: dict[str, Any] = {}
-    for rid in sorted(pm.rooms):
+    for rid in sorted(pm.rooms, key=_natural):
+        objects = [o.label for o in mind.objects.values() if o.room == rid]
         if not cmap.graph.has_room(rid):
+            rooms[rid] = {"believed": None, "p": None, "category": {}, "p_target": None,
+                          "objects": objects}
             continue
         category = cmap.room_category(rid)
         try:
             p_target = cmap.p_object_at(target, rid)
         except Exception:  # noqa: BLE001 - a label the knowledge base does not know
             p_target = None
-        rooms[rid] = {"category": _top(category), "p_target": rounded(p_target)}
+        believed = max(category, key=category.get)
+        rooms[rid] = {"believed": believed, "p": rounded(category[believed]),
+                      "category": _top(category), "p_target": rounded(p_target),
+                      "objects": objects}
     placeholders: dict[str, Any] = {}
     for pid in sorted(pm.placeholders):
         try:
@@ -493,6 +615,13 @@ def final_beliefs(mind: Any, target: str) -> dict[str, Any]:
             continue
         placeholders[pid] = {"category": _top(category)}
     return {"rooms": rooms, "placeholders": placeholders}
+
+
+def _natural(name: str) -> tuple[str, int]:
+    """room2 before room10."""
+    head = name.rstrip("0123456789")
+    tail = name[len(head):]
+    return head, int(tail) if tail else -1
 
 
 def _top(dist: Mapping[str, float], n: int = 4) -> dict[str, float]:

@@ -6,6 +6,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from avs_planner.episode.explain import distribution_text
+from avs_planner.episode.explain_terms import with_article
 
 
 def _p(value: Any) -> str:
@@ -14,6 +15,25 @@ def _p(value: Any) -> str:
 
 def _t(value: Any) -> str:
     return "?" if value is None else f"{float(value):.1f} s"
+
+
+def _room_belief(room: Mapping[str, Any]) -> str:
+    """'a kitchen (0.97; office 0.02, bathroom 0.01), P=0.6; objects: table, cerealbox'."""
+    dist = room.get("category") or {}
+    believed, p = room.get("believed"), room.get("p")
+    if believed is None and dist:  # an explanation written before `believed` was recorded
+        believed = max(dist, key=lambda k: float(dist[k]))
+        p = dist[believed]
+    if believed is None:
+        text = "no category belief"
+    else:
+        others = {k: v for k, v in dist.items() if k != believed}
+        text = f"{with_article(believed)} ({float(p):.2f}" + (
+            f"; {distribution_text(others, 2)})" if others else ")")
+    text += f", P={_p(room.get('p_target'))}"
+    if room.get("objects"):
+        text += "; objects: " + ", ".join(room["objects"])
+    return text
 
 
 def render(explanation: Mapping[str, Any]) -> str:
@@ -118,10 +138,9 @@ def render(explanation: Mapping[str, Any]) -> str:
     final = e.get("final_beliefs") or {}
     if final.get("rooms"):
         out.append("")
-        out.append(f"Beliefs at the end (P({e.get('target')} in room), room category):")
-        for rid, room in final["rooms"].items():
-            out.append(f"  {rid}: P={_p(room.get('p_target'))}, "
-                       f"{distribution_text(room.get('category') or {}, 3)}")
+        out.append(f"Beliefs at the end (each room's most probable category, P({e.get('target')}"
+                   f" in the room), the objects known in it):")
+        out += [f"  {rid}: {_room_belief(room)}" for rid, room in final["rooms"].items()]
     notes = e.get("notes") or []
     if notes:
         out.append("")

@@ -220,3 +220,109 @@ def test_a_planner_timeout_keeps_the_assumptions_until_the_fallback_plan() -> No
     assert [e["status"] for e in explanation["assumptions"]] == [
         "refuted", "refuted", "confirmed", "confirmed"]
     assert "planned again with the fallback heuristic" in explain.render(explanation)
+
+
+LEADS5 = "(assume-leads-to-room placeholder5 kitchen new-room1)"
+EXISTS5 = "(assume-obj-exists-in cerealbox new-room1 kitchen new-object1)"
+
+
+def seen_behind_trace(room: str, belief: dict[str, float],
+                      places: list[list[Any]]) -> list[dict[str, Any]]:
+    """Seed 003's Fig. 3a run as `avs simulate --scenario a --seed 1` traced it: plan 5
+    assumes a kitchen behind placeholder5; on the way there the robot sees a table, a counter
+    and the cereal box through the doorway (the mind puts them in `room`), placeholder5
+    vanishes, and the monitor calls the room hypothesis impossible."""
+    corridor = {"corridor": 0.9, "office": 0.1}
+    return [
+        {"t": 0.0, "type": "start", "target": "cerealbox", "world": "office",
+         "strategy": "switching", "seed": 1, "robot": "pioneer"},
+        {"t": 0.0, "type": "map", "pose": [6.0, 3.2, 0.0],
+         "places": [["place1", 6.0, 3.2, "room1"]],
+         "placeholders": [["placeholder5", 2.03, 4.03]], "rooms": {"room1": corridor},
+         "objects": [["object1", "table", 9.0, 5.21, "room1"]]},
+        plan(129.4, "replan", [LEADS5, EXISTS5, "(move place15 placeholder5)",
+                               "(createviewcones-in cerealbox new-room1)",
+                               "(searchforobject-in cerealbox new-room1 new-object1 "
+                               "placeholder5)", "(reportposition new-object1 cerealbox)"],
+             [0.124, 0.924, 1.0, 1.0, 0.5, 1.0]),
+        {"t": 129.4, "type": "action", "action": "(move place15 placeholder5)",
+         "status": "start"},
+        {"t": 166.4, "type": "map", "pose": [3.06, 3.56, 3.0],
+         "placeholders": [["placeholder5", 1.53, 4.68]]},
+        {"t": 171.2, "type": "observation", "label": "table", "detected": True,
+         "watching": True, "position": [1.99, 6.02, 0.27], "object": "object2"},
+        {"t": 173.2, "type": "observation", "label": "cerealbox", "detected": True,
+         "watching": True, "position": [2.16, 5.84, 0.93]},
+        {"t": 173.2, "type": "action", "action": "(move place15 placeholder5)",
+         "status": "done", "detail": "saw the target on the way"},
+        {"t": 173.2, "type": "map", "pose": [2.14, 3.79, 2.0], "places": places,
+         "placeholders": [], "rooms": {"room1": corridor, room: belief},
+         "objects": [["object1", "table", 9.0, 5.21, "room1"],
+                     ["object2", "table", 1.99, 6.02, room],
+                     ["object4", "cerealbox", 2.16, 5.84, room]]},
+        {"t": 173.2, "type": "monitor", "verdict": "assumption_contradicted", "confirmed": [],
+         "assumptions": {LEADS5: 0.0}},
+        {"t": 173.2, "type": "replan", "status": "assumption_contradicted", "action": LEADS5,
+         "detail": "no longer possible (unreachable or probability 0)"},
+        plan(173.2, "replan", ["(reportposition object4 cerealbox)"], [1.0]),
+        {"t": 174.3, "type": "action", "action": "(reportposition object4 cerealbox)",
+         "status": "found", "detail": "cerealbox at (2.16, 5.84, 0.93)"},
+        {"t": 174.3, "type": "done", "outcome": "found", "reason": "cerealbox at (2.16, 5.84)"},
+    ]
+
+
+def test_a_room_hypothesis_is_confirmed_by_the_kitchen_and_box_found_behind_it() -> None:
+    """The robot mapped a room behind placeholder5 that it believes a kitchen, with the box in
+    it: both assumptions came true, though the placeholder is gone (the monitor's verdict)."""
+    trace = seen_behind_trace("room4", {"kitchen": 0.97, "corridor": 0.02},
+                              [["place1", 6.0, 3.2, "room1"], ["place18", 2.91, 3.56, "room1"],
+                               ["place19", 1.9, 4.9, "room4"]])
+    by_action = entries(explain.build(trace))
+    (leads,) = by_action[LEADS5]
+    assert leads["status"] == "confirmed" and leads["ended_at"] == 173.2
+    assert "the space behind it is room4, believed kitchen 0.97" in leads["reason"]
+    assert "found there: a table, a cerealbox" in leads["reason"]
+    (exists,) = by_action[EXISTS5]
+    assert exists["status"] == "confirmed"
+    assert "a cerealbox was found there: object4 at (2.16, 5.84), in room4" in exists["reason"]
+
+
+def test_a_box_found_where_the_map_merged_the_kitchen_into_the_corridor() -> None:
+    """No door recognised: the kitchen's floor is part of the corridor's room1 (believed a
+    corridor). The box assumed behind placeholder5 was found there (confirmed); the kitchen,
+    by the robot's own belief, was not (refuted, naming the room and its belief)."""
+    trace = seen_behind_trace("room1", {"corridor": 0.61, "kitchen": 0.13},
+                              [["place1", 6.0, 3.2, "room1"], ["place18", 2.91, 3.56, "room1"]])
+    explanation = explain.build(trace)
+    by_action = entries(explanation)
+    (leads,) = by_action[LEADS5]
+    assert leads["status"] == "refuted"
+    assert ("the space behind it is room1, a room mapped before it was assumed, believed "
+            "corridor 0.61, kitchen 0.13: not a kitchen") in leads["reason"]
+    (exists,) = by_action[EXISTS5]
+    assert exists["status"] == "confirmed" and "object4" in exists["reason"]
+    assert "rests on" not in exists["reason"]
+    assert explanation["outcome"] == "found"
+
+
+def test_a_placeholder_that_vanished_unvisited_keeps_the_monitors_reason() -> None:
+    """No place near where it stood and nothing found there: the old reading stands."""
+    trace = seen_behind_trace("room1", {"corridor": 0.61}, [["place1", 6.0, 3.2, "room1"]])
+    trace = [e for e in trace if not (e["type"] == "map" and e["t"] == 173.2)]
+    (leads,) = entries(explain.build(trace))[LEADS5]
+    assert leads["status"] == "refuted" and "placeholder5 was explored" in leads["reason"]
+    assert "no unseen kitchen can be assumed behind it" in leads["reason"]
+
+
+def test_the_final_beliefs_name_each_room_with_its_most_probable_category() -> None:
+    final = {"rooms": {"room1": {"believed": "corridor", "p": 0.61,
+                                 "category": {"corridor": 0.61, "kitchen": 0.13,
+                                              "office": 0.1},
+                                 "p_target": 1.0, "objects": ["table", "cerealbox"]},
+                       "room2": {"category": {"office": 0.97, "corridor": 0.03},
+                                 "p_target": 0.0064}},  # written before `believed`
+             "placeholders": {}}
+    text = explain.render(explain.build(found_trace(), final))
+    assert "room1: a corridor (0.61; kitchen 0.13, office 0.10), P=1; objects: table, " \
+           "cerealbox" in text
+    assert "room2: an office (0.97; corridor 0.03), P=0.0064" in text
