@@ -17,7 +17,7 @@ from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep, SearchOption
 from avs_planner.episode.executor import Executor
 from avs_planner.episode.outcome import Outcome, SearchResult, StepOutcome, StepStatus
 from avs_planner.episode.state_builder import AvsState, StateBuilder
-from avs_planner.episode.stopping import remaining
+from avs_planner.episode.stopping import Remaining, look_cost, remaining
 from avs_planner.episode.trace import Trace
 
 
@@ -195,7 +195,7 @@ class SwitchingLoop:
         (`stopping.remaining`), or None while some continuation is worth its cost."""
         if not self.config.stop_rule:
             return None
-        belief = remaining(self.executor.mind, self.builder, self.executor.robot.pose[:2])
+        belief = self._remaining()
         if belief.worth_going_on(self.config.reward):
             return None
         best = belief.best(self.config.reward)
@@ -418,8 +418,12 @@ class SwitchingLoop:
         """The building-level belief that the target is still to be found (for the trace)."""
         if not self.config.stop_rule:
             return None
-        mind, pose = self.executor.mind, self.executor.robot.pose
-        return round(remaining(mind, self.builder, pose[:2]).p, 5)
+        return round(self._remaining().p, 5)
+
+    def _remaining(self) -> Remaining:
+        ex = self.executor
+        return remaining(ex.mind, self.builder, ex.robot.pose[:2],
+                         look_cost(ex.mind.body, ex.config.look_headings))
 
     def _budget_spent(self) -> str | None:
         cfg = self.config

@@ -12,13 +12,15 @@ Search in Large Environments").
 
 The stopping rule uses the paper's own objective c + R(1 - p): any continuation finds the
 target with at most the probability left, P, and costs at least the cheapest first step (the
-way to the nearest room or placeholder left plus the cheapest search that could find the
-target there). When R * P is not more than that, going on is worse than giving up by the
-planner's own measure, whatever plan it would make; the give-up names the probability left.
+way to the nearest room or placeholder left plus the cheapest way to find the target there:
+a search, or one look around, since the detector watches wherever the robot arrives).
+When R * P is not more than that, going on is worse than giving up by the planner's
+measure, whatever plan it would make; the give-up names the probability left.
 The test is on the whole of P, not option by option: exploring reveals several rooms at once,
 and ten placeholders of p = 0.09 each are worth going on for although none alone is (a
 first version judged each alone and gave up 9 s into an apartment with P = 0.59 left).
-Costs are in the planner's units (`StateBuilder`: metres over the body's speed, search costs).
+Costs are in the planner's units (`StateBuilder`: metres over the body's speed, search
+costs; a look in the body's seconds).
 """
 
 from __future__ import annotations
@@ -74,15 +76,18 @@ class Remaining:
                 f"{cheapest.cost:.0f})")
 
 
-def remaining(mind: Mind, builder: StateBuilder, here: tuple[float, float]) -> Remaining:
-    """The building-level belief for the builder's target, seen from the robot at `here`."""
+def remaining(mind: Mind, builder: StateBuilder, here: tuple[float, float],
+              look: float = 0.0) -> Remaining:
+    """The building-level belief for the builder's target, seen from the robot at `here`.
+    `look`: what one look around costs (the detector watches as the robot arrives anywhere,
+    so a look is the cheapest way to find the target in a room, cheaper than any search)."""
     label, cmap, pm = builder.task.target, mind.cmap, mind.place_map
     try:
         field_ = distance_field(mind.grid, here, mind.config.robot_radius)
     except PathQueryError:
         field_ = None
     speed = builder.travel_speed()
-    search = _cheapest_searches(builder)
+    search = _cheapest_searches(builder, look)
     options: list[Option] = []
     for rid, room in pm.rooms.items():
         if not cmap.graph.has_room(rid):
@@ -110,12 +115,20 @@ class _Searches:
     fresh: float  # ... where none is: search the room, or find a support and search it
 
 
-def _cheapest_searches(builder: StateBuilder) -> _Searches:
+def _cheapest_searches(builder: StateBuilder, look: float) -> _Searches:
     target = builder.task.target
     in_room, on_support = builder.search_cost(target, "in"), builder.search_cost(target, "on")
     supports = [builder.search_cost(s, "in") for s in builder.labels if s != target]
-    return _Searches(min(in_room, on_support),
-                     min(in_room, on_support + min(supports, default=math.inf)))
+    return _Searches(min(in_room, on_support, look),
+                     min(in_room, on_support + min(supports, default=math.inf), look))
+
+
+def look_cost(body, headings: int) -> float:  # noqa: ANN001 - a RobotBody or None
+    """Seconds of one look around: a full turn with a frame at each of `headings`."""
+    if body is None:
+        return 0.0
+    headings = max(2, headings)
+    return headings * (body.turn_time(2.0 * math.pi / headings) + body.sensing_time)
 
 
 def _travel(mind: Mind, field_, here: tuple[float, float],  # noqa: ANN001

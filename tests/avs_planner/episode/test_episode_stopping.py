@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
-from avs_planner.episode.stopping import Option, Remaining, remaining
+from avs_planner.body import JointRange, RobotBody
+from avs_planner.episode.stopping import Option, Remaining, look_cost, remaining
 from conceptual_map.conceptual.existence import ObjectLedger
 from conceptual_map.conceptual.placeholders import PlaceholderEvidence, p_label_beyond
 from conceptual_map.knowledge import load_knowledge
@@ -35,8 +38,9 @@ def test_a_building_searched_through_gives_up_naming_what_is_left(corridor) -> N
             mind.cmap.observe_search(label, rid, coverage=1.0, p_detect=0.95)
         for space in mind.cmap.objects.sublocations(rid, builder.task.target):
             mind.cmap.observe_search(builder.task.target, space, coverage=1.0, p_detect=0.95)
-    belief = remaining(mind, builder, executor.robot.pose[:2])
+    belief = remaining(mind, builder, executor.robot.pose[:2], look=10.0)
     assert {o.kind for o in belief.options} == {"room"}
+    assert all(o.cost >= 10.0 for o in belief.options)  # a look at least, even standing there
     assert belief.p < 0.1
     assert not belief.worth_going_on(500.0)
     text = belief.describe(500.0)
@@ -79,3 +83,15 @@ def test_p_beyond_a_placeholder_follows_its_hypotheses() -> None:
     assert zero == pytest.approx(0.0)
     ledger.record_search("cerealbox", "r", coverage=1.0, p_detect=1.0)  # not a fresh room
     assert np.all(ledger.fresh_room_lambda("cerealbox") == lam)
+
+
+def test_a_look_around_costs_a_full_turn_and_a_frame_per_heading() -> None:
+    body = RobotBody(
+        name="pioneer", footprint_radius=0.25, holonomic=False, camera_height=1.4,
+        torso=JointRange(0.0, 0.0), pan=JointRange(-2.77, 2.77), tilt=JointRange(-0.82, 0.54),
+        hfov=1.05, vfov=0.8, depth_range=5.0, detect_range=4.0, laser_range=5.6,
+        linear_speed=0.5, angular_speed=1.0, torso_speed=1.0, pan_speed=1.0, tilt_speed=1.0,
+        scan_time=0.1, sensing_time=0.5)
+    assert look_cost(None, 6) == 0.0
+    assert look_cost(body, 6) == pytest.approx(2.0 * math.pi + 6 * 0.5)
+    assert look_cost(body, 1) == pytest.approx(2.0 * math.pi + 2 * 0.5)  # at least two
