@@ -291,10 +291,15 @@ class Executor(Driving):
         (the very first look comes before the first place)."""
         obj = None
         for seen in list(self._unplaced):
-            if self.mind.room_at(seen.position[:2]) is None:
+            room = self.mind.room_at(seen.position[:2])
+            if room is None and seen.label == self.builder.task.target:
+                # a target seen through a door is reported from here; its room (evidence
+                # about the room's category) is the nearest known one until it is entered
+                room = self.mind.nearest_room(seen.position[:2])
+            if room is None:
                 continue
             self._unplaced.remove(seen)
-            obj = self.mind.add_object(seen.label, seen.position)
+            obj = self.mind.add_object(seen.label, seen.position, room=room)
             self.found_sids[obj.id] = seen.id
             self.seen_while_moving[obj.id] = {
                 ("label-of", obj.id, seen.label), ("detected", obj.id),

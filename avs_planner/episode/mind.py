@@ -195,6 +195,13 @@ class Mind:
                    for d in self.place_map.doors.values())
 
     def room_at(self, position: tuple[float, float]) -> str | None:
+        """The room whose mapped floor holds `position` (`PlaceMap.room_at`): None beyond a
+        door the robot has not passed. The room of the nearest place credited a kitchen's
+        table and cereal box seen through its door to the corridor the robot looked from, and
+        the corridor's readings then outweighed them (the room ended "corridor 1.00")."""
+        return self.place_map.room_at(self.grid, position)
+
+    def nearest_room(self, position: tuple[float, float]) -> str | None:
         """The room of the place nearest to `position` (None before any room exists)."""
         best, best_d = None, math.inf
         for pid, place in self.place_map.places.items():
@@ -204,10 +211,11 @@ class Mind:
         return self.place_map.room_of(best) if best is not None else None
 
     def add_object(self, label: str, position: tuple[float, float, float],
-                   support: str | None = None) -> KnownObject:
-        """A confirmed detection becomes a known object (and evidence for its room)."""
+                   support: str | None = None, room: str | None = None) -> KnownObject:
+        """A confirmed detection becomes a known object (and evidence for its room: the
+        support's, else `room`, else the room whose floor holds it)."""
         room = (self.objects[support].room if support is not None
-                else self.room_at(position[:2]))
+                else room or self.room_at(position[:2]))
         if room is None:
             raise ValueError(f"no room known near {position[:2]}")
         n = len(self.objects) + 1

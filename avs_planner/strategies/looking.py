@@ -162,9 +162,11 @@ def _step_back(ctx: SearchContext, position, distance: float  # noqa: ANN001 - x
 def _confirm(ctx: SearchContext, seen) -> KnownObject | None:  # noqa: ANN001 - a Seen
     """The detection as a known object, if it lies in a room of the task's category."""
     mind = ctx.mind
-    if mind.room_at(seen.position[:2]) is None:
+    # a target seen through a door counts from here: its room is the nearest known one
+    room = mind.room_at(seen.position[:2]) or mind.nearest_room(seen.position[:2])
+    if room is None:
         return None
-    obj = mind.add_object(ctx.target, seen.position)
+    obj = mind.add_object(ctx.target, seen.position, room=room)
     ctx.executor.found_sids[obj.id] = seen.id
     return obj if _in_category(ctx, obj) else None
 
