@@ -198,10 +198,10 @@ def test_the_held_out_campaign_is_unseen_buildings_of_three_styles_by_both_robot
 
     monkeypatch.setattr(subjects_module, "generated_targets", fake)
     runs = load_campaign("heldout").runs()
-    assert len(runs) == 3 * 6 * 3 * 3 * 2
+    assert len(runs) == 3 * 8 * 3 * 3 * 2
     assert sorted(calls) == sorted((seed, style, None) for style in ("office", "apartment",
                                                                      "lab")
-                                   for seed in range(10000, 10006))
+                                   for seed in range(10000, 10008))
     assert {r.subject.group for r in runs} == {"gen-office", "gen-apartment", "gen-lab"}
     assert {r.robot for r in runs} == {"pioneer", "pr2"}
     assert [s.name for s in load_campaign("heldout").strategies] == STRATEGIES

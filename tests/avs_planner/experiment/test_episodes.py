@@ -74,7 +74,7 @@ def test_the_cli_lists_the_built_in_campaigns(capsys):
     out = capsys.readouterr().out
     assert "seed003-fig3" in out and "120 runs" in out
     lines = {line.split()[0]: line for line in out.splitlines() if line.strip()}
-    assert "324 runs" in lines["heldout"] and "120 runs" in lines["heldout-fig3"]
+    assert "432 runs" in lines["heldout"] and "120 runs" in lines["heldout-fig3"]
 
 
 def test_the_cli_runs_a_campaign_and_prints_its_counts(tmp_path, capsys):
