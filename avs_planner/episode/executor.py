@@ -39,6 +39,10 @@ Event = Callable[..., None]
 
 @dataclass
 class ExecutorConfig:
+    """How the executor drives, looks and confirms. Defaults whose comments cite episodes were
+    chosen on development worlds and seeds (generated buildings below seed 10000, Fig. 3
+    noise seeds 0-99), never on the held-out range (docs/experiments.md)."""
+
     leg: float = 1.0  # m driven between scans
     arrive: float = 0.35  # m from a MOVE's goal counts as there
     max_legs: int = 40
@@ -46,7 +50,7 @@ class ExecutorConfig:
     dt_policy: str = "pouct"
     # POUCT simulations per decision. The DT's own benchmark found 50 as good as 150 on its
     # synthetic instances, but in episodes 50 rejected searches that 150 confirmed (scenario
-    # f, 20 seeds: 16/20 found with 50, 18/20 with 150; bench/episode_bench.py)
+    # f, development seeds 0-19: 16/20 found with 50, 18/20 with 150; bench/episode_bench.py)
     dt_sims: int = 150
     # a look counts as a detection only when a second frame sees the label again within
     # `agree` m (a phantom rarely repeats), so misses are likelier and phantoms rarer than

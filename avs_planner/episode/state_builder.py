@@ -59,7 +59,7 @@ class BuilderConfig:
     # a search is given (up to 6 in a room, 4 around a support: `episode/viewcones.py`),
     # each a drive of `cone_spacing` m, a quarter turn and two frames (a look is two
     # detections). Without a body, the seed's numbers above, in its own units.
-    # Off by default (strategy option `seconds`): on generated office worlds 0-7 (24
+    # Off by default (strategy option `seconds`): on development office worlds 0-7 (24
     # episodes) it found 14/16 present objects but gave up on 4/8 absent ones within the
     # budget, against 12/16 and 8/8 with the seed's costs; neither meets both targets.
     seconds: bool = False
