@@ -26,7 +26,7 @@ $(VENV)/.installed-bench: pyproject.toml $(NATIVE) | $(BIN)/python
 	touch $@
 
 ## run: set up .venv and run the main job: one object-search episode in the built-in office
-## world (seed 003, Fig. 3a: start in the corridor, find the cereal box), outputs in runs/
+## world (Göbelbecker et al., Fig. 3a: start in the corridor, find the cereal box), outputs in runs/
 ## (with the viewer extra installed also a Rerun recording: `avs view runs/office-cerealbox`)
 run: $(VENV)/.installed
 	$(BIN)/avs simulate --scenario a --seed 1 --out runs/office-cerealbox \
