@@ -26,7 +26,7 @@ def register(subparsers: Any) -> None:
                         "office, or the scenario's)")
     parser.add_argument("--generated", type=int, metavar="SEED",
                         help="a generated world (see `avs world generate`) instead of --world")
-    parser.add_argument("--style", default="office", help="generated world style "
+    parser.add_argument("--style", help="generated world style "
                         "(office, apartment, lab; default office)")
     parser.add_argument("--rooms", type=int, help="generated world: number of rooms")
     parser.add_argument("--target", help="object label to find, e.g. cerealbox; a label the "
@@ -77,6 +77,8 @@ def run(args: argparse.Namespace) -> int:
         spec = _spec(args, base)
         checked = EpisodeSpec.from_dict(spec)  # bad options or QSR descriptions: exit 1
         _check_label(checked)  # before the run, as a label refused with --strict-labels
+        _check_start(checked)  # a pose outside the building is refused, as the API does
+        _check_out(Path(args.out))
     except (EpisodeError, ValueError) as exc:
         print(f"avs: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -99,7 +101,44 @@ def _check_label(spec: Any) -> None:
         target_knowledge(load_knowledge(), spec.target, strict=True)
 
 
+def _check_start(spec: Any) -> None:
+    """`--start` must stand on a free spot of a room of the world (else the robot would
+    search from outside the building until its budget ran out)."""
+    if spec.start is None or spec.world_text is not None:
+        return  # an inline world file is checked by the runner
+    from avs_planner.episode.robot import generated_spec, load_spec
+    from avs_planner.episode.validate import start_problem
+
+    world = generated_spec(spec.generate) if spec.generate else load_spec(spec.world)
+    problem = start_problem(world, spec.start, spec.robot or world.robot.model)
+    if problem:
+        raise ValueError(f"--start: {problem}")
+
+
+def _check_out(out: Path) -> None:
+    """The output directory can be made and written to (a clear error, not a traceback
+    after the episode has run)."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / ".avs-write-test"
+        probe.write_text("", encoding="utf-8")
+        probe.unlink()
+    except OSError as exc:
+        raise ValueError(f"--out {str(out)!r} cannot be written: {exc.strerror or exc}") \
+            from None
+
+
+def _check_flags(args: argparse.Namespace) -> None:
+    """Flags that would be silently ignored together are an error."""
+    if args.generated is not None and args.world:
+        raise ValueError("--generated SEED and --world name two different worlds: give one")
+    if args.generated is None and (args.style is not None or args.rooms is not None):
+        raise ValueError("--style and --rooms shape a generated world: use them with "
+                         "--generated SEED")
+
+
 def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
+    _check_flags(args)
     spec = dict(base)
     for key, value in (("world", args.world), ("target", args.target),
                        ("category", args.category), ("robot", args.robot),
@@ -114,7 +153,8 @@ def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
         spec["start"] = _pose(args.start)
     if args.generated is not None:
         spec.pop("world", None)
-        spec["generate"] = {"seed": args.generated, "style": args.style, "rooms": args.rooms}
+        spec["generate"] = {"seed": args.generated, "style": args.style or "office",
+                            "rooms": args.rooms}
     if args.strategy:
         spec["strategy"] = args.strategy
     if args.pre_explore:

@@ -19,12 +19,25 @@ from avs_planner.episode import EpisodeError, run_episode
         (["--world", "office"], "--target LABEL"),
         (["--target", "cerealbox", "--start-room", "attic"], "attic"),
         (["--scenario", "z"], "unknown scenario 'z'"),
+        (["--target", "cerealbox", "--start", "100,1,0"], "outside every room"),
+        (["--target", "cup", "--generated", "3", "--world", "office"], "two different worlds"),
+        (["--target", "cup", "--world", "office", "--style", "lab"], "with --generated"),
+        (["--target", "cup", "--rooms", "4"], "with --generated"),
     ],
 )
 def test_bad_input_exits_1(argv, message, tmp_path, capsys) -> None:
     code = main(["simulate", *argv, "--out", str(tmp_path)])
     assert code == 1
     assert message in capsys.readouterr().err
+
+
+def test_an_output_directory_that_cannot_be_written_is_bad_input(tmp_path, capsys) -> None:
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a directory")
+    code = main(["simulate", "--target", "cerealbox", "--out", str(blocker / "run")])
+    err = capsys.readouterr().err
+    assert code == 1
+    assert "--out" in err and "cannot be written" in err
 
 
 def test_spec_errors_name_the_key() -> None:
