@@ -46,6 +46,15 @@ def world_file_problem(text: str) -> str | None:
     return None
 
 
+
+def _checked_pddl(text: str) -> str:
+    """PDDL text within the nesting and name limits (`limits.pddl_problem`), else a short
+    validation error."""
+    problem = pddl_problem(text, "the text")
+    if problem:
+        raise ValueError(problem)
+    return text
+
 class TaskState(StrEnum):
     """Where a task is in its life; the last five are terminal."""
 
@@ -186,10 +195,7 @@ class PlanCreate(BaseModel):
     @field_validator("domain", "problem")
     @classmethod
     def _bounded_pddl(cls, text: str) -> str:
-        problem = pddl_problem(text, "the text")
-        if problem:
-            raise ValueError(problem)
-        return text
+        return _checked_pddl(text)
     reward: float | None = Field(None, gt=0, description="R in c(pi) + R(1 - p(pi))")
     weight: float | None = Field(None, ge=1, le=100)
     timeout_s: float | None = Field(None, gt=0, le=3600)
@@ -267,10 +273,7 @@ class DomainCheckCreate(BaseModel):
     @field_validator("domain")
     @classmethod
     def _bounded_domain(cls, text: str) -> str:
-        problem = pddl_problem(text, "the text")
-        if problem:
-            raise ValueError(problem)
-        return text
+        return _checked_pddl(text)
 
     @field_validator("problems")
     @classmethod

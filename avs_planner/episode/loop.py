@@ -136,9 +136,9 @@ class SwitchingLoop:
                 self.result.found = outcome.reported
                 return self._end(Outcome.FOUND, outcome.detail)
             self.planner.plan = self.planner.plan[:index] + self.planner.plan[index + 1:]
-            before, state = state, self.builder.build()
+            state = self.builder.build()
             if self.executor.robot.clock == clock and _signature(state) == tried[1]:
-                self._no_effect(step, before)
+                self._no_effect(step, tried)
                 state = self.builder.build()  # without the withheld move
             settled = step.label if _search_rejected(step, outcome) else None
             result = self._monitor(state, outcome, settled)
@@ -154,13 +154,13 @@ class SwitchingLoop:
                 return self._end(Outcome.GAVE_UP, self._no_plan(result))
         return self._end(Outcome.TIMEOUT, f"{self.config.max_steps} steps executed")
 
-    def _no_effect(self, step: PlanStep, state: AvsState) -> None:
+    def _no_effect(self, step: PlanStep, tried: tuple[str, int]) -> None:
         """The step took no time and left the belief state as it was: planned again from
         that state it would do nothing again, as often as the CP asked (a move between two
         places that ended where it began was replanned 85 times at one simulated instant).
         Like a failed step it is evidence: never executed again from this state, and a move
         is withheld from the plan's topology until something new is learned."""
-        self.failed.add((step.label, _signature(state)))
+        self.failed.add(tried)
         if step.name == "move":
             self.executor.mind.move_failed(step.args[1])
         self.trace.emit("belief", no_effect=step.label,
@@ -211,7 +211,7 @@ class SwitchingLoop:
 
     def _no_plan(self, result: PlanResult) -> str:
         """Why the episode gives up, in words."""
-        hopeless = self._hopeless()
+        hopeless = result.extra.get("hopeless") or self._hopeless()
         if hopeless:
             return hopeless
         if result.extra.get("not_worth"):
@@ -282,8 +282,9 @@ class SwitchingLoop:
                 result = self._plan_again("after exploring")
             if result.solved:
                 return result
-            if self._hopeless():
-                return result  # the caller gives up, naming the probability left
+            hopeless = self._hopeless()
+            if hopeless:  # the caller gives up, naming the probability left
+                return replace(result, extra={**result.extra, "hopeless": hopeless})
             if result.extra.get("not_worth") and self._explore_instead():
                 # nothing on the mapped part is worth searching, but exploring is worth
                 # more than the one chain of assumptions a plan puts on it (`_worth_it`)

@@ -123,13 +123,9 @@ def test_a_move_blocked_by_an_unmapped_obstacle_goes_around_it() -> None:
         sim.world.close()
 
 
-def test_no_failed_action_is_repeated_from_an_unchanged_state(corridor) -> None:  # noqa: ANN001
-    """Every move is refused (with no contact point to learn from): the episode must end
-    with a reason, never re-running a failed action from the same belief state."""
-    mind, builder, executor = corridor
-    executor.robot.move_along = lambda path: False
+def _run_recording(loop: SwitchingLoop) -> tuple:
+    """Run the loop, recording each executed (step, belief state signature)."""
     executed: list[tuple[str, int]] = []
-    loop = SwitchingLoop(builder, executor, Trace(lambda: executor.robot.clock, None, None))
     run = loop._execute
 
     def record(step, state):  # noqa: ANN001, ANN202
@@ -137,7 +133,16 @@ def test_no_failed_action_is_repeated_from_an_unchanged_state(corridor) -> None:
         return run(step, state)
 
     loop._execute = record
-    result = loop.run()
+    return loop.run(), executed
+
+
+def test_no_failed_action_is_repeated_from_an_unchanged_state(corridor) -> None:  # noqa: ANN001
+    """Every move is refused (with no contact point to learn from): the episode must end
+    with a reason, never re-running a failed action from the same belief state."""
+    mind, builder, executor = corridor
+    executor.robot.move_along = lambda path: False
+    loop = SwitchingLoop(builder, executor, Trace(lambda: executor.robot.clock, None, None))
+    result, executed = _run_recording(loop)
     assert result.outcome.value == "gave_up", result.reason
     assert executed and len(executed) == len(set(executed))
     assert mind.failed_moves
@@ -150,19 +155,10 @@ def test_a_move_that_takes_no_time_and_changes_nothing_is_not_planned_again(corr
     mind, builder, executor = corridor
     executor.drive_to = lambda goal, stop=None: StepOutcome(StepStatus.DONE)
     executor.look_around = lambda: None  # arrived at a placeholder: nothing new either
-    executed: list[tuple[str, int]] = []
     events: list[dict] = []
     trace = Trace(lambda: executor.robot.clock, None, None)
     trace.subscribe(events.append)
-    loop = SwitchingLoop(builder, executor, trace)
-    run = loop._execute
-
-    def record(step, state):  # noqa: ANN001, ANN202
-        executed.append((step.label, _signature(state)))
-        return run(step, state)
-
-    loop._execute = record
-    result = loop.run()
+    result, executed = _run_recording(SwitchingLoop(builder, executor, trace))
     assert result.outcome.value == "gave_up", result.reason
     assert executed and len(executed) == len(set(executed))
     no_effect = [e["no_effect"] for e in events if e.get("no_effect")]
