@@ -449,8 +449,9 @@ class StateBuilder:
         return body.linear_speed if self.config.seconds and body is not None else 1.0
 
     def cannot_search(self, label: str, relation: str, location: str) -> None:
-        """The robot has no view of `location` to search it for `label` from: counted as
-        searched as often as it takes to settle it (`max_failed_*_searches`)."""
+        """The robot has no view of `location` to search it for `label` from, or the DT
+        judged no look there worth its cost: counted as searched as often as it takes to
+        settle it (`max_failed_*_searches`)."""
         if relation == "on":
             self.failed_on[(label, location)] = self.config.max_failed_support_searches
         else:

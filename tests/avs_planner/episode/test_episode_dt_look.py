@@ -47,3 +47,29 @@ def test_without_the_tiebreak_a_split_look_is_a_miss(corridor) -> None:
     _, _, executor = corridor
     match, count = _look(executor, [_seen(2.0, 1.0), None, _seen(2.0, 1.0)], tiebreak=False)
     assert match is None and count == 2
+
+
+def test_a_search_the_dt_would_not_look_in_is_settled_for_the_planner(corridor) -> None:
+    """The DT, on its belief, finds no look worth its cost: asked again from the same state
+    it would decide the same in no time, and the loop took that repeat for a livelock and
+    gave up with the rest of the building unsearched. The location is settled instead;
+    a search that looked counts once, as before."""
+    from avs_planner.dt import DTStatus, ViewCone
+    from avs_planner.dt.domain import ActionKind
+    from avs_planner.episode.viewcones import ConeSet
+
+    _, _, executor = corridor
+    builder = executor.builder
+    search = ViewConeSearch(executor, "cerealbox", "in", "room1")
+    no_look = SimpleNamespace(trace=[], status=DTStatus.REJECTED, detection=None)
+    outcome = search._conclude(no_look, "cerealbox", "in", "room1", ConeSet((), 0.0, 0.0))
+    assert outcome.detail == "rejected without looking"
+    assert builder.failed_in[("cerealbox", "room1")] >= builder.config.max_failed_room_searches
+
+    builder.failed_in.clear()
+    cone = ViewCone("c0", (0.0, 0.0, 0.0), 0.4)
+    look = SimpleNamespace(action=SimpleNamespace(kind=ActionKind.PROCESS_VIEW_CONE, cone=0))
+    looked = SimpleNamespace(trace=[look], status=DTStatus.REJECTED, detection=None)
+    outcome = search._conclude(looked, "cerealbox", "in", "room1", ConeSet((cone,), 0.8, 0.4))
+    assert outcome.detail == "rejected"
+    assert builder.failed_in[("cerealbox", "room1")] == 1
