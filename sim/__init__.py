@@ -10,6 +10,7 @@ Imports nothing else of ours: it is the world, not the robot's mind. Typical use
 See `sim/README.md` for the world-file format, the time model and the sensor models.
 """
 
+import sim._quiet_pybullet  # noqa: F401  (first: pybullet without its banner)
 from sim.camera import DetectorConfig
 from sim.errors import JointLimitError, MotionError, PathBlockedError, SimError, WorldFileError
 from sim.place_classifier import PlaceClassifier
