@@ -82,7 +82,8 @@ def run(args: argparse.Namespace) -> int:
     except (EpisodeError, ValueError) as exc:
         print(f"avs: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    progress = _Progress(enabled=sys.stderr.isatty() or not args.json)
+    tty = sys.stderr.isatty()
+    progress = _Progress(enabled=tty or not args.json, tty=tty)
     summary = run_episode(spec, progress, None)
     progress.finish()
     if args.json:
@@ -209,10 +210,12 @@ def _pose(text: str) -> list[float]:
 
 
 class _Progress:
-    """One overwritten status line on stderr: sim time, plans, the step being executed."""
+    """The episode's progress on stderr: sim time, plans, the step being executed. On a
+    terminal one status line rewritten in place; elsewhere (a log, a pipe) one line per
+    finished step, so a log reads as lines and not as carriage returns."""
 
-    def __init__(self, enabled: bool):
-        self.enabled = enabled
+    def __init__(self, enabled: bool, tty: bool = True):
+        self.enabled, self.tty = enabled, tty
         self.plans = 0
         self.shown = False
 
@@ -221,13 +224,20 @@ class _Progress:
             self.plans += 1
         if not self.enabled or event["type"] not in ("plan", "action", "dt", "done"):
             return
+        if not self.tty and (event["type"] == "plan" or event.get("status") == "start"):
+            return
         what = event.get("action") or event.get("result") or event.get("outcome") or ""
+        if event["type"] == "action" and event.get("status") not in (None, "start", "done"):
+            what = f"{what} {event['status']}"
         line = f"t={event['t']:7.1f}s  plans={self.plans:3d}  {event['type']:6s} {what}"
-        print("\r" + line[:100].ljust(100), end="", file=sys.stderr, flush=True)
+        if self.tty:
+            print("\r" + line[:100].ljust(100), end="", file=sys.stderr, flush=True)
+        else:
+            print(line, file=sys.stderr, flush=True)
         self.shown = True
 
     def finish(self) -> None:
-        if self.shown:
+        if self.shown and self.tty:
             print(file=sys.stderr)
 
 
