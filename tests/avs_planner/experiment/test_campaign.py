@@ -237,7 +237,7 @@ def test_the_held_out_fig3_campaign_is_a_to_f_over_the_held_out_noise_seeds():
     assert {r.strategy.name for r in runs} == {"switching"}
 
 
-@pytest.mark.parametrize("name", ["seed003-fig3", "generated-50"])
+@pytest.mark.parametrize("name", ["seed003-fig3", "generated-50", "development"])
 def test_development_campaigns_stay_off_the_held_out_seeds(name, monkeypatch):
     monkeypatch.setattr(subjects_module, "generated_targets",
                         lambda seed, style, rooms: [("cup", True)])
