@@ -11,7 +11,7 @@ import math
 import reprlib
 import tempfile
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -210,8 +210,12 @@ class Episode:
         self.spec = spec
         self.out = Path(spec.output_dir) if spec.output_dir else None
         self.world_spec = self._world_spec()
-        knowledge, self.warnings = target_knowledge(load_knowledge(), spec.target,
-                                                    spec.strict_labels)
+        knowledge = load_knowledge()
+        # labels and categories as the knowledge spells them: "CerealBox" is the cerealbox
+        spec = self.spec = replace(spec, target=knowledge.spelled(spec.target),
+                                   category=knowledge.spelled(spec.category)
+                                   if isinstance(spec.category, str) else spec.category)
+        knowledge, self.warnings = target_knowledge(knowledge, spec.target, spec.strict_labels)
         check_categories(self.world_spec, knowledge.categories)
         self.robot: SimRobot = open_world(self.world_spec, spec.seed, knowledge.categories)
         self.mind = Mind.for_body(self.robot.body(), knowledge)  # its own body, not the world

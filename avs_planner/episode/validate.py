@@ -86,11 +86,12 @@ def _check_labels(task: Mapping[str, Any], knowledge: Knowledge) -> list[FieldPr
         problems.append(FieldProblem("strict_labels", f"must be true or false, got {strict!r}"))
     if not isinstance(target, str) or not target:
         problems.append(FieldProblem("target", "an object label is required"))
-    elif strict is not False and target not in knowledge.labels:
+    elif strict is not False and knowledge.spelled(target) not in knowledge.labels:
         problems.append(FieldProblem("target", f"unknown object label {target!r}; "
                                      f"the knowledge base knows {_listed(knowledge.labels)}"))
     category = task.get("category")
-    if category is not None and category not in knowledge.categories:
+    if category is not None and (not isinstance(category, str)
+                                 or knowledge.spelled(category) not in knowledge.categories):
         problems.append(FieldProblem("category", f"unknown room category {category!r}; the "
                                      f"knowledge base knows {_listed(knowledge.categories)}"))
     return problems

@@ -73,6 +73,18 @@ class Knowledge:
         """Object labels with a room-level lambda."""
         return frozenset(self.object_lambda)
 
+    def spelled(self, name: str) -> str:
+        """`name` as the knowledge spells it, where it lists a label or category that
+        differs only in case or in spaces for underscores ("CerealBox" -> "cerealbox",
+        "Living Room" -> "living_room"); else `name` unchanged."""
+        if name in self.object_lambda or name in self._category_index:
+            return name
+        key = _fold(name)
+        for known in (*sorted(self.object_lambda), *self.categories):
+            if _fold(known) == key:
+                return known
+        return name
+
     def category_index(self, category: str) -> int:
         """Index of `category`; KeyError naming it if unknown."""
         try:
@@ -146,3 +158,9 @@ class Knowledge:
             if lab == label:
                 total += self.room_lambda(support) * lam
         return total
+
+
+def _fold(name: str) -> str:
+    """A name compared without case, surrounding spaces, or the difference between a
+    space, a hyphen and an underscore."""
+    return "_".join(name.strip().casefold().replace("-", " ").replace("_", " ").split())

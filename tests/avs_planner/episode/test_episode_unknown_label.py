@@ -1,4 +1,4 @@
-"""A target label the knowledge does not list (issue 34): searched for with the knowledge's
+"""A target label the knowledge does not list: searched for with the knowledge's
 uninformed prior and a `warning` event, or refused with `strict_labels`."""
 
 from __future__ import annotations
@@ -53,3 +53,23 @@ def test_task_check_accepts_an_unknown_label_only_when_not_strict() -> None:
     assert check_task({**task, "strict_labels": False}, world) == []
     assert [p.field for p in check_task({**task, "strict_labels": 1}, world)] == [
         "strict_labels", "target"]
+
+
+def test_labels_and_categories_are_read_whatever_their_case() -> None:
+    """"CerealBox" is the knowledge's cerealbox and "Living Room" its living_room, for the
+    task check (the service) and the episode alike; a label that differs in more than case
+    and separators is still a label the knowledge does not list."""
+    from conceptual_map.knowledge import load_knowledge
+
+    knowledge = load_knowledge()
+    assert knowledge.spelled("CerealBox") == "cerealbox"
+    assert knowledge.spelled(" Living Room ") == "living_room"
+    assert knowledge.spelled("living-room") == "living_room"
+    assert knowledge.spelled("Cereal Box") == "Cereal Box"  # not listed: unchanged
+    task = {"target": "CerealBox", "category": "KITCHEN", "world": "office"}
+    import sim
+
+    office = Path(sim.__file__).parent / "worlds" / "office.yaml"
+    assert check_task(task, office) == []
+    summary = run_episode({**task, "seed": 1, "time_budget_s": 20.0})
+    assert summary["target"] == "cerealbox"
