@@ -379,9 +379,10 @@ class Executor(Driving):
                 self.mind.forget_object(obj.id)
                 self.found_sids.pop(obj.id, None)
                 return StepOutcome(StepStatus.FAILED, f"{obj.label} not seen again at "
-                                   f"{obj.position} when looked at before reporting; "
+                                   f"{_at(obj.position)} when looked at before reporting; "
                                    f"{obj.id} forgotten")
-            return StepOutcome(StepStatus.FOUND, f"{obj.label} at {obj.position}", reported=obj)
+            return StepOutcome(StepStatus.FOUND, f"{obj.label} at {_at(obj.position)} in "
+                               f"{obj.room}", reported=obj)
         return StepOutcome(StepStatus.FAILED, f"no skill executes {step.name}")
 
     def nearest_placeholder(self) -> str | None:
@@ -541,3 +542,7 @@ class Executor(Driving):
             self.builder.cannot_search(label, relation, location)
         return outcome
 
+
+def _at(position: tuple[float, ...]) -> str:
+    """A position for a reader: centimetres, as the other strategies report theirs."""
+    return "(" + ", ".join(f"{v:.2f}" for v in position) + ")"
