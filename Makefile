@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 
-.PHONY: run test test-all lint bench serve clean
+.PHONY: run test test-all lint bench serve constraints clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -13,16 +13,17 @@ $(BIN)/python:
 # install compiles the extensions in avs_planner/cp in place).
 NATIVE := setup.py avs_planner/cp/_native.c avs_planner/cp/_fixpoint.c avs_planner/cp/_ground.c
 
-$(VENV)/.installed: pyproject.toml $(NATIVE) | $(BIN)/python
-	$(BIN)/python -m pip install -q -e .
+# constraints.txt: the tested set of versions (`make constraints` refreshes it)
+$(VENV)/.installed: pyproject.toml constraints.txt $(NATIVE) | $(BIN)/python
+	$(BIN)/python -m pip install -q -c constraints.txt -e .
 	touch $@
 
-$(VENV)/.installed-dev: pyproject.toml $(NATIVE) | $(BIN)/python
-	$(BIN)/python -m pip install -q -e '.[dev]'
+$(VENV)/.installed-dev: pyproject.toml constraints.txt $(NATIVE) | $(BIN)/python
+	$(BIN)/python -m pip install -q -c constraints.txt -e '.[dev]'
 	touch $@
 
-$(VENV)/.installed-bench: pyproject.toml $(NATIVE) | $(BIN)/python
-	$(BIN)/python -m pip install -q -e '.[dev,bench]'
+$(VENV)/.installed-bench: pyproject.toml constraints.txt $(NATIVE) | $(BIN)/python
+	$(BIN)/python -m pip install -q -c constraints.txt -e '.[dev,bench]'
 	touch $@
 
 ## run: set up .venv and run the main job: one object-search episode in the built-in office
@@ -51,6 +52,18 @@ bench: $(VENV)/.installed-bench
 ## serve: the HTTP service on 127.0.0.1:8000 (see api/README.md)
 serve: $(VENV)/.installed
 	$(BIN)/avs serve
+
+## constraints: refresh constraints.txt from a fresh venv with the newest versions pyproject.toml
+## allows (then run `make test`: the file is the set the tests passed with)
+constraints:
+	rm -rf .venv-constraints
+	$(PYTHON) -m venv .venv-constraints
+	.venv-constraints/bin/python -m pip install -q --upgrade pip
+	.venv-constraints/bin/python -m pip install -q -e '.[dev]'
+	{ sed -n '/^#/p' constraints.txt; \
+	  .venv-constraints/bin/python -m pip freeze --exclude-editable; } > constraints.txt.new
+	mv constraints.txt.new constraints.txt
+	rm -rf .venv-constraints
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache
