@@ -14,7 +14,7 @@ from avs_planner.errors import PddlError
 from avs_planner.pddl.diagnostics import Diagnostic
 from avs_planner.pddl.formulas import FormulaChecker, Usage
 from avs_planner.pddl.probabilistic import translate_domain
-from avs_planner.pddl.problem_checks import check_problem
+from avs_planner.pddl.problem_checks import NEGATIVE_INIT, check_problem
 from avs_planner.pddl.requirements import check_requirements
 from avs_planner.pddl.sexpr import parse_sexprs
 from avs_planner.pddl.structure import Domain, Report, find_define, read_domain
@@ -41,7 +41,7 @@ class PddlSource:
 Source = PddlSource | str | Path
 NAME_CLASH = "name-clash"
 # Warnings about what the reader accepts or repairs (what `avs plan` passes on to the user)
-LENIENT = {"missing-requirement", NAME_CLASH, "duplicate-type", "either-type"}
+LENIENT = {"missing-requirement", NAME_CLASH, "duplicate-type", "either-type", NEGATIVE_INIT}
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,8 @@ from avs_planner.pddl.structure import (
     read_problem,
 )
 
+NEGATIVE_INIT = "negative-init"  # a (not ...) in :init: a warning, then ignored
+
 if TYPE_CHECKING:
     from avs_planner.pddl.check import PddlSource
 
@@ -105,7 +107,16 @@ def _check_init(problem: Problem, checker: FormulaChecker) -> InitValues:
         elif fact.head() == "=":
             _init_assignment(fact, checker, values)
         elif fact.head() == "not":
-            checker.report.add(fact, "syntax", ":init lists true facts only; drop the (not ...)")
+            inner = fact.items[1] if len(fact.items) == 2 else None
+            if not isinstance(inner, SList) or not inner.items or inner.head() in ("=", "not"):
+                checker.report.add(fact, "syntax", "expected (not (PREDICATE OBJECT ...))")
+                continue
+            checker.atom(inner, {})
+            # as Fast Downward and unified-planning read it: under the closed world a fact
+            # not listed is false, so a negative literal says nothing more
+            checker.report.add(fact, NEGATIVE_INIT, "a negative literal in :init is ignored: "
+                               "under the closed world a fact is false unless listed",
+                               warning=True)
         else:
             checker.atom(fact, {})
             values.atoms.add(_ground(fact))
