@@ -1,4 +1,5 @@
-"""The continual planner as a unified-planning engine: `OneshotPlanner(name="avs")`.
+"""The continual planner as a unified-planning engine: `OneshotPlanner(name="avs")`, and
+`AnytimePlanner(name="avs")` for the anytime schedule's improving plans.
 
 Importing this module registers the engine (and with it UP's `replanner[avs]`) in UP's
 default factory; `import avs_planner.up_engine` is enough. UP's model has no success
@@ -10,7 +11,7 @@ plus optionally `reward`, `weight`, `heuristic`, `node_limit`, `min_success`, `e
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from typing import IO, Any
 
 import unified_planning as up
@@ -20,6 +21,10 @@ from unified_planning.engines import (
     PlanGenerationResult,
     PlanGenerationResultStatus,
 )
+from unified_planning.engines.mixins.anytime_planner import (
+    AnytimeGuarantee,
+    AnytimePlannerMixin,
+)
 from unified_planning.engines.mixins.oneshot_planner import (
     OneshotPlannerMixin,
     OptimalityGuarantee,
@@ -28,8 +33,9 @@ from unified_planning.environment import get_environment
 from unified_planning.model import FNode, Problem, ProblemKind
 from unified_planning.plans import ActionInstance, SequentialPlan
 
+from avs_planner.cp.anytime import AnytimeRun
 from avs_planner.cp.heuristics import get_heuristic
-from avs_planner.cp.planner import plan
+from avs_planner.cp.planner import improving_plans, plan
 from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep, SearchOptions
 from avs_planner.errors import PlanningError
 from avs_planner.pddl.model import ProbabilisticProblem
@@ -42,7 +48,8 @@ CREDITS = Credits(
     contact="see the avs-planner README",
     website="https://github.com/",
     license="MIT",
-    short_description="Weighted A* on c + R(1 - p) with probabilistic h^max / FF (seed 003).",
+    short_description="Weighted A* on c + R(1 - p) with probabilistic h^max / FF, after "
+    "Goebelbecker et al., \"A Planning Approach to Active Visual Search in Large Environments\".",
     long_description="Probabilistic continual planner after Goebelbecker et al.: grounds to "
     "bitsets, searches weighted A* on cost + R(1 - success probability).",
 )
@@ -55,12 +62,15 @@ _STATUS = {
 }
 
 
-class AvsPlanner(Engine, OneshotPlannerMixin):
-    """UP engine wrapper around `avs_planner.cp.planner.plan`."""
+class AvsPlanner(Engine, OneshotPlannerMixin, AnytimePlannerMixin):
+    """UP engine wrapper around `avs_planner.cp.planner.plan` (one-shot) and
+    `improving_plans` (anytime: each plan better by the objective than the last, as the
+    greedy search and then the weighted-A* restarts find it)."""
 
     def __init__(self, **params: Any):
         Engine.__init__(self)
         OneshotPlannerMixin.__init__(self)
+        AnytimePlannerMixin.__init__(self)
         self._success: Mapping[str, FNode] = params.pop("success", {})
         self._options = SearchOptions(
             reward=float(params.pop("reward", SearchOptions.reward)),
@@ -129,13 +139,39 @@ class AvsPlanner(Engine, OneshotPlannerMixin):
             )
         return self._to_up(problem, result, options)
 
+    @staticmethod
+    def ensures(anytime_guarantee: AnytimeGuarantee) -> bool:
+        # every plan handed on is better by the objective than the one before
+        return anytime_guarantee == AnytimeGuarantee.INCREASING_QUALITY
+
+    def _get_solutions(
+        self,
+        problem: up.model.AbstractProblem,
+        timeout: float | None = None,
+        output_stream: IO[str] | None = None,
+    ) -> Iterator[PlanGenerationResult]:
+        """The anytime schedule's plans as it finds them (status INTERMEDIATE), then, when
+        it found none, one result saying why; `timeout` bounds the whole run."""
+        assert isinstance(problem, Problem)
+        options = SearchOptions(**{**self._options.__dict__, "timeout_s": timeout,
+                                   "anytime": True})
+        run = AnytimeRun()
+        try:
+            for result in improving_plans(ProbabilisticProblem(problem, self._success),
+                                          options, run):
+                yield PlanGenerationResult(
+                    PlanGenerationResultStatus.INTERMEDIATE,
+                    to_up_plan(problem, result.plan), self.name, _metrics(result))
+        except PlanningError as exc:
+            yield PlanGenerationResult(PlanGenerationResultStatus.UNSUPPORTED_PROBLEM, None,
+                                       self.name, log_messages=[_log(str(exc))])
+            return
+        if not run.best.solved:
+            final = run.result(options)
+            yield PlanGenerationResult(_STATUS[final.status], None, self.name, _metrics(final))
+
     def _to_up(self, problem: Problem, result: PlanResult, options) -> PlanGenerationResult:
-        metrics = {
-            "engine_internal_time": str(result.planning_time_s),
-            "expanded": str(result.expanded),
-            "probability": str(result.probability),
-            "objective": str(result.objective),
-        }
+        metrics = _metrics(result)
         if not result.solved:
             return PlanGenerationResult(_STATUS[result.status], None, self.name, metrics)
         optimal = (get_heuristic(options.heuristic).admissible and options.weight == 1.0
@@ -145,6 +181,15 @@ class AvsPlanner(Engine, OneshotPlannerMixin):
             else PlanGenerationResultStatus.SOLVED_SATISFICING
         )
         return PlanGenerationResult(status, to_up_plan(problem, result.plan), self.name, metrics)
+
+
+def _metrics(result: PlanResult) -> dict[str, str]:
+    return {
+        "engine_internal_time": str(result.planning_time_s),
+        "expanded": str(result.expanded),
+        "probability": str(result.probability),
+        "objective": str(result.objective),
+    }
 
 
 def _log(message: str) -> up.engines.LogMessage:

@@ -18,7 +18,8 @@ from __future__ import annotations
 import copy
 import math
 import time
-from dataclasses import dataclass, replace
+from collections.abc import Iterator
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -47,30 +48,67 @@ def anytime_search(
     task: GroundTask, options: SearchOptions, symmetries: Symmetries = NO_SYMMETRIES
 ) -> PlanResult:
     """Greedy first, then restarting weighted A*; the best plan by objective at the end."""
-    start = time.perf_counter()
+    run = AnytimeRun()
+    for _ in anytime_plans(task, options, symmetries, run):
+        pass
+    return run.result(options)
+
+
+@dataclass
+class AnytimeRun:
+    """What an `anytime_plans` run leaves behind: its best result, expansions, the history of
+    improvements and why it stopped early (None: it finished its schedule)."""
+
+    best: PlanResult = field(default_factory=lambda: PlanResult(PlanStatus.TIMEOUT))
+    expanded: int = 0
+    history: list[dict] = field(default_factory=list)
+    stopped: str | None = None
+    start: float = field(default_factory=time.perf_counter)
+
+    def result(self, options: SearchOptions) -> PlanResult:
+        """The best plan with the run's totals (`anytime_search`'s answer)."""
+        return _done(self.best, options, self.start, self.expanded, self.history,
+                     self.stopped if self.best.solved else None)
+
+
+def anytime_plans(task: GroundTask, options: SearchOptions,
+                  symmetries: Symmetries = NO_SYMMETRIES, run: AnytimeRun | None = None
+                  ) -> Iterator[PlanResult]:
+    """Each plan better by the objective than the ones before, as the schedule finds it:
+    the greedy search's, then each restart's that improves on it (what unified-planning's
+    `AnytimePlanner` hands on). `run` collects the totals (`AnytimeRun.result`)."""
+    run = run if run is not None else AnytimeRun()
+    start = run.start
     deadline = None if options.timeout_s is None else start + options.timeout_s
     best, expanded = greedy_search(task, options, symmetries, deadline)
-    history = [_entry("greedy", best, start)] if best.solved else []
-    if not best.solved and best.status not in (PlanStatus.TIMEOUT, PlanStatus.NODE_LIMIT):
-        return _done(best, options, start, expanded, history, None)
-    stopped = None if best.solved else "timeout"
+    run.best, run.expanded = best, expanded
+    if best.solved:
+        run.history.append(_entry("greedy", best, start))
+        yield _improved(best, options, run)
+    elif best.status not in (PlanStatus.TIMEOUT, PlanStatus.NODE_LIMIT):
+        return
+    run.stopped = None if best.solved else "timeout"
     for weight in WEIGHTS:
         left = None if deadline is None else deadline - time.perf_counter()
         if left is not None and left <= 0:
-            stopped = "timeout"
+            run.stopped = "timeout"
             break
         result = search(task, replace(options, anytime=False, weight=weight, timeout_s=left),
                         symmetries)
-        expanded += result.expanded
-        if result.solved and result.objective < best.objective - 1e-9:
-            best = result
-            history.append(_entry(weight, result, start))
+        run.expanded += result.expanded
+        if result.solved and result.objective < run.best.objective - 1e-9:
+            run.best = result
+            run.history.append(_entry(weight, result, start))
+            yield _improved(result, options, run)
         if result.status is PlanStatus.TIMEOUT or result.stopped_by == "timeout":
-            stopped = "timeout"
+            run.stopped = "timeout"
             break
-    if not best.solved:
-        return _done(best, options, start, expanded, history, None)
-    return _done(best, options, start, expanded, history, stopped)
+
+
+def _improved(result: PlanResult, options: SearchOptions, run: AnytimeRun) -> PlanResult:
+    """A plan as it is handed on mid-run: timed from the run's start, not stopped early."""
+    return replace(result, planning_time_s=time.perf_counter() - run.start,
+                   expanded=run.expanded, weight=options.weight, stopped_by=None)
 
 
 @dataclass(frozen=True)

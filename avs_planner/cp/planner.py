@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Iterator
 from dataclasses import replace
 
-from avs_planner.cp.anytime import anytime_search
+from avs_planner.cp.anytime import AnytimeRun, anytime_plans, anytime_search
 from avs_planner.cp.grounding import DEFAULT_CACHE, GroundingCache, gc_paused, ground
 from avs_planner.cp.search import PlanResult, SearchOptions, search
 from avs_planner.cp.symmetry import NO_SYMMETRIES, Symmetries, find_symmetries
@@ -36,6 +37,28 @@ def plan(
             planning_time_s=time.perf_counter() - start,
             grounding_time_s=grounded - start,
         )
+
+
+def improving_plans(pproblem: ProbabilisticProblem, options: SearchOptions | None = None,
+                    run: AnytimeRun | None = None) -> Iterator[PlanResult]:
+    """The anytime schedule's plans as it finds them, each better by the objective than the
+    last (`anytime.anytime_plans`), from the problem's :init; `run` collects the totals.
+    Times count grounding."""
+    options = (options or SearchOptions()).check()
+    run = run if run is not None else AnytimeRun()
+    with gc_paused():
+        state = DEFAULT_CACHE.initial_state(pproblem)
+        task = ground(pproblem, state)
+        symmetries = (
+            find_symmetries(pproblem, state, task) if options.symmetry else NO_SYMMETRIES
+        )
+    plans = anytime_plans(task, options, symmetries, run)
+    while True:  # the search runs with the collector paused, the caller's turn does not
+        with gc_paused():
+            result = next(plans, None)
+        if result is None:
+            return
+        yield result
 
 
 def plan_task(task: GroundTask, options: SearchOptions | None = None) -> PlanResult:

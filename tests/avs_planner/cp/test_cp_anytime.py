@@ -65,6 +65,38 @@ def test_up_engine_anytime_is_satisficing() -> None:
     assert result.status is PlanGenerationResultStatus.SOLVED_SATISFICING
 
 
+def test_up_anytime_planner_yields_each_improving_plan() -> None:
+    """`AnytimePlanner(name="avs")`: the plans of the anytime schedule as it finds them (the
+    same as the one-shot anytime run's history, elevators 2), each valid and better than the
+    last; an unsolvable problem ends in one result saying so."""
+    from unified_planning.engines.mixins.anytime_planner import AnytimeGuarantee
+    from unified_planning.shortcuts import AnytimePlanner
+
+    task = _read("elevators", 2)
+    with AnytimePlanner(name="avs") as planner:
+        assert planner.ensures(AnytimeGuarantee.INCREASING_QUALITY)
+        results = list(planner.get_solutions(task.problem, timeout=60))
+    assert len(results) >= 2
+    assert {r.status for r in results} == {PlanGenerationResultStatus.INTERMEDIATE}
+    objectives = [float(r.metrics["objective"]) for r in results]
+    assert objectives == sorted(objectives, reverse=True) and len(set(objectives)) == len(
+        objectives)
+    history = plan(task, SearchOptions(anytime=True, timeout_s=60)).extra["anytime"]
+    assert objectives == [h["objective"] for h in history]
+    validator = SequentialPlanValidator()
+    validator.skip_checks = True  # elevators' partially defined travel costs
+    for result in results:
+        assert validator.validate(task.problem, result.plan).status.name == "VALID"
+
+    blocks = _read("blocks", 1).problem.clone()
+    blocks.clear_goals()
+    a = blocks.all_objects[0]
+    blocks.add_goal(blocks.fluent("on")(a, a))
+    with AnytimePlanner(name="avs") as planner:
+        ends = list(planner.get_solutions(blocks))
+    assert [r.status for r in ends] == [PlanGenerationResultStatus.UNSOLVABLE_PROVEN]
+
+
 def _solve_params() -> list:
     from tests.ipc import IPC, NOT_SOLVED_YET
 
