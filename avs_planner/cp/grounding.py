@@ -26,6 +26,7 @@ from avs_planner.cp.action_table import ActionTable
 from avs_planner.cp.compact import compact
 from avs_planner.cp.derived import derived, ids_of, reachable, relevant, task_rows
 from avs_planner.cp.encoding import ConstantExpr, NumericValues
+from avs_planner.cp.formulas import FALSE, FormulaGrounder
 from avs_planner.cp.schema import LiftedSchema, compile_schemas
 from avs_planner.cp.settled import SettledAtoms, settled_atoms
 from avs_planner.cp.structure import GroundStructure, bitset, build_structure
@@ -92,25 +93,61 @@ def _goal(problem: Problem, structure: GroundStructure, true_atoms: frozenset[At
     """Goal bitsets (positive, negative) and whether a goal atom no action touches (so its
     truth is the initial state's) makes it impossible."""
     pos = neg = 0
-    impossible = False
     index = structure.fact_index
+    literals, impossible = _goal_literals(problem)
+    for atom, negated in literals:
+        i = index.get(atom)
+        if i is None:
+            # never mentioned by any action: its truth is fixed by the initial state
+            impossible |= (atom in true_atoms) == negated
+            continue
+        if negated:
+            neg |= 1 << i
+        else:
+            pos |= 1 << i
+    return pos, neg, impossible or bool(pos & neg)
+
+
+def _goal_literals(problem: Problem) -> tuple[list[tuple[Atom, bool]], bool]:
+    """The goal as (atom, negated) literals. A conjunction of literals is read directly;
+    anything else (a `forall` over objects, an `imply`, an `exists` with one way to hold) is
+    grounded over the problem's objects (`FormulaGrounder`, nothing decided as static) and
+    must come out a conjunction of literals: a goal that stays a disjunction is refused,
+    naming it. Also whether a part of it can never hold (a `forall` over a false body)."""
+    literals: list[tuple[Atom, bool]] = []
+    grounder, impossible = None, False
     for goal in problem.goals:
         for cond in _flatten(goal):
             negated = cond.is_not()
             inner = cond.arg(0) if negated else cond
-            if not inner.is_fluent_exp():
-                raise PlanningError(f"unsupported goal condition {cond}")
-            atom = (inner.fluent().name, *(a.object().name for a in inner.args))
-            i = index.get(atom)
-            if i is None:
-                # never mentioned by any action: its truth is fixed by the initial state
-                impossible |= (atom in true_atoms) == negated
+            if inner.is_fluent_exp() and all(a.is_object_exp() for a in inner.args):
+                literals.append(((inner.fluent().name, *(a.object().name for a in inner.args)),
+                                 negated))
                 continue
-            if negated:
-                neg |= 1 << i
-            else:
-                pos |= 1 << i
-    return pos, neg, impossible or bool(pos & neg)
+            if grounder is None:
+                grounder = FormulaGrounder(
+                    frozenset(), set(), lambda t: [o.name for o in problem.objects(t)])
+            try:
+                cnf = grounder.cnf(cond, {})
+            except PlanningError as exc:
+                raise PlanningError(f"unsupported goal condition {cond}: {exc}") from None
+            if cnf == FALSE:
+                impossible = True
+                continue
+            for clause in cnf:
+                if len(clause) != 1:
+                    raise PlanningError(
+                        f"unsupported goal condition {cond}: it grounds to a disjunction "
+                        f"({' or '.join(_literal(a, p) for a, p in sorted(clause))}); goals "
+                        "must ground to a conjunction of literals")
+                (atom, positive), = clause
+                literals.append((atom, not positive))
+    return literals, impossible
+
+
+def _literal(atom: Atom, positive: bool) -> str:
+    text = f"({' '.join(atom)})"
+    return text if positive else f"(not {text})"
 
 
 def _flatten(node: FNode) -> list[FNode]:

@@ -45,6 +45,7 @@ def check_problem(domain: Domain, source: PddlSource, usage: Usage) -> list[Diag
     values = _check_init(problem, init_checker)
     if problem.goal is not None:
         FormulaChecker(domain, report, names, usage).goal(problem.goal, {})
+        _disjunctive_goal(problem.goal, True, report)
         _goal_true_in_init(problem, values.atoms, report)
     if problem.metric is not None:
         _check_metric(problem.metric, init_checker)
@@ -174,6 +175,29 @@ def _check_probabilities(
                     "probability-range",
                     f"probability {value.text} for '{name}' is outside [0, 1]",
                 )
+
+
+def _disjunctive_goal(node: Node, positive: bool, report: Report) -> None:
+    """The planner's goal is a conjunction of literals once quantifiers are grounded: a
+    `forall` over objects is one, an `or`, `exists` or `imply` (or an `and`/`forall` under a
+    `not`) is not. Reported here with its position, as `avs plan` would refuse it."""
+    if not isinstance(node, SList) or not node.items:
+        return
+    head = node.head()
+    if head == "not" and len(node.items) == 2:
+        _disjunctive_goal(node.items[1], not positive, report)
+        return
+    disjunctive = head in ("or", "exists", "imply") if positive else head in ("and", "forall")
+    if disjunctive:
+        report.add(node, "unsupported-goal", f"a goal that is a disjunction ({head}"
+                   f"{'' if positive else ' under a not'}) is not supported: the planner "
+                   "reaches a conjunction of literals (forall over objects is fine)")
+        return
+    if head in ("and", "or"):
+        for child in node.items[1:]:
+            _disjunctive_goal(child, positive, report)
+    elif head in ("forall", "exists") and len(node.items) == 3:
+        _disjunctive_goal(node.items[2], positive, report)
 
 
 def _goal_true_in_init(problem: Problem, atoms: set[GroundAtom], report: Report) -> None:

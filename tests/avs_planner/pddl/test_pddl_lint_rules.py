@@ -83,7 +83,7 @@ def test_did_you_mean_for_types_and_objects() -> None:
 
 
 def test_goal_with_quantifier_is_not_judged_true() -> None:
-    problem = PROBLEM.replace("(and (on a desk))", "(exists (?b - block) (on ?b desk))")
+    problem = PROBLEM.replace("(and (on a desk))", "(forall (?b - block) (on ?b desk))")
     domain = DOMAIN.replace(":probabilistic-effects", ":probabilistic-effects :adl")
     codes = _codes(domain, problem)
     assert ("goal-true-in-init", "warning") not in codes and not any(s == "error" for _, s in codes)
