@@ -114,8 +114,9 @@ def variants(
     base_add, base_delete = groups.pop(frozenset(), ([], []))
     conditions = list(groups)
     if len(conditions) > MAX_CONDITIONS:
-        raise PlanningError(f"a ground action has {len(conditions)} state-dependent effect "
-                            f"conditions (at most {MAX_CONDITIONS} are supported)")
+        raise PlanningError(f"{len(conditions)} state-dependent effect conditions; at most "
+                            f"{MAX_CONDITIONS} are supported (the ground action is split "
+                            f"into a copy per combination, {2 ** MAX_CONDITIONS} at most)")
     out = []
     for chosen in itertools.product((True, False), repeat=len(conditions)):
         variant = Variant([], [], [], list(base_add), list(base_delete))

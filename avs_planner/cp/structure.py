@@ -267,8 +267,13 @@ def expand_conditional(
     static, static_names = statics
 
     def per_binding(binding: dict[str, str]) -> list[Variant]:
-        return variants(schema.conditional, binding, space.encode, static, static_names,
-                        space.names_of)
+        try:
+            return variants(schema.conditional, binding, space.encode, static, static_names,
+                            space.names_of)
+        except PlanningError as exc:  # name the ground action it is about
+            args = " ".join(binding[p] for p in schema.params if p in binding)
+            raise PlanningError(f"action {schema.name}, as ({schema.name} {args}): {exc}"
+                                ) from None
 
     index, found = expand_rows(schema.params, columns, rows, space.names, per_binding)
     pre, neg, add, delete = (a[index] for a in arrays)

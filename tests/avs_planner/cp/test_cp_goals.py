@@ -76,3 +76,25 @@ def test_the_grounder_names_a_goal_that_stays_a_disjunction() -> None:
     problem.add_goal(em.Or(served(problem.object("p1")), served(problem.object("p2"))))
     with pytest.raises(PlanningError, match=r"grounds to a disjunction \(\(served p1\) or"):
         plan(type(task)(problem), SearchOptions())
+
+
+def test_too_many_state_dependent_effect_conditions_name_the_ground_action() -> None:
+    from avs_planner.cp.conditional import MAX_CONDITIONS
+
+    n = MAX_CONDITIONS + 1
+    objects = " ".join(f"o{i}" for i in range(n))
+    domain = """(define (domain lamps)
+  (:requirements :strips :typing :conditional-effects)
+  (:types lamp)
+  (:predicates (on ?l - lamp) (lit ?l - lamp) (done))
+  (:action switch :parameters (?l - lamp) :effect (on ?l))
+  (:action flip :parameters ()
+    :effect (and (done) (forall (?l - lamp) (when (on ?l) (lit ?l))))))
+"""
+    problem = f"""(define (problem many) (:domain lamps)
+  (:objects {objects} - lamp)
+  (:init (on o0))
+  (:goal (done)))
+"""
+    with pytest.raises(PlanningError, match=rf"action flip, as \(flip \): {n} state-dependent"):
+        plan(read_text(domain, problem), SearchOptions())
