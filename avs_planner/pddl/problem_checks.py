@@ -88,7 +88,9 @@ def _check_header(domain: Domain, problem: Problem, report: Report) -> None:
             report.add(
                 entry.atom,
                 "name-clash",
-                f"object '{name}' has the same name as a type, predicate, function or action",
+                f"object '{name}' has the same name as a type, predicate, function or action "
+                "(read as Fast Downward reads it: the names live apart)",
+                warning=True,
             )
 
 
