@@ -25,7 +25,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "plan",
         help="plan a (probabilistic) PDDL problem",
-        description="Find a plan minimising c(pi) + R(1 - p(pi)) (seed 003). Exit codes: "
+        description="Find a plan minimising c(pi) + R(1 - p(pi)) (Goebelbecker et al., A Planning "
+        "Approach to Active Visual Search in Large Environments). Exit codes: "
         "0 solved, 1 bad input, 2 unsolvable / no plan with p > 0 (or above --min-success), "
         "3 timeout or node limit with no plan found yet (with one found, the best so far is "
         "printed, exit 0, and `stopped_by` says which limit ended the search).",
@@ -36,20 +37,28 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--reward", type=float, default=None,
                         help="goal reward R (default 500)")
     parser.add_argument("--weight", type=float, default=None,
-                        help="weight w >= 1 on the remaining cost estimate (1: A*; default 2)")
-    parser.add_argument("--timeout", type=float, default=None, help="seconds (default: none)")
+                        help="weight w >= 1 on the remaining cost estimate (1: A*; default 2); "
+                        "picks the weighted mode")
+    parser.add_argument("--timeout", type=float, default=None,
+                        help="seconds (default: none); with it the default mode is anytime")
     parser.add_argument("--node-limit", type=int, default=None, help="max expanded states")
     parser.add_argument("--patience", type=_patience, default=None,
                         help="once a plan is found, expansions without a better one before "
                         "the best is returned ('inf': no limit; default 2500 with an "
                         "inadmissible heuristic, no limit with hmax)")
-    parser.add_argument("--anytime", action="store_true",
-                        help="anytime satisficing: greedy best-first with FF and helpful "
-                        "actions (LAMA's first iteration), then weighted A* restarts with "
-                        "w = 5, 3, 2, 1; prints the best plan by objective at --timeout "
-                        "(or when the last restart ends). Probabilistic objectives kept")
-    parser.add_argument("--heuristic", default="ff",
-                        help="hmax (admissible), hadd, ff (default) or blind")
+    parser.add_argument("--mode", choices=("auto", "anytime", "weighted"), default="auto",
+                        help="anytime: greedy best-first with FF and helpful actions (LAMA's "
+                        "first iteration), then weighted A* restarts with w = 5, 3, 2, 1; "
+                        "prints the best plan by objective at --timeout (or when the last "
+                        "restart ends); probabilistic objectives kept. weighted: one weighted "
+                        "A* search (with --heuristic hmax and --weight 1, optimal). auto (the "
+                        "default): anytime when a --timeout bounds it and neither --weight "
+                        "nor --heuristic is given, else weighted (the restarts down to w = 1 "
+                        "have no bound of their own)")
+    parser.add_argument("--anytime", action="store_true", help="the same as --mode anytime")
+    parser.add_argument("--heuristic", default=None,
+                        help="hmax (admissible), hadd, ff (default) or blind; picks the "
+                        "weighted mode")
     parser.add_argument("--min-success", type=float, default=0.0,
                         help="give up if the best plan's success probability is below this")
     parser.add_argument("--engine", choices=("auto", "native", "python"), default="auto",
@@ -68,9 +77,9 @@ def run(args: argparse.Namespace) -> int:
 
     given = {"reward": args.reward, "weight": args.weight}
     options = SearchOptions(
-        heuristic=args.heuristic, timeout_s=args.timeout, node_limit=args.node_limit,
+        heuristic=args.heuristic or "ff", timeout_s=args.timeout, node_limit=args.node_limit,
         min_success=args.min_success, engine=args.engine, patience=args.patience,
-        threads=args.threads, anytime=args.anytime,
+        threads=args.threads, anytime=_anytime(args),
         **{k: v for k, v in given.items() if v is not None},
     ).check()
     pproblem = read_files(args.domain, args.problem)
@@ -82,6 +91,15 @@ def run(args: argparse.Namespace) -> int:
     if hint:
         print(hint, file=sys.stderr)
     return EXIT_CODES[result.status.value]
+
+
+def _anytime(args: argparse.Namespace) -> bool:
+    """`--mode`: auto is anytime when a timeout bounds it and no option of the weighted
+    search (a weight, a heuristic) was asked for."""
+    mode = "anytime" if args.anytime else args.mode
+    if mode == "auto":
+        return (args.timeout is not None and args.weight is None and args.heuristic is None)
+    return mode == "anytime"
 
 
 def _limit_hint(result: PlanResult, heuristic: str) -> str | None:

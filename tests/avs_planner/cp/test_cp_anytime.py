@@ -97,6 +97,32 @@ def test_up_anytime_planner_yields_each_improving_plan() -> None:
     assert [r.status for r in ends] == [PlanGenerationResultStatus.UNSOLVABLE_PROVEN]
 
 
+def test_avs_plan_runs_the_anytime_mode_by_default_when_a_timeout_bounds_it(monkeypatch
+                                                                           ) -> None:
+    """`--mode auto`: anytime with a --timeout and no weighted-search option, else one
+    weighted A* search; --anytime and --mode pick it outright."""
+    import avs_planner.cp.planner as planner_module
+    from avs_planner.cli import main
+
+    seen = []
+    real = planner_module.plan
+
+    def spy(pproblem, options=None, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
+        seen.append(options.anytime)
+        return real(pproblem, options, *args, **kwargs)
+
+    monkeypatch.setattr(planner_module, "plan", spy)
+    folder = require_ipc() / "gripper"
+    files = [str(folder / "domain.pddl"), str(folder / "instance-1.pddl")]
+    for extra, anytime in ([[], False], [["--timeout", "20"], True],
+                           [["--timeout", "20", "--weight", "3"], False],
+                           [["--timeout", "20", "--heuristic", "hadd"], False],
+                           [["--mode", "weighted", "--timeout", "20"], False],
+                           [["--anytime"], True], [["--mode", "anytime"], True]):
+        assert main(["plan", *files, "--json", *extra]) == 0
+        assert seen[-1] is anytime, extra
+
+
 def _solve_params() -> list:
     from tests.ipc import IPC, NOT_SOLVED_YET
 
