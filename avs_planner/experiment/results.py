@@ -22,6 +22,8 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+from avs_planner.experiment.errors import CampaignError
+
 RESULTS_FILE = "results.csv"
 WALL_CUT = "wall_cut"
 WALL_CUT_REASON = "wall time budget"  # how the episode loop and strategies word that stop
@@ -144,9 +146,34 @@ def _cell(value: Any) -> Any:
 
 
 def read_results(path: Path) -> list[dict[str, Any]]:
-    """The table back as typed rows (None for empty cells)."""
-    with path.open(newline="", encoding="utf-8") as f:
-        return [{k: _parse(k, v) for k, v in r.items()} for r in csv.DictReader(f)]
+    """The table back as typed rows (None for empty cells); CampaignError naming the file
+    and what is wrong when it is not a results table (columns missing, a cell that is not
+    of its column's type, not UTF-8 text)."""
+    try:
+        with path.open(newline="", encoding="utf-8") as f:
+            reader = csv.DictReader(f)
+            missing = [c for c in KEY_COLUMNS + ["status", "outcome"]
+                       if c not in (reader.fieldnames or [])]
+            if missing:
+                raise CampaignError(f"{path}: not a results table of `avs experiment run`: "
+                                    f"no column {', '.join(missing)}")
+            rows = []
+            for line, r in enumerate(reader, start=2):
+                row = {}
+                for k, v in r.items():
+                    if k is None:
+                        continue  # cells beyond the header's columns
+                    try:
+                        row[k] = _parse(k, v)
+                    except ValueError:
+                        raise CampaignError(f"{path}:{line}: column {k}: {v!r} is not a "
+                                            f"value of that column") from None
+                rows.append(row)
+            return rows
+    except UnicodeDecodeError as exc:
+        raise CampaignError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
+    except csv.Error as exc:
+        raise CampaignError(f"{path}: not a CSV table ({exc})") from None
 
 
 def _parse(column: str, text: str | None) -> Any:

@@ -61,6 +61,23 @@ def test_the_cli_refuses_a_report_without_results(tmp_path, capsys):
     assert "no results.csv" in capsys.readouterr().err
 
 
+def test_the_cli_reports_a_malformed_results_table_as_bad_input(tmp_path, capsys):
+    from avs_planner.experiment.results import COLUMNS
+
+    table = tmp_path / "results.csv"
+    table.write_text("a,b\n1,2\n", encoding="utf-8")
+    assert main(["experiment", "report", str(tmp_path)]) == 1
+    assert "no column run_id" in capsys.readouterr().err
+    row = {c: "" for c in COLUMNS} | {"run_id": "r", "status": "ok", "seed": "zero"}
+    table.write_text(",".join(COLUMNS) + "\n" + ",".join(row[c] for c in COLUMNS) + "\n",
+                     encoding="utf-8")
+    assert main(["experiment", "report", str(tmp_path)]) == 1
+    assert "results.csv:2: column seed: 'zero'" in capsys.readouterr().err
+    table.write_bytes(b"\xff\xfe\x00")
+    assert main(["experiment", "report", str(tmp_path)]) == 1
+    assert "not a UTF-8 text file" in capsys.readouterr().err
+
+
 def test_the_cli_refuses_an_address_without_ray(tmp_path, capsys):
     campaign = tmp_path / "c.yaml"
     campaign.write_text("scenarios: [a]\n")
