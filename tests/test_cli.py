@@ -23,3 +23,23 @@ def test_unknown_command_is_usage_error() -> None:
     with pytest.raises(SystemExit) as exc:
         main(["no-such-command"])
     assert exc.value.code == EXIT_BAD_INPUT
+
+
+def test_every_command_has_a_description_in_its_help() -> None:
+    """`avs CMD --help` says what the command does, beyond its one-line summary."""
+    import argparse
+
+    from avs_planner.cli import build_parser
+
+    def walk(parser: argparse.ArgumentParser, path: list[str]):  # noqa: ANN202
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, sub in action.choices.items():
+                    yield from walk(sub, [*path, name])
+                return
+        yield path, parser
+
+    leaves = list(walk(build_parser(), []))
+    assert len(leaves) >= 10
+    for path, parser in leaves:
+        assert parser.description and len(parser.description) > 40, " ".join(path)

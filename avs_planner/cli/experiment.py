@@ -24,7 +24,11 @@ def register(subparsers: Any) -> None:
     sub = parser.add_subparsers(dest="experiment_command", metavar="ACTION", required=True)
     _register_run(sub)
     _register_report(sub)
-    listing = sub.add_parser("list", help="list the built-in campaigns and their sizes")
+    listing = sub.add_parser(
+        "list", help="list the built-in campaigns and their sizes",
+        description="List the built-in campaigns (avs_planner/experiment/campaigns/): name, "
+        "number of episodes, what they run. `heldout` and `heldout-fig3` are the evaluation-"
+        "only range; `development` is their twin on development seeds (docs/experiments.md).")
     listing.set_defaults(func=run_list)
 
 

@@ -20,11 +20,20 @@ def register(subparsers: Any) -> None:
     parser = subparsers.add_parser("sim", help="simulated worlds: render and check world files")
     commands = parser.add_subparsers(dest="sim_command", metavar="SIM_COMMAND", required=True)
     worlds = ", ".join(_builtin_world_names())
-    render = commands.add_parser("render", help="draw a world top-down to a PNG")
+    render = commands.add_parser(
+        "render", help="draw a world top-down to a PNG",
+        description="Draw a world file (or a built-in world) top-down to a PNG: walls, doors, "
+        "rooms with their categories, furniture and objects, and the robot's start. This is "
+        "the world's truth, as the experimenter sees it; the robot never does.")
     render.add_argument("--world", required=True, help=f"built-in name ({worlds}) or YAML path")
     render.add_argument("--out", help="PNG to write (default: WORLDNAME.png)")
     render.set_defaults(func=run_render)
-    check = commands.add_parser("check", help="validate a world file and summarise it")
+    check = commands.add_parser(
+        "check", help="validate a world file and summarise it",
+        description="Read a world file (or a built-in world), check it and build it once in "
+        "the simulator (its fields, the robot's start, room categories the knowledge knows), "
+        "and print a one-line summary: size, rooms, doors, furniture, objects, robot "
+        "(--json: the full summary). A problem is reported with where it is; exit 1.")
     check.add_argument("--world", required=True, help=f"built-in name ({worlds}) or YAML path")
     check.add_argument("--json", action="store_true", help="print the summary as JSON")
     check.set_defaults(func=run_check)
