@@ -43,3 +43,15 @@ def test_every_command_has_a_description_in_its_help() -> None:
     assert len(leaves) >= 10
     for path, parser in leaves:
         assert parser.description and len(parser.description) > 40, " ".join(path)
+
+
+def test_simulate_without_out_never_overwrites_an_earlier_run(tmp_path, monkeypatch) -> None:
+    from avs_planner.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    args = ["simulate", "--scenario", "a", "--seed", "1", "--time-budget", "5", "--json"]
+    for _ in range(2):
+        assert main(args) in (0, 2, 3)
+    runs = sorted(p.name for p in (tmp_path / "runs").iterdir())
+    assert runs == ["office-cerealbox", "office-cerealbox-2"]
+    assert all((tmp_path / "runs" / r / "summary.json").exists() for r in runs)

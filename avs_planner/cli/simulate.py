@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 from pathlib import Path
 from typing import Any
@@ -56,7 +57,10 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--pre-explore", action="store_true", help="map the building before "
                         "the clock starts (the strategy's own survey where it has one, e.g. "
                         "flap's with depth frames)")
-    parser.add_argument("--out", default="avs-episode", help="output directory")
+    parser.add_argument("--out", default=None,
+                        help="output directory (default: a new one under runs/ named after "
+                        "the world and target, e.g. runs/office-cerealbox-2: a run never "
+                        "overwrites an earlier one unless --out names it)")
     parser.add_argument("--record", action="store_true", help="also write OUT/recording.rrd, "
                         "a Rerun recording (needs `pip install 'avs-planner[viewer]'`; replay "
                         "it with `avs view OUT`)")
@@ -172,8 +176,25 @@ def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
         spec["view"] = True
     if not spec.get("target"):
         raise ValueError("--target LABEL (or --scenario) is required")
+    if args.out is None:
+        args.out = str(_fresh_out(spec))
     spec["output_dir"] = args.out
     return spec
+
+
+def _fresh_out(spec: dict[str, Any], root: Path = Path("runs")) -> Path:
+    """runs/WORLD-TARGET, or the first of -2, -3, ... not taken by an earlier run."""
+    gen = spec.get("generate")
+    if gen:
+        world = f"gen-{gen.get('style', 'office')}-{gen.get('seed')}"
+    else:
+        world = Path(str(spec.get("world") or "office")).stem
+    stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", f"{world}-{spec['target']}")
+    out, n = root / stem, 1
+    while out.exists():
+        n += 1
+        out = root / f"{stem}-{n}"
+    return out
 
 
 def _qsr_file(path: str) -> Any:
