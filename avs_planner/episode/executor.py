@@ -22,6 +22,7 @@ from avs_planner.episode.dt_search import ViewConeSearch
 from avs_planner.episode.glimpses import Glimpses
 from avs_planner.episode.mind import KnownObject, Mind
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
+from avs_planner.episode.robot_api import Robot
 from avs_planner.episode.state_builder import AvsState, StateBuilder
 from avs_planner.episode.viewcones import (
     CameraModel,
@@ -115,7 +116,7 @@ class Stats:
 class Executor(Driving):
     """Runs plan steps; `emit(type, **fields)` records trace events."""
 
-    def __init__(self, robot: Any, mind: Mind, builder: StateBuilder, camera: CameraModel,
+    def __init__(self, robot: Robot, mind: Mind, builder: StateBuilder, camera: CameraModel,
                  emit: Event, config: ExecutorConfig | None = None, seed: int = 0):
         self.robot, self.mind, self.builder = robot, mind, builder
         self.camera, self.emit = camera, emit

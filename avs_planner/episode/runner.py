@@ -26,6 +26,7 @@ from avs_planner.episode.robot import (
     load_spec,
     open_world,
 )
+from avs_planner.episode.robot_api import fence
 from avs_planner.episode.snapshots import MapSnapshots
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.trace import Trace, write_summary
@@ -224,17 +225,20 @@ class Episode:
         self.trace = Trace(lambda: self.robot.clock, self.out / "trace.jsonl" if self.out
                            else None, emit)
         self.builder = StateBuilder(self.mind, SearchTask(spec.target, spec.category))
-        camera = self.robot.robot.model.camera
-        self.camera = CameraModel(self.robot.camera_height, camera.hfov, camera.detect_range,
-                                  vfov=camera.vfov)
-        self.executor = Executor(self.robot, self.mind, self.builder, self.camera,
+        body = self.robot.body()
+        self.camera = CameraModel(self.robot.camera_height, body.hfov, body.detect_range,
+                                  vfov=body.vfov)
+        # the mind's side gets the robot through the fence: its sensors and motions, never
+        # the world behind them (`robot_api.fence`); the harness keeps `self.robot`
+        sensed = fence(self.robot)
+        self.executor = Executor(sensed, self.mind, self.builder, self.camera,
                                  self._emit, ExecutorConfig(dt_policy=spec.dt_policy),
                                  seed=spec.seed)
         self.trace.subscribe(MapSnapshots(self.executor, self._emit).observe)
         from avs_planner.strategies import SearchContext
 
         self.context = SearchContext(
-            robot=self.robot, body=self.robot.body(), mind=self.mind, builder=self.builder,
+            robot=sensed, body=body, mind=self.mind, builder=self.builder,
             executor=self.executor, trace=self.trace, target=spec.target,
             category=spec.category, time_budget_s=spec.time_budget_s,
             wall_budget_s=spec.wall_budget_s, options=spec.strategy_options,

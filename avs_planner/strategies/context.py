@@ -10,16 +10,18 @@ from avs_planner.body import RobotBody
 from avs_planner.episode.executor import Executor
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import Outcome, SearchResult
+from avs_planner.episode.robot_api import Robot
 from avs_planner.episode.state_builder import StateBuilder
 from avs_planner.episode.trace import Trace
 
 
 @dataclass
 class SearchContext:
-    """One episode's shared parts. `robot` is the adapter (pose, moves, sensing, clock),
-    never the simulator; `options` are the strategy's checked options."""
+    """One episode's shared parts. `robot` is the robot through its fence (pose, moves,
+    sensing, clock: `episode/robot_api.py`), never the simulator; `options` are the
+    strategy's checked options."""
 
-    robot: Any
+    robot: Robot
     body: RobotBody
     mind: Mind
     builder: StateBuilder
