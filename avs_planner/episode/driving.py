@@ -42,6 +42,11 @@ class Driving:
         """Drive leg by leg to `goal`, re-planning the path on the growing grid."""
         cfg = self.config
         route: list[tuple[float, float]] = []  # the rest of the last A* path
+        # the margin that path keeps: a squeeze's is slimmer, and re-checked at the full
+        # radius it never holds; re-planned from inside the gap, a full-radius path escapes
+        # the start's inflation zone in a straight line and clips the gap's exit corner (a
+        # PR2 leaving a 0.74 m gap touched the fridge's corner until it gave up)
+        margin = self.mind.config.robot_radius
         age = detours = 0
         for _ in range(cfg.max_legs):
             if stop():
@@ -49,10 +54,10 @@ class Driving:
             here = self.robot.pose
             if math.dist(here[:2], goal) <= cfg.arrive:
                 return StepOutcome(StepStatus.DONE)
-            if age >= cfg.replan_legs or not self._clear(route):
+            if age >= cfg.replan_legs or not self._clear(route, margin):
+                margin = self.mind.config.robot_radius
                 try:
-                    path = plan_path(self.mind.grid, here[:2], goal,
-                                     self.mind.config.robot_radius)
+                    path = plan_path(self.mind.grid, here[:2], goal, margin)
                 except MapError as exc:
                     nearby = self._free_near(goal)
                     if nearby is None:
@@ -60,7 +65,7 @@ class Driving:
                     goal, route = nearby, []
                     continue
                 if not path.found:
-                    path = self._squeeze(here[:2], goal)
+                    path, margin = self.squeeze_path(here[:2], goal)
                 if not path.found:
                     return StepOutcome(StepStatus.FAILED, self._no_path(goal))
                 route, age = list(path.waypoints), 0
@@ -123,14 +128,14 @@ class Driving:
         return f"no path to ({goal[0]:.2f}, {goal[1]:.2f})" + (
             f" ({'; '.join(known)})" if known else "")
 
-    def _clear(self, route: list[tuple[float, float]]) -> bool:
-        """The rest of the last path still keeps the full margin on the grown grid (so the
-        A* search is not repeated after every leg). The robot's own footprint is skipped:
-        the laser never sees the cells under the base."""
+    def _clear(self, route: list[tuple[float, float]], radius: float | None = None) -> bool:
+        """The rest of the last path still keeps its margin `radius` (default: the planning
+        radius) on the grown grid (so the A* search is not repeated after every leg). The
+        robot's own footprint is skipped: the laser never sees the cells under the base."""
         if len(route) < 2:
             return False
         grid = self.mind.grid
-        radius = self.mind.config.robot_radius
+        radius = self.mind.config.robot_radius if radius is None else radius
         free = grid.traversable(radius)
         step = grid.resolution / 2
         start = np.asarray(route[0])
@@ -147,10 +152,16 @@ class Driving:
         return True
 
     def _squeeze(self, start: tuple[float, float], goal: tuple[float, float]):  # noqa: ANN202
+        """`squeeze_path`'s path alone."""
+        return self.squeeze_path(start, goal)[0]
+
+    def squeeze_path(self, start: tuple[float, float], goal: tuple[float, float]
+                     ) -> tuple[PathResult, float]:
         """A path with a slimmer margin (the robot may start close to furniture; never below
         its footprint less a cell: `clearance` underestimates by half a cell), then one
         through unknown cells (a laser mounted ahead of the base never sees the cells under
-        and behind it); the simulator still refuses any motion that would collide."""
+        and behind it); the simulator still refuses any motion that would collide. Returns
+        the path and the margin it keeps."""
         radius = self.mind.config.robot_radius
         tries = ((self.squeeze_margin(), False), (radius, True))
         for margin, unknown in tries:
@@ -160,10 +171,10 @@ class Driving:
             except MapError:
                 continue
             if path.found:
-                return path
+                return path, margin
         # no path (the robot may stand where only a squeeze fits: a query from there with
         # the full radius is refused, which must not end the episode)
-        return PathResult(PathStatus.NO_PATH, (), math.inf, 0)
+        return PathResult(PathStatus.NO_PATH, (), math.inf, 0), radius
 
     def squeeze_margin(self) -> float:
         """The slimmest margin a path may keep: the mind's own squeeze radius

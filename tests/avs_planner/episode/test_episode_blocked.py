@@ -257,15 +257,7 @@ robot: {{model: pioneer, start: [2.5, 2.5, 0.0]}}
 """
 
 
-@pytest.mark.parametrize("robot", [
-    "pioneer",
-    pytest.param("pr2", marks=pytest.mark.xfail(strict=False, reason=(
-        "known fault: leaving the 0.74 m gap, the squeezing path's shortcut passes the "
-        "fridge's corner 0.32 m from the PR2's centre (footprint 0.34 m, squeeze margin "
-        "0.29 m); wedged between corner and wall every leg is refused, the keep-out disc "
-        "closes the gap, and the robot gives up with P = 0.84 left. It passed before only "
-        "when a later retry took another line; to fix in path planning at squeeze exits"))),
-])
+@pytest.mark.parametrize("robot", ["pioneer", "pr2"])
 def test_a_target_behind_a_gap_the_grid_under_measures_is_found(robot: str) -> None:
     """A tall fridge row leaves a 0.74 m gap to the wall, the only way to the table: the PR2
     (0.68 m) passes it, but the grid (a lower bound on clearance) shows it narrower than the
