@@ -148,17 +148,8 @@ def _room_cells(mind: Mind, room: str, reach: float) -> np.ndarray:
 
 def candidate_cells(mind: Mind, reach: float) -> tuple[np.ndarray, np.ndarray]:
     """Where objects (and their supports) may be: the centres of occupied/unknown cells next
-    to free space, within `reach` of a place, each with the room whose floor it borders
-    (an object array of room ids, None where it borders no room's floor).
-
-    A cell's room is the one holding most of its free 4-neighbours (`PlaceMap.room_extents`:
-    the free space, split at the doors, that a room's places stand in). The nearest place
-    is not the room: the corridor's side of a room's wall lies nearer to the room's places
-    than to the corridor's, yet can only be seen from the corridor; counted as the room's, a
-    third of a meeting room's cells could never be looked at from inside it, and neither its
-    searches nor the frames taken in it ever ruled out more than two thirds of it. A cell
-    whose free neighbours belong to no room (space seen through a door, not entered) is no
-    known room's."""
+    to free space, within `reach` of a place, each with the room of its nearest place
+    (an object array of room ids, None where the place has no room)."""
     grid, pm = mind.grid, mind.place_map
     states = grid.state_grid()
     free = states == CellState.FREE
@@ -171,23 +162,13 @@ def candidate_cells(mind: Mind, reach: float) -> tuple[np.ndarray, np.ndarray]:
     if len(idx) == 0 or not pm.places:
         return np.zeros((0, 2)), np.zeros(0, dtype=object)
     points = grid.to_world(idx)
-    centres = np.array([p.position for p in pm.places.values()])
+    ids = sorted(pm.places)
+    centres = np.array([pm.places[p].position for p in ids])
     dist = np.linalg.norm(points[:, None, :] - centres[None, :, :], axis=2)
+    nearest = dist.argmin(axis=1)
+    room_of = np.array([pm.room_of(p) for p in ids], dtype=object)
     keep = dist.min(axis=1) <= reach
-    idx, points = idx[keep], points[keep]
-    room_of = np.full(len(idx), None, dtype=object)
-    if pm.rooms and len(idx):
-        owner, ids = pm.room_extents(grid)
-        padded = np.pad(owner, 1)  # 0: not free, or no room's
-        i, j = idx[:, 0] + 1, idx[:, 1] + 1
-        around = np.stack([padded[i - 1, j], padded[i + 1, j], padded[i, j - 1],
-                           padded[i, j + 1]], axis=1)
-        votes = np.stack([(around == around[:, [k]]) & (around[:, [k]] > 0)
-                          for k in range(4)], axis=1).sum(axis=2)
-        best = around[np.arange(len(idx)), votes.argmax(axis=1)]
-        names = np.array([None, *ids], dtype=object)
-        room_of = names[best]
-    return points, room_of
+    return points[keep], room_of[nearest[keep]]
 
 
 def _in_wedge(points: np.ndarray, pose: tuple[float, float, float],
