@@ -12,6 +12,7 @@ plus optionally `reward`, `weight`, `heuristic`, `node_limit`, `min_success`, `e
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping
+from dataclasses import replace
 from typing import IO, Any
 
 import unified_planning as up
@@ -129,7 +130,7 @@ class AvsPlanner(Engine, OneshotPlannerMixin, AnytimePlannerMixin):
         output_stream: IO[str] | None = None,
     ) -> PlanGenerationResult:
         assert isinstance(problem, Problem)
-        options = SearchOptions(**{**self._options.__dict__, "timeout_s": timeout})
+        options = replace(self._options, timeout_s=timeout)
         try:
             result = plan(ProbabilisticProblem(problem, self._success), options)
         except PlanningError as exc:
@@ -153,8 +154,7 @@ class AvsPlanner(Engine, OneshotPlannerMixin, AnytimePlannerMixin):
         """The anytime schedule's plans as it finds them (status INTERMEDIATE), then, when
         it found none, one result saying why; `timeout` bounds the whole run."""
         assert isinstance(problem, Problem)
-        options = SearchOptions(**{**self._options.__dict__, "timeout_s": timeout,
-                                   "anytime": True})
+        options = replace(self._options, timeout_s=timeout, anytime=True)
         run = AnytimeRun()
         try:
             for result in improving_plans(ProbabilisticProblem(problem, self._success),

@@ -24,12 +24,7 @@ def plan(
     options = (options or SearchOptions()).check()
     with gc_paused():
         start = time.perf_counter()
-        if state is None:
-            state = (DEFAULT_CACHE if cache is None else cache).initial_state(pproblem)
-        task = ground(pproblem, state, cache)
-        symmetries = (
-            find_symmetries(pproblem, state, task) if options.symmetry else NO_SYMMETRIES
-        )
+        task, symmetries = _ground(pproblem, options, state, cache)
         grounded = time.perf_counter()
         result = _search(task, options, symmetries)
         return replace(
@@ -47,11 +42,7 @@ def improving_plans(pproblem: ProbabilisticProblem, options: SearchOptions | Non
     options = (options or SearchOptions()).check()
     run = run if run is not None else AnytimeRun()
     with gc_paused():
-        state = DEFAULT_CACHE.initial_state(pproblem)
-        task = ground(pproblem, state)
-        symmetries = (
-            find_symmetries(pproblem, state, task) if options.symmetry else NO_SYMMETRIES
-        )
+        task, symmetries = _ground(pproblem, options)
     plans = anytime_plans(task, options, symmetries, run)
     while True:  # the search runs with the collector paused, the caller's turn does not
         with gc_paused():
@@ -59,6 +50,18 @@ def improving_plans(pproblem: ProbabilisticProblem, options: SearchOptions | Non
         if result is None:
             return
         yield result
+
+
+def _ground(pproblem: ProbabilisticProblem, options: SearchOptions,
+            state: WorldState | None = None, cache: GroundingCache | None = None
+            ) -> tuple[GroundTask, Symmetries]:
+    """The task grounded from `state` (default: the problem's :init), and its symmetries
+    when the options ask for them."""
+    if state is None:
+        state = (DEFAULT_CACHE if cache is None else cache).initial_state(pproblem)
+    task = ground(pproblem, state, cache)
+    symmetries = find_symmetries(pproblem, state, task) if options.symmetry else NO_SYMMETRIES
+    return task, symmetries
 
 
 def plan_task(task: GroundTask, options: SearchOptions | None = None) -> PlanResult:
