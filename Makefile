@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 
-.PHONY: run test test-all lint bench serve constraints clean
+.PHONY: run test test-all sanitize lint bench serve constraints clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -40,6 +40,11 @@ test: $(VENV)/.installed-dev
 ## test-all: the whole suite, slow tests included
 test-all: $(VENV)/.installed-dev
 	$(BIN)/python -m pytest -q -m ''
+
+## sanitize: build the three C extensions with AddressSanitizer + UBSan out of tree (build/sanitize/;
+## the in-place .so files are not touched) and run the differential tests against them (needs gcc)
+sanitize: $(VENV)/.installed-dev
+	$(BIN)/python tools/sanitize.py
 
 ## lint: ruff, and the dependency rules of docs/architecture.md (import-linter contracts in pyproject.toml)
 lint: $(VENV)/.installed-dev
