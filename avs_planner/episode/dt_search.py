@@ -180,18 +180,31 @@ class ViewConeSearch:
         for space in support_spaces(self.ex.mind, label, location):
             self.ex.mind.cmap.observe_search(label, space, min(1.0, coverage), 1.0)
 
+    def _coverage(self, made: ConeSet, looks: dict[int, int], label: str, relation: str,
+                  location: str) -> float:
+        """The share of the location's objects the looks would have seen. On the top of a
+        support (where the knowledge puts `label` on it only), from what each look had of the
+        top in view (`Glimpses.top_share`), as frames in passing count, when the cones are
+        the 2D ones round it; else, or when no look had the top in view by that model, from
+        the cones' shares of the location (`looked_share`)."""
+        glimpses, obj = self.ex.glimpses, self.ex.mind.objects.get(location)
+        if relation == "on" and looks and glimpses is not None and obj is not None \
+                and self.ex.support_views is None \
+                and support_relations(self.ex.mind, label, obj.label) == ("on",):
+            share = glimpses.top_share(location, [
+                (made.cones[i].pose, *(made.cones[i].head or (0.0, 0.0)), k)
+                for i, k in looks.items()])
+            if share:
+                return share
+        return looked_share(made, looks, 1.0 - self.ex.config.detector.false_negative)
+
     def _conclude(self, result, label: str, relation: str, location: str,  # noqa: ANN001
                   made: ConeSet, interrupted: bool = False) -> StepOutcome:
         looks: dict[int, int] = {}
         for step in result.trace:
             if step.action.kind is not ActionKind.MOVE:
                 looks[step.action.cone] = looks.get(step.action.cone, 0) + 1
-        p_detect = 1.0 - self.ex.config.detector.false_negative
-        # the share of the location's objects these looks would have seen: a cone's share
-        # of the location (its mass) seen with 1 - (1 - p_detect)^k after k looks into it
-        coverage = (sum(made.cones[i].probability * (1.0 - (1.0 - p_detect) ** k)
-                        for i, k in looks.items()) * made.coverage / made.probability
-                    if made.probability > 0 else 0.0)
+        coverage = self._coverage(made, looks, label, relation, location)
         if result.status is DTStatus.CONFIRMED and result.detection is not None:
             seen = result.detection
             support = location if relation == "on" else None
@@ -209,7 +222,7 @@ class ViewConeSearch:
             self._searched(label, relation, location, coverage)
         if interrupted:  # not a failed search: it stopped because the target turned up
             return StepOutcome(StepStatus.DONE, TARGET_SEEN)
-        if coverage == 0.0:
+        if not looks:
             # the DT, on its belief, found no look there worth its cost: asked again from
             # the same state it would decide the same, in no time, and the loop took the
             # repeat for a livelock and gave up with everything else still to search
@@ -223,6 +236,23 @@ class ViewConeSearch:
             key = (label, location)
             self.ex.builder.failed_in[key] = self.ex.builder.failed_in.get(key, 0) + 1
         return StepOutcome(StepStatus.DONE, "rejected")
+
+
+def looked_share(made: ConeSet, looks: dict[int, int], p_detect: float) -> float:
+    """The share of the location's objects that `looks` (cone index -> looks into it) would
+    have seen: the cones cover `made.coverage` of the location between them, each cone its
+    probability's part of that; a cone looked into k times misses with (1 - p_detect)^k.
+
+    The cone makers differ in what their probabilities add up to (a room's cones to
+    P(ObjectAt) x coverage, a support's to P(ObjectAt)), so each cone's part is its
+    probability over the cones' sum, never over `made.probability`: divided by that, a
+    room's coverage counted twice (a search over 0.8 of a room thinned it as if over 0.64)."""
+    mass = sum(c.probability for c in made.cones)
+    if mass <= 0.0:
+        return 0.0
+    seen = sum(made.cones[i].probability * (1.0 - (1.0 - p_detect) ** k)
+               for i, k in looks.items())
+    return seen / mass * made.coverage
 
 
 class PathLengths:

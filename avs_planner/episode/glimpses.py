@@ -138,6 +138,22 @@ class Glimpses:
                 self._observe(label, RelatedSpace("on", oid),
                               self._share([len(where) for where in looks]))
 
+    def top_share(self, oid: str, looks: Iterable[tuple[tuple[float, float, float], float,
+                                                       float, int]]) -> float | None:
+        """The share of the known object `oid`'s top that `looks` would have seen: each look
+        (camera pose, pan, tilt, how many times) is one chance for the detector at every point
+        of the top it had in view (`_top_in_view`). A DT search of a support looks at it
+        from several standpoints around it, each seeing most of the top: those are repeated
+        chances at the same objects, not a partition of them. None for an unknown object."""
+        obj = self.mind.objects.get(oid)
+        if obj is None:
+            return None
+        top = 2.0 * obj.position[2]
+        counts = np.zeros(len(self._top_points))
+        for pose, pan, tilt, times in looks:
+            counts += times * self._top_in_view(obj.position[:2], pose, pan, tilt, top)
+        return self._share(counts.tolist())
+
     def _top_in_view(self, centre: tuple[float, float], pose: tuple[float, float, float],
                      pan: float, tilt: float, top: float) -> np.ndarray:
         """Which points of the top (`_top_points` around `centre`, at height `top`) are in

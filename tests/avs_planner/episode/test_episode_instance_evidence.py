@@ -14,10 +14,10 @@ import pytest
 from avs_planner.dt import ViewCone
 from avs_planner.dt.domain import ActionKind, DTAction
 from avs_planner.dt.session import DTResult, DTStatus, DTStep
-from avs_planner.episode.dt_search import ViewConeSearch
+from avs_planner.episode.dt_search import ViewConeSearch, looked_share
 from avs_planner.episode.glimpses import Glimpses
 from avs_planner.episode.mind import Mind
-from avs_planner.episode.viewcones import CameraModel, ConeSet
+from avs_planner.episode.viewcones import CameraModel, ConeSet, room_cones, support_cones
 from conceptual_map.conceptual import RelatedSpace
 from conceptual_map.metric import CellState
 from conceptual_map.metric.synthetic import rooms_world
@@ -46,6 +46,52 @@ def test_every_look_of_a_dt_search_into_a_cone_counts(corridor) -> None:
     d = 1.0 - executor.config.detector.false_negative
     seen = 0.8 * (0.5 * (1.0 - (1.0 - d) ** 2) + 0.5 * d)
     assert mind.cmap.objects.remaining(room, "table") == pytest.approx(left * (1.0 - seen))
+
+
+def test_a_room_search_thins_by_its_coverage_once(corridor) -> None:
+    """A room's cones carry P(ObjectAt) x their share of its cells, adding up to P x
+    coverage: looking once into each of them leaves 1 - p_detect x coverage of the room's
+    count unseen (it used to leave 1 - p_detect x coverage^2, the coverage counted twice)."""
+    mind, _, executor = corridor
+    room, _ = _here(mind)
+    made = room_cones(mind, room, "table", 0.5, executor.camera, "k")
+    assert made.cones and 0.0 < made.coverage < 1.0
+    assert sum(c.probability for c in made.cones) == pytest.approx(0.5 * made.coverage)
+    left = mind.cmap.objects.remaining(room, "table")
+    result = DTResult(DTStatus.REJECTED, 0.05, 2.0, _looks(*range(len(made.cones))))
+    ViewConeSearch(executor, "table", "in", room)._conclude(result, "table", "in", room, made)
+    d = 1.0 - executor.config.detector.false_negative
+    assert mind.cmap.objects.remaining(room, "table") == pytest.approx(
+        left * (1.0 - d * made.coverage))
+
+
+def test_a_support_search_counts_each_standpoint_as_a_look_at_the_whole_top(corridor) -> None:
+    """The cones round a support each see most of its top: a search that looks through all
+    of them has had several chances at an object anywhere on it (as frames in passing
+    count, `Glimpses.top_share`), not one chance at each cone's fraction of it, which left
+    1 - 0.9 p_detect of a desk unsearched however many cones looked at it."""
+    mind, _, executor = corridor
+    executor.enable_glimpses()
+    room, (x, y) = _here(mind)
+    table = mind.add_object("table", (x + 2.0, y, 0.375))
+    made = support_cones(mind, table, 0.5, executor.camera, "k")
+    assert len(made.cones) >= 2
+    looks = {i: 1 for i in range(len(made.cones))}
+    d = 1.0 - executor.config.detector.false_negative
+    result = DTResult(DTStatus.REJECTED, 0.05, 2.0, _looks(*looks))
+    ViewConeSearch(executor, "cerealbox", "on", table.id)._conclude(
+        result, "cerealbox", "on", table.id, made)
+    share = executor.glimpses.top_share(
+        table.id, [(c.pose, *c.head, 1) for c in made.cones])
+    left = mind.cmap.objects.remaining(RelatedSpace("on", table.id), "cerealbox")
+    assert left == pytest.approx(1.0 - share)
+    assert share > looked_share(made, looks, d)
+    # one look from one side is one chance at the part of the top it had in view; from the
+    # other side, a second chance where the two views overlap and a first one elsewhere
+    first, last = ((c.pose, *c.head, 1) for c in (made.cones[0], made.cones[-1]))
+    one = executor.glimpses.top_share(table.id, [first])
+    assert 0.0 < one < d
+    assert one < executor.glimpses.top_share(table.id, [first, last]) <= share
 
 
 def _support(mind, builder):
