@@ -14,7 +14,7 @@ from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Any
 
-from avs_planner.cp.search import PlanStep
+from avs_planner.cp.search import DEFAULT_REWARD, PlanStep
 from avs_planner.cp.task import Atom
 from avs_planner.dt import DetectorModel
 from avs_planner.episode.driving import TARGET_SEEN, Driving
@@ -65,8 +65,10 @@ class ExecutorConfig:
     # it, up to this many times per move; then the move fails and the CP plans around it
     detours: int = 2
     # s of robot time: the CP's goal reward R, the DT's terminal penalties; the switching
-    # strategy sets it from `LoopConfig.reward` (one R per episode)
-    miss_penalty: float = 500.0
+    # strategy's executor is built with its `LoopConfig.reward` (one R per episode)
+    miss_penalty: float = DEFAULT_REWARD
+    # the detector looks for the target as the robot moves (`watch`; the loop's `watch`)
+    watch: bool = True
     support_radius: float = 0.9  # m: a detection this near a support is "on" it
     same_object: float = 1.0  # m: a detection this near a known object of its label is it
     above_support: tuple[float, float] = (-0.15, 0.45)  # m around the support's top
@@ -125,7 +127,7 @@ class Executor(Driving):
         self.cones: dict[tuple[str, str, str], ConeSet] = {}
         self.found_sids: dict[str, int] = {}
         self.stats = Stats()
-        self.watching = True  # the detector looks for the target as the robot moves
+        self.watching = self.config.watch  # the detector looks for the target as it moves
         self.support_views: Callable[..., ConeSet] | None = None  # replaces support_cones
         self.on_look: Callable[[], None] | None = None  # before each DT look (e.g. depth)
         self.seen_while_moving: dict[str, set[Atom]] = {}

@@ -13,10 +13,11 @@ from pathlib import Path
 from typing import Any
 
 from avs_planner.cp.continual import ContinualPlanner, Decision
-from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep, SearchOptions
-from avs_planner.episode.executor import Executor
+from avs_planner.cp.search import DEFAULT_REWARD, PlanResult, PlanStatus, PlanStep, SearchOptions
+from avs_planner.episode.errors import EpisodeError
+from avs_planner.episode.executor import Executor, ExecutorConfig
 from avs_planner.episode.outcome import Outcome, SearchResult, StepOutcome, StepStatus
-from avs_planner.episode.state_builder import AvsState, StateBuilder
+from avs_planner.episode.state_builder import AvsState, BuilderConfig, StateBuilder
 from avs_planner.episode.stopping import Remaining, look_cost, remaining
 from avs_planner.episode.trace import Trace
 
@@ -28,7 +29,9 @@ class LoopConfig:
     (generated buildings below seed 10000, Fig. 3 noise seeds 0-99), never on the held-out
     range (docs/experiments.md); R and the costs are the paper's."""
 
-    reward: float = 500.0
+    # R: what finding the object is worth, in the robot's seconds: the CP's goal reward and
+    # the DT's terminal penalties (`executor_config`); the paper's value
+    reward: float = DEFAULT_REWARD
     weight: float = 3.0
     heuristic: str = "hadd"  # on these problems far fewer expansions than ff
     min_success: float = 0.01
@@ -74,6 +77,26 @@ class LoopConfig:
     stop_rule: bool = True
 
 
+    def executor_config(self, base: ExecutorConfig | None = None) -> ExecutorConfig:
+        """The executor's settings these loop settings decide (R, the watch, glimpses, the
+        look around), over `base`: the episode builds its executor with them once."""
+        return replace(base or ExecutorConfig(), miss_penalty=self.reward, watch=self.watch,
+                       glimpses=self.glimpses, look_headings=self.look_headings)
+
+    def builder_config(self, base: BuilderConfig | None = None) -> BuilderConfig:
+        """The state builder's settings these loop settings decide (costs in seconds)."""
+        return replace(base or BuilderConfig(), seconds=self.seconds)
+
+    def configured(self, executor: Executor, builder: StateBuilder) -> list[str]:
+        """The settings `executor` and `builder` were built with that differ from what
+        these loop settings decide (empty when they were built from them)."""
+        pairs = [(executor.config, self.executor_config(executor.config)),
+                 (builder.config, self.builder_config(builder.config))]
+        return [f"{f}={getattr(have, f)!r} (the loop's settings say {getattr(want, f)!r})"
+                for have, want in pairs for f in have.__dataclass_fields__
+                if getattr(have, f) != getattr(want, f)]
+
+
 class SwitchingLoop:
     """Owns the continual planner; asks the executor to run each non-assumptive step."""
 
@@ -81,6 +104,11 @@ class SwitchingLoop:
                  config: LoopConfig | None = None, should_stop: Any = None):
         self.builder, self.executor, self.trace = builder, executor, trace
         self.config = config or LoopConfig()
+        differ = self.config.configured(executor, builder)
+        if differ:
+            raise EpisodeError("the executor and state builder must be built with the loop's "
+                               "settings (`LoopConfig.executor_config`, `builder_config`): "
+                               + "; ".join(differ))
         self.should_stop = should_stop or (lambda: False)
         self.result = SearchResult(Outcome.GAVE_UP, "")
         self.planner: ContinualPlanner | None = None
@@ -91,14 +119,6 @@ class SwitchingLoop:
         self.failed: set[tuple[str, int]] = set()
 
     def run(self) -> SearchResult:
-        self.executor.watching = self.config.watch
-        if self.config.glimpses and self.executor.glimpses is None:
-            self.executor.enable_glimpses()
-        if self.config.look_headings != self.executor.config.look_headings:
-            self.executor.config = replace(self.executor.config,
-                                           look_headings=self.config.look_headings)
-        if self.config.seconds != self.builder.config.seconds:
-            self.builder.config = replace(self.builder.config, seconds=self.config.seconds)
         self.executor.look_around()
         state = self.builder.build()
         self.planner = ContinualPlanner(state.skeleton(), self._options(),
@@ -312,7 +332,7 @@ class SwitchingLoop:
         beliefs (an elongated office reads as a corridor). Visit the places of the nearest
         room whose category is uncertain, once per room, so it is classified again; only
         rooms that could still hold the target under some category (`could_hold`)."""
-        certain = self.builder.config.certain_category
+        certain = self.builder.certain_category
         room = self.executor.uncertain_room(certain, self.visited_rooms,
                                             self.builder.could_hold)
         if room is None:
@@ -330,11 +350,9 @@ class SwitchingLoop:
         doorway see the corridor). Once per episode, rooms believed up to `doubt_category`
         become uncertain again, so the planner may assume another category for them (and
         `_visit_uncertain_room` may re-classify them)."""
-        cfg = self.builder.config
         doubt = self.config.doubt_category
-        if cfg.certain_category >= doubt:
+        if not self.builder.doubt_categories(doubt):
             return False
-        self.builder.config = replace(cfg, certain_category=doubt)
         self.trace.emit("belief", doubt_categories=doubt, reason="no plan above the threshold")
         return True
 

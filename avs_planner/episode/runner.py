@@ -224,16 +224,19 @@ class Episode:
             self.out.mkdir(parents=True, exist_ok=True)
         self.trace = Trace(lambda: self.robot.clock, self.out / "trace.jsonl" if self.out
                            else None, emit)
-        self.builder = StateBuilder(self.mind, SearchTask(spec.target, spec.category))
+        # the strategy's settings, built once: what its executor and state builder run with
+        executor_config, builder_config = self._strategy().configs(spec.strategy_options)
+        self.builder = StateBuilder(self.mind, SearchTask(spec.target, spec.category),
+                                    builder_config)
         body = self.robot.body()
         self.camera = CameraModel(self.robot.camera_height, body.hfov, body.detect_range,
                                   vfov=body.vfov)
         # the mind's side gets the robot through the fence: its sensors and motions, never
         # the world behind them (`robot_api.fence`); the harness keeps `self.robot`
         sensed = fence(self.robot)
-        self.executor = Executor(sensed, self.mind, self.builder, self.camera,
-                                 self._emit, ExecutorConfig(dt_policy=spec.dt_policy),
-                                 seed=spec.seed)
+        self.executor = Executor(sensed, self.mind, self.builder, self.camera, self._emit,
+                                 replace(executor_config or ExecutorConfig(),
+                                         dt_policy=spec.dt_policy), seed=spec.seed)
         self.trace.subscribe(MapSnapshots(self.executor, self._emit).observe)
         from avs_planner.strategies import SearchContext
 

@@ -114,6 +114,7 @@ class StateBuilder:
         self.mind = mind
         self.task = task
         self.config = config or BuilderConfig()
+        self._doubted: float | None = None  # the bar `doubt_categories` raised it to
         knowledge = mind.cmap.knowledge
         if task.target not in knowledge.labels:
             raise EpisodeError(f"unknown target label {task.target!r}; the knowledge knows "
@@ -203,13 +204,27 @@ class StateBuilder:
         return AvsState(f"episode-{self.revision}", names, frozenset(atoms), values,
                         ("reported", self.task.target), positions, pm.current_place)
 
+    @property
+    def certain_category(self) -> float:
+        """A room's category believed at least this much is taken as known: the config's
+        bar until the loop doubts the categories (`doubt_categories`)."""
+        return self.config.certain_category if self._doubted is None else self._doubted
+
+    def doubt_categories(self, threshold: float) -> bool:
+        """From now on a room's category counts as known only when believed at least
+        `threshold` (raising the bar; False when it is already that high)."""
+        if self.certain_category >= threshold:
+            return False
+        self._doubted = threshold
+        return True
+
     def _categories(self, rooms: list[str]) -> list[str]:
         """The likely categories plus the certain category of any known room."""
         out = list(self.categories)
         for rid in rooms:
             belief = self.mind.cmap.room_category(rid)
             best = max(belief, key=belief.get)
-            if belief[best] >= self.config.certain_category and best not in out:
+            if belief[best] >= self.certain_category and best not in out:
                 out.append(best)
         self._current_categories = out
         return out
@@ -304,7 +319,7 @@ class StateBuilder:
         for rid in rooms:
             belief = cmap.room_category(rid)
             best = max(belief, key=belief.get)
-            if belief[best] >= self.config.certain_category:
+            if belief[best] >= self.certain_category:
                 atoms |= {("has-category", rid, best), ("defined-category", rid)}
             for c in self._current_categories:
                 values[("p-room-category", rid, c)] = self._prune(belief[c])

@@ -36,9 +36,15 @@ class Strategy:
     # frontier exploration, before the clock starts (e.g. FLAP's survey with depth frames)
     check: str | None = None  # "module:function" checking the converted options further
     # (raises an AvsError naming the option)
+    configure: str | None = None  # "module:function": checked options -> (ExecutorConfig,
+    # BuilderConfig) the episode builds its executor and state builder with (None: defaults)
 
     def load(self) -> Run:
         return _load(self.entry)
+
+    def configs(self, options: Mapping[str, Any]) -> tuple[Any, Any]:
+        """(ExecutorConfig, BuilderConfig) for checked `options` (None, None: the defaults)."""
+        return _load(self.configure)(options) if self.configure else (None, None)
 
     def load_prepare(self) -> Callable[[SearchContext], None] | None:
         return _load(self.prepare) if self.prepare else None
@@ -122,7 +128,8 @@ STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
     Strategy("switching", "the switching planner: continual PDDL planner with assumptions + "
              "POMDP view-cone search (Goebelbecker et al.)",
              "avs_planner.strategies.switching:run", _SWITCHING_OPTIONS,
-             check="avs_planner.strategies.switching:check_options"),
+             check="avs_planner.strategies.switching:check_options",
+             configure="avs_planner.strategies.switching:configure"),
     Strategy("exhaustive", "baseline: frontier exploration, nearest placeholder first, "
              "looking all round at every stop; no priors",
              "avs_planner.strategies.baselines:run_exhaustive",

@@ -12,17 +12,21 @@ weighting in a comparison (the extra labels change the detector's noise draws)."
 
 from __future__ import annotations
 
-from dataclasses import replace
+from collections.abc import Mapping
+from typing import Any
 
 from avs_planner.episode.errors import EpisodeError
+from avs_planner.episode.executor import ExecutorConfig
 from avs_planner.episode.loop import LoopConfig, SwitchingLoop
 from avs_planner.episode.outcome import SearchResult
 from avs_planner.episode.qsr_cones import install as install_qsr_cones
+from avs_planner.episode.state_builder import BuilderConfig
 from avs_planner.strategies.context import SearchContext
 from avs_planner.strategies.flap_views import VIEWS
 from avs_planner.strategies.flap_views import make as make_views
 
 QSR_CONES = ("on", "off", "observe")
+OWN_OPTIONS = ("views", "qsr_cones")  # the strategy's own options; the rest are the loop's
 
 
 def run(ctx: SearchContext) -> SearchResult:
@@ -35,13 +39,24 @@ def run(ctx: SearchContext) -> SearchResult:
         qsr = install_qsr_cones(ctx.executor, ctx.qsr, ctx.target)
         if qsr is not None:
             qsr.weighting = mode == "on"
-    config = LoopConfig(time_budget_s=ctx.time_budget_s, wall_budget_s=ctx.wall_budget_s,
-                        dump_dir=ctx.dump_dir, **options)
-    # one goal reward R per episode: the CP's objective and the DT's terminal penalties
-    ctx.executor.config = replace(ctx.executor.config, miss_penalty=config.reward)
+    config = loop_config(options, time_budget_s=ctx.time_budget_s,
+                         wall_budget_s=ctx.wall_budget_s, dump_dir=ctx.dump_dir)
     loop = SwitchingLoop(ctx.builder, ctx.executor, ctx.trace, config, ctx.should_stop)
     loop.start_clock = ctx.start_clock
     return loop.run()
+
+
+def loop_config(options: Mapping[str, Any], **episode: Any) -> LoopConfig:
+    """The episode's one settings object: the loop's options (without the strategy's own
+    `views` and `qsr_cones`) and what the episode spec gives (budgets, dump directory)."""
+    return LoopConfig(**{k: v for k, v in options.items() if k not in OWN_OPTIONS}, **episode)
+
+
+def configure(options: Mapping[str, Any]) -> tuple[ExecutorConfig, BuilderConfig]:
+    """The executor's and state builder's settings, built once from the episode's options
+    before either exists (`Strategy.configure`): one R, one look around, one watch."""
+    config = loop_config(options)
+    return config.executor_config(), config.builder_config()
 
 
 def check_options(options: dict) -> None:

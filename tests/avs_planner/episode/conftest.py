@@ -37,3 +37,22 @@ def corridor():
     robot, mind, builder, executor = _look_around_the_corridor()
     yield mind, builder, executor
     robot.world.close()
+
+
+@pytest.fixture()
+def switching_loop():
+    """Make a `SwitchingLoop` over an executor and state builder made without its settings:
+    gives them the settings the loop decides first, as the episode builds them
+    (`LoopConfig.executor_config`, `builder_config`)."""
+    from avs_planner.episode.loop import LoopConfig, SwitchingLoop
+
+    def make(builder, executor, trace, config=None, should_stop=None):  # noqa: ANN001, ANN202
+        config = config or LoopConfig()
+        executor.config = config.executor_config(executor.config)
+        executor.watching = executor.config.watch
+        if executor.config.glimpses and executor.glimpses is None:
+            executor.enable_glimpses()
+        builder.config = config.builder_config(builder.config)
+        return SwitchingLoop(builder, executor, trace, config, should_stop)
+
+    return make

@@ -136,19 +136,21 @@ def _run_recording(loop: SwitchingLoop) -> tuple:
     return loop.run(), executed
 
 
-def test_no_failed_action_is_repeated_from_an_unchanged_state(corridor) -> None:  # noqa: ANN001
+def test_no_failed_action_is_repeated_from_an_unchanged_state(
+        corridor, switching_loop) -> None:  # noqa: ANN001
     """Every move is refused (with no contact point to learn from): the episode must end
     with a reason, never re-running a failed action from the same belief state."""
     mind, builder, executor = corridor
     executor.robot.move_along = lambda path: False
-    loop = SwitchingLoop(builder, executor, Trace(lambda: executor.robot.clock, None, None))
+    loop = switching_loop(builder, executor, Trace(lambda: executor.robot.clock, None, None))
     result, executed = _run_recording(loop)
     assert result.outcome.value == "gave_up", result.reason
     assert executed and len(executed) == len(set(executed))
     assert mind.failed_moves
 
 
-def test_a_move_that_takes_no_time_and_changes_nothing_is_not_planned_again(corridor) -> None:  # noqa: ANN001
+def test_a_move_that_takes_no_time_and_changes_nothing_is_not_planned_again(
+        corridor, switching_loop) -> None:  # noqa: ANN001
     """The base "arrives" without moving (the drive ends at once): the step took no time and
     the belief state is unchanged, so the same move from the same state would do nothing
     again. It is withheld, like a failed move, instead of replanned at the same instant."""
@@ -158,7 +160,7 @@ def test_a_move_that_takes_no_time_and_changes_nothing_is_not_planned_again(corr
     events: list[dict] = []
     trace = Trace(lambda: executor.robot.clock, None, None)
     trace.subscribe(events.append)
-    result, executed = _run_recording(SwitchingLoop(builder, executor, trace))
+    result, executed = _run_recording(switching_loop(builder, executor, trace))
     assert result.outcome.value == "gave_up", result.reason
     assert executed and len(executed) == len(set(executed))
     no_effect = [e["no_effect"] for e in events if e.get("no_effect")]
@@ -201,9 +203,10 @@ def test_a_failed_move_is_withheld_until_something_new_is_learned(corridor) -> N
     assert lengths is None
 
 
-def test_blocked_spots_are_retried_when_nothing_else_is_left_at_most_twice(corridor) -> None:  # noqa: ANN001
+def test_blocked_spots_are_retried_when_nothing_else_is_left_at_most_twice(
+        corridor, switching_loop) -> None:  # noqa: ANN001
     mind, builder, executor = corridor
-    loop = SwitchingLoop(builder, executor, Trace(lambda: executor.robot.clock, None, None))
+    loop = switching_loop(builder, executor, Trace(lambda: executor.robot.clock, None, None))
     here = executor.robot.pose[:2]
     for k in range(3):
         mind.block((here[0] + 2.0, here[1]), time=float(k))

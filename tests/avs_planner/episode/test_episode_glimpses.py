@@ -10,7 +10,7 @@ import pytest
 
 from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep
 from avs_planner.episode.glimpses import Glimpses
-from avs_planner.episode.loop import LoopConfig, SwitchingLoop, _explores, _search_rejected
+from avs_planner.episode.loop import LoopConfig, _explores, _search_rejected
 from avs_planner.episode.outcome import StepOutcome, StepStatus
 from avs_planner.episode.trace import Trace
 from conceptual_map.conceptual import ConceptualError, RelatedSpace
@@ -131,12 +131,12 @@ LOCAL = [PlanStep("move", ("place1", "place2"), 5.0, 1.0),
 EXPLORING = [PlanStep("move", ("place1", "placeholder3"), 5.0, 1.0), *LOCAL[1:]]
 
 
-def test_a_plan_worth_less_than_it_costs_is_not_executed(corridor) -> None:
+def test_a_plan_worth_less_than_it_costs_is_not_executed(corridor, switching_loop) -> None:
     _, builder, executor = corridor
     events = []
     trace = Trace(lambda: executor.robot.clock)
     trace.emit = lambda type_, **fields: events.append((type_, fields))  # type: ignore
-    loop = SwitchingLoop(builder, executor, trace, LoopConfig(reward=500.0))
+    loop = switching_loop(builder, executor, trace, LoopConfig(reward=500.0))
     judged = loop._worth_it(_result(LOCAL, p=0.2, cost=125.0))  # 500 x 0.2 = 100 < 125
     assert judged.status is PlanStatus.NO_PLAN_ABOVE_THRESHOLD and not judged.plan
     assert "worth" in loop._no_plan(judged) and "p=0.2" in loop._no_plan(judged)
@@ -144,7 +144,7 @@ def test_a_plan_worth_less_than_it_costs_is_not_executed(corridor) -> None:
     assert loop._worth_it(_result(LOCAL, p=0.3, cost=125.0)).solved  # 150 > 125
     # a plan that explores is kept: exploring shows more than its one chain of assumptions
     assert loop._worth_it(_result(EXPLORING, p=0.05, cost=125.0)).solved
-    off = SwitchingLoop(builder, executor, trace, LoopConfig(worth_test=False))
+    off = switching_loop(builder, executor, trace, LoopConfig(worth_test=False))
     assert off._worth_it(_result(LOCAL, p=0.2, cost=125.0)).solved
 
 

@@ -16,7 +16,7 @@ from avs_planner.dt.domain import ActionKind, DTAction
 from avs_planner.dt.session import DTResult, DTStatus, DTStep
 from avs_planner.episode.driving import TARGET_SEEN, _split_leg
 from avs_planner.episode.dt_search import ViewConeSearch
-from avs_planner.episode.loop import LoopConfig, SwitchingLoop
+from avs_planner.episode.loop import LoopConfig
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import StepOutcome, StepStatus
 from avs_planner.episode.robot import Seen
@@ -87,7 +87,8 @@ def test_uncertain_rooms_are_found_nearest_first_and_skipped_once_visited(corrid
     assert executor.visit_room(room, max_places=2).status is StepStatus.DONE
 
 
-def test_categories_believed_certain_are_doubted_once_before_giving_up(corridor) -> None:
+def test_categories_believed_certain_are_doubted_once_before_giving_up(
+        corridor, switching_loop) -> None:
     mind, builder, executor = corridor
     room, _ = _here(mind)
     belief = mind.cmap.room_category(room)
@@ -99,9 +100,9 @@ def test_categories_believed_certain_are_doubted_once_before_giving_up(corridor)
     events = []
     trace = Trace(lambda: executor.robot.clock)
     trace.emit = lambda type_, **fields: events.append((type_, fields))  # type: ignore[method-assign]
-    loop = SwitchingLoop(builder, executor, trace, LoopConfig(doubt_category=1.0))
+    loop = switching_loop(builder, executor, trace, LoopConfig(doubt_category=1.0))
     assert loop._doubt_categories()
-    assert builder.config.certain_category == 1.0
+    assert builder.certain_category == 1.0
     state = builder.build()
     assert ("has-category", room, best) not in state.atoms  # the planner may assume again
     assert any(k[:2] == ("p-room-category", room) for k in state.values)
@@ -109,14 +110,15 @@ def test_categories_believed_certain_are_doubted_once_before_giving_up(corridor)
     assert not loop._doubt_categories()  # once per episode
 
 
-def test_a_search_that_hits_its_node_limit_is_retried_in_the_anytime_mode(corridor) -> None:
+def test_a_search_that_hits_its_node_limit_is_retried_in_the_anytime_mode(
+        corridor, switching_loop) -> None:
     """The first CP call stops at its (tiny) expansion limit; the fallback runs the anytime
     schedule (greedy FF first, then weighted A* restarts) and returns a plan."""
     from avs_planner.cp.continual import ContinualPlanner
 
     _, builder, executor = corridor
     trace = Trace(lambda: executor.robot.clock)
-    loop = SwitchingLoop(builder, executor, trace, LoopConfig(cp_node_limit=1))
+    loop = switching_loop(builder, executor, trace, LoopConfig(cp_node_limit=1))
     state = builder.build()
     loop.planner = ContinualPlanner(state.skeleton(), loop._options(),
                                     min_success=loop.config.min_success)
@@ -260,14 +262,14 @@ def test_a_confirmation_one_short_with_agreement_looks_again(corridor, monkeypat
     assert len(frames) - len(queue) == taken
 
 
-def test_the_success_threshold_bounds_the_search_not_its_result(corridor) -> None:
+def test_the_success_threshold_bounds_the_search_not_its_result(corridor, switching_loop) -> None:
     """The CP is asked for the best plan among those with p >= min_success: filtered after the
     search, a cheap hopeless best plan (p 0.008) hid a worthwhile one (p 0.07) and the robot
     gave up 27 s in (generated office 3, stapler)."""
     from avs_planner.cp.continual import ContinualPlanner
 
     _, builder, executor = corridor
-    loop = SwitchingLoop(builder, executor, Trace(lambda: executor.robot.clock),
+    loop = switching_loop(builder, executor, Trace(lambda: executor.robot.clock),
                          LoopConfig(min_success=0.2))
     assert loop._options().min_success == 0.2
     state = builder.build()
