@@ -16,6 +16,9 @@ unseen floor it has:
   more true rooms (a door not recognised); a *split* is a true room substantially overlapped
   by two or more robot rooms (a door seen where there is none). Substantially: at least
   `SUBSTANTIAL_M2` and `SUBSTANTIAL_SHARE` of the smaller of the two.
+  A search that ends early leaves rooms unseen, and those cannot be matched: the score
+  also counts the true rooms matched among those the robot entered (`entered_matched` of
+  `entered_rooms`), the segmentation of what it did see.
 - **categories**: over the true rooms the robot entered (its path passed at least
   `ENTER_DEPTH` inside), the most probable category the robot believes for the robot room
   covering most of the true room, against the world file's category, weighted by the true
@@ -121,7 +124,9 @@ def score_map(truth: Sequence[TrueRoom], robot: RobotMap,
         "rooms_true": len(truth), "rooms_robot": len(rids), "rooms_matched": len(matched),
         "merges": int(np.count_nonzero(substantial.sum(axis=0) >= 2)),
         "splits": int(np.count_nonzero(substantial.sum(axis=1) >= 2)),
-        "entered_rooms": int(sum(entered)), "entered_area_m2": round(entered_area, 2),
+        "entered_rooms": int(sum(entered)),
+        "entered_matched": sum(1 for i in matched if entered[i]),
+        "entered_area_m2": round(entered_area, 2),
         "category_accuracy": round(right / entered_area, 4) if entered_area > 0 else None,
         "rooms": rooms,
     }

@@ -452,17 +452,20 @@ def _map_table(rows: list[Row], strategies: list[str], stamp: str) -> list[str]:
     lines = _stamped(
         "Map quality", stamp,
         "Over completed runs whose summary scores the room map: rooms matched, summed over "
-        "runs, of the true rooms, summed; merges and splits (a mapped room covering several "
-        "true ones, a true room mapped as several), summed; room-category accuracy weighted "
-        "by the area the robot entered (sum of accuracy x entered area / sum of entered "
+        "runs, of the true rooms, summed (a search that ends early never sees some rooms), "
+        "and of the true rooms the robot entered; merges and splits (a mapped room covering "
+        "several true ones, a true room mapped as several), summed; room-category accuracy "
+        "weighted by the area the robot entered (sum of accuracy x entered area / sum of entered "
         "area); the entered area, median per run.", "",
-        "| slice | strategy | runs scored | rooms matched | merges | splits | category "
-        "accuracy (area-weighted) | entered m² per run |", "|---|---|---|---|---|---|---|---|")
+        "| slice | strategy | runs scored | rooms matched | of rooms entered | merges | splits "
+        "| category accuracy (area-weighted) | entered m² per run |",
+        "|---|---|---|---|---|---|---|---|---|")
     for name, part in _slices(scored):
         for strategy in strategies:
             mine = [r for r in part if r["strategy"] == strategy]
             if mine:
                 lines.append(f"| {name} | {strategy} | {len(mine)} | {_matched(mine)} | "
+                             f"{_matched(mine, 'map_entered_rooms', 'map_entered_matched')} | "
                              f"{_total(mine, 'map_merges')} | {_total(mine, 'map_splits')} | "
                              f"{_accuracy(mine)} | "
                              f"{_num(median(_values(mine, 'map_entered_area_m2')), 1)} |")
@@ -473,13 +476,14 @@ def _values(rows: list[Row], column: str) -> list[float]:
     return [r[column] for r in rows if r.get(column) is not None]
 
 
-def _matched(rows: list[Row]) -> str:
-    both = [r for r in rows if r.get("map_rooms_true") is not None
-            and r.get("map_rooms_matched") is not None]
-    true = sum(r["map_rooms_true"] for r in both)
+def _matched(rows: list[Row], of: str = "map_rooms_true",
+             matched_column: str = "map_rooms_matched") -> str:
+    """Rooms matched (`matched_column`), summed over runs, of `of`, summed."""
+    both = [r for r in rows if r.get(of) is not None and r.get(matched_column) is not None]
+    true = sum(r[of] for r in both)
     if not true:
         return "--"
-    matched = sum(r["map_rooms_matched"] for r in both)
+    matched = sum(r[matched_column] for r in both)
     return f"{matched:g}/{true:g} = {100 * matched / true:.0f}%"
 
 

@@ -28,7 +28,7 @@ RESULTS_FILE = "results.csv"
 WALL_CUT = "wall_cut"
 WALL_CUT_REASON = "wall time budget"  # how the episode loop and strategies word that stop
 MAP_SCORE_KEYS = ("rooms_true", "rooms_matched", "merges", "splits", "category_accuracy",
-                  "entered_area_m2")
+                  "entered_area_m2", "entered_rooms", "entered_matched")
 KEY_COLUMNS = ["run_id", "scenario", "world", "group", "target", "expected", "strategy",
                "robot", "seed"]
 VALUE_COLUMNS = ["status", "error", "outcome", "reason", "correct", "success",

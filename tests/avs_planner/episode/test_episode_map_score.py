@@ -116,6 +116,8 @@ def test_category_accuracy_weights_rooms_by_area_and_counts_only_rooms_entered()
                        "room4": ["office2"]}, beliefs)
     score = score_map(OFFICE, robot, PATH)  # the kitchen was seen, not entered
     assert score["entered_rooms"] == 3 and score["entered_area_m2"] == pytest.approx(68.0)
+    # every room matched; of the rooms entered, the three entered
+    assert (score["rooms_matched"], score["entered_matched"]) == (4, 3)
     # office1 (30 m^2) wrong; the corridor (18) and office2 (20) right
     assert score["category_accuracy"] == pytest.approx(38 / 68, abs=1e-4)
     # wrong in the small corridor instead: the accuracy is higher

@@ -264,17 +264,19 @@ def test_map_quality_and_dt_verdicts_when_summaries_carry_them(tmp_path):
     rows = [_row("switching", 0, outcome="found", success="true", sim_time_s=90,
                  map_rooms_true=6, map_rooms_matched=5, map_merges=1, map_splits=0,
                  map_category_accuracy=0.75, map_entered_area_m2=40, dt_confirmed=1,
+                 map_entered_rooms=4, map_entered_matched=4,
                  dt_rejected=2),
             _row("switching", 1, outcome="found", success="true", sim_time_s=95, dt_calls=0,
                  map_rooms_true=6, map_rooms_matched=4, map_merges=0, map_splits=1,
                  map_category_accuracy=0.5, map_entered_area_m2=20, dt_confirmed=0,
+                 map_entered_rooms=2, map_entered_matched=1,
                  dt_rejected=0),
             _row("switching", 2, outcome="found", success="true", sim_time_s=99),  # old
             _row("exhaustive", 0, outcome="found", success="true", sim_time_s=120,
                  dt_calls=0)]
     _write(tmp_path / "results.csv", rows)
     report = build_report(tmp_path, tmp_path / "report.md").read_text()
-    assert ("| all | switching | 2 | 9/12 = 75% | 1 | 1 | 67% (over 60 m²) | 30.0 |"
+    assert ("| all | switching | 2 | 9/12 = 75% | 5/6 = 83% | 1 | 1 | 67% (over 60 m²) | 30.0 |"
             in report)
     assert "| all | exhaustive |" not in report.split("## Map quality")[1].split("##")[0]
     assert "| switching | g1 | 3 | 2/3 (67%) | 4 | 2.0 [2] | 1 | 2 |" in report
