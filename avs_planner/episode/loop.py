@@ -76,7 +76,6 @@ class LoopConfig:
     # (`episode/stopping.py`), not only when no single plan reaches the threshold
     stop_rule: bool = True
 
-
     def executor_config(self, base: ExecutorConfig | None = None) -> ExecutorConfig:
         """The executor's settings these loop settings decide (R, the watch, glimpses, the
         look around), over `base`: the episode builds its executor with them once."""

@@ -48,3 +48,17 @@ def test_a_loop_refuses_an_executor_built_with_other_settings(corridor) -> None:
     executor.config = LoopConfig().executor_config(executor.config)
     with pytest.raises(EpisodeError, match=r"miss_penalty=500.0 \(the loop's settings say 800"):
         SwitchingLoop(builder, executor, Trace(lambda: 0.0), LoopConfig(reward=800))
+
+
+def test_every_switching_option_is_in_the_settings_table() -> None:
+    """docs/strategies.md documents the switching strategy's settings in one table."""
+    import re
+    from pathlib import Path
+
+    from avs_planner.strategies import get_strategy
+
+    text = Path(__file__).resolve().parents[3].joinpath("docs", "strategies.md").read_text()
+    table = text.split("### The switching strategy's settings", 1)[1].split("\n\n", 3)[2]
+    named = set(re.findall(r"`(\w+)`", "\n".join(line.split("|")[1] for line in
+                                                    table.splitlines() if line.startswith("| `"))))
+    assert named == set(get_strategy("switching").options)
