@@ -5,10 +5,16 @@ occupied cell. The shortest chord is the opening's width across; it is a door wh
 narrower than ~1.5 m (double doors included), widens again a wall's thickness before and after
 (a narrow corridor or a gap beside a long piece of furniture stays narrow for longer), and its
 jambs continue as walls along the chord's line.
+
+A hypothesis may still be the gap between pieces of furniture, or between furniture and a
+wall: the laser sees furniture as an outline round unseen (or occupied) inside, and an edge of
+it in line with the chord passes for a wall. `between_walls` tells them apart once both sides
+are seen: beside a door the jambs are thin walls with free floor on both of their faces.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -129,6 +135,39 @@ def _is_short(grid: OccupancyGrid, opening: Opening, config: PlaceMapConfig) -> 
     )
     plus, minus = chord_extents(grid, beside, np.array([opening.angle]), config.probe_range)
     return bool(np.all(plus[:, 0] + minus[:, 0] >= opening.width + _WIDENING))
+
+
+def between_walls(grid: OccupancyGrid, ends: tuple, depth: float,
+                  sides: Iterable[int] = (1, -1), state: np.ndarray | None = None) -> bool:
+    """Whether the structure beyond both ends of the door chord `ends` (a to b) is a thin
+    wall as seen from `sides` (+1: the side of the normal (-dy, dx) of b - a; -1: the other):
+    at most points 0.1-0.3 m beyond each jamb, along the chord's line, free cells lie within
+    `depth` (a door's `door_max_depth`: a wall is thinner) on each of those sides of the line.
+    The edge of a table, shelf or chair in line with the chord has its unseen (or occupied)
+    inside on one side. Only the sides the robot has been on are asked: a wall's far face
+    near the jambs is hidden from the near side, the door seen but not passed through."""
+    states = grid.state_grid() if state is None else state
+    a, b = np.asarray(ends[0], dtype=float), np.asarray(ends[1], dtype=float)
+    length = float(np.linalg.norm(b - a))
+    if length <= 0.0:
+        return False
+    axis = (b - a) / length
+    normal = np.array([-axis[1], axis[0]])
+    beyond = np.array([0.1, 0.2, 0.3])
+    across = np.arange(0.5 * grid.resolution, depth + 1e-9, 0.5 * grid.resolution)
+    for end, sign in ((b, 1.0), (a, -1.0)):
+        base = end[None, :] + sign * beyond[:, None] * axis  # (3, 2) points on the wall line
+        thin = np.ones(len(beyond), dtype=bool)
+        for side in sorted({float(np.sign(v)) for v in sides} - {0.0}):
+            pts = base[:, None, :] + side * across[None, :, None] * normal
+            cells = grid.to_cell(pts.reshape(-1, 2))
+            inside = grid.inside(cells)
+            free = np.zeros(len(cells), dtype=bool)
+            free[inside] = states[cells[inside, 0], cells[inside, 1]] == CellState.FREE
+            thin &= free.reshape(len(beyond), len(across)).any(axis=1)
+        if thin.mean() < 0.5:
+            return False
+    return True
 
 
 def crossings(points: np.ndarray, ends: tuple[np.ndarray, np.ndarray]) -> int:

@@ -15,7 +15,7 @@ import numpy as np
 from conceptual_map.errors import MapError
 from conceptual_map.metric.grid2d import OccupancyGrid
 from conceptual_map.places.config import PlaceMapConfig
-from conceptual_map.places.doors import Opening, crossings, openings_along
+from conceptual_map.places.doors import Opening, between_walls, crossings, openings_along
 from conceptual_map.places.frontiers import FrontierRegion, frontier_regions
 from conceptual_map.places.model import (
     Change,
@@ -50,6 +50,11 @@ class PlaceMap:
         self._path: list[np.ndarray] = []
         self._counters: dict[str, int] = {}
         self._door_revision = 0  # edges remember which revision of the doors they were checked at
+        # the doors that part rooms: those whose jambs are thin walls as seen from the sides
+        # the path went on (`doors.between_walls`), checked again whenever the grid changed;
+        # the others stay door hypotheses (e.g. the gap between pieces of furniture)
+        self._walled: frozenset[str] = frozenset()
+        self._walls_key: tuple | None = None
         self._extents: tuple | None = None  # (key, owner, room ids, free regions): room_extents
 
     # ---- public API -------------------------------------------------------------------------
@@ -71,6 +76,7 @@ class PlaceMap:
         points = self._trajectory(poses)
         events += self._grow_places(grid, points, time)
         events += self._find_doors(grid, points, time)
+        self._check_walls(grid)
         self._mark_door_edges()
         events += self._refresh_placeholders(grid, poses[-1][:2], time)
         events += self._refresh_rooms(grid, time)
@@ -115,10 +121,11 @@ class PlaceMap:
     def _room_extents(self, grid: OccupancyGrid) -> tuple[np.ndarray, list[str], np.ndarray]:
         """`room_extents` and the free regions they are made of, cached until the grid, the
         doors or the rooms change."""
+        self._check_walls(grid)
         key = (id(grid), grid.version, self._door_revision,
                tuple(sorted((rid, room.places) for rid, room in self.rooms.items())))
         if self._extents is None or self._extents[0] != key:
-            labels = free_regions(grid, [d.ends for d in self.doors.values()])
+            labels = free_regions(grid, self._room_door_ends())
             members = {rid: [self.places[p].position for p in sorted(room.places)
                              if p in self.places] for rid, room in self.rooms.items()}
             owner, ids = room_extents(grid, labels, members)
@@ -299,8 +306,27 @@ class PlaceMap:
             confirmed=len(self._sides[door_id]) == 2,
         )
 
+    def _check_walls(self, grid: OccupancyGrid) -> None:
+        """Which doors part rooms (`_walled`), again if the grid or the doors changed."""
+        sides = {k: tuple(sorted(self._sides.get(k, ()))) for k in self.doors}
+        key = (id(grid), grid.version,
+               tuple(sorted((k, d.ends, sides[k]) for k, d in self.doors.items())))
+        if key == self._walls_key:
+            return
+        self._walls_key = key
+        state = grid.state_grid()
+        walled = frozenset(k for k, d in self.doors.items() if between_walls(
+            grid, d.ends, self.config.door_max_depth, sides[k], state))
+        if walled != self._walled:
+            self._walled = walled
+            self._door_revision += 1
+
+    def _room_door_ends(self) -> list:
+        return [self.doors[k].ends for k in sorted(self._walled) if k in self.doors]
+
     def _mark_door_edges(self) -> None:
-        """An edge passes a door if its straight line does, or (if driven) the path driven does."""
+        """An edge passes a door if its straight line does, or (if driven) the path driven does.
+        Only doors that part rooms count (`_check_walls`)."""
         for u, v, data in self.graph.edges(data=True):
             if u not in self.places or v not in self.places:
                 continue
@@ -313,7 +339,7 @@ class PlaceMap:
             crossed = (  # an even number of crossings comes back to the same side
                 d.id
                 for d in self.doors.values()
-                if any(crossings(ln, d.ends) % 2 == 1 for ln in lines)
+                if d.id in self._walled and any(crossings(ln, d.ends) % 2 == 1 for ln in lines)
             )
             data["door"] = next(crossed, None)
             data["doors_checked"] = self._door_revision
@@ -417,9 +443,11 @@ class PlaceMap:
     # ---- rooms ------------------------------------------------------------------------------
 
     def _refresh_rooms(self, grid: OccupancyGrid, time: float) -> list[MapEvent]:
+        self._check_walls(grid)
+        self._mark_door_edges()
         groups = place_groups(self.graph)
         matched = match_by_overlap({k: set(r.places) for k, r in self.rooms.items()}, groups)
-        labels = free_regions(grid, [d.ends for d in self.doors.values()])
+        labels = free_regions(grid, self._room_door_ends())
         events, kept = [], set()
         for i, members in enumerate(groups):
             rid = matched.get(i) or self._new_id("room")
