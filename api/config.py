@@ -11,7 +11,7 @@ from pydantic_settings import BaseSettings, SettingsConfigDict
 
 DEFAULT_EPISODE_RUNNER = "avs_planner.jobs:run_episode"
 DEFAULT_PLAN_RUNNER = "avs_planner.jobs:plan"
-DEFAULT_TASK_CHECKER = "avs_planner.episode.validate:check_task"
+DEFAULT_TASK_CHECKER = "avs_planner.harness.validate:check_task"
 
 
 class Settings(BaseSettings):

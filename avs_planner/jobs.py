@@ -2,7 +2,7 @@
 
 The service runs these in worker processes, so inputs and outputs are JSON-able dicts and the
 heavy modules are imported on first use. A part that cannot be imported (e.g. the episode
-runner, `avs_planner.episode`, in a trimmed install) raises `JobUnavailableError`, never a fake
+runner, `avs_planner.harness`, in a trimmed install) raises `JobUnavailableError`, never a fake
 result.
 """
 
@@ -97,9 +97,9 @@ def _invalid(file: str, line: int, column: int, message: str) -> dict[str, Any]:
 
 
 def episode_runner_available() -> bool:
-    """Whether `avs_planner.episode.run_episode` can be imported (imports it to find out)."""
+    """Whether `avs_planner.harness.run_episode` can be imported (imports it to find out)."""
     try:
-        episode = importlib.import_module("avs_planner.episode")
+        episode = importlib.import_module("avs_planner.harness")
     except ImportError:
         return False
     return callable(getattr(episode, "run_episode", None))
@@ -114,9 +114,9 @@ def run_episode(spec: Mapping[str, Any], emit: Emit, should_stop: ShouldStop) ->
     `output_dir`, where the runner writes `trace.jsonl`, `summary.json` and `trajectory.png`
     (the service serves that picture). Events are the trace's dicts (`t`, `wall`, `type`, ...).
     """
-    episode = _require("avs_planner.episode", "the episode runner (switching loop)")
+    episode = _require("avs_planner.harness", "the episode runner (switching loop)")
     runner = getattr(episode, "run_episode", None)
     if runner is None:
-        raise JobUnavailableError("the episode runner (avs_planner.episode.run_episode) not "
+        raise JobUnavailableError("the episode runner (avs_planner.harness.run_episode) not "
                                   "available yet")
     return runner(dict(spec), emit, should_stop)

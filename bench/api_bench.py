@@ -2,7 +2,7 @@
 
 Starts `avs serve` on 127.0.0.1 (a free port, a temporary data dir), then measures the same
 request loop in phases of one run: the idle service (the reference), then with two episodes
-running. Episodes come from the real runner (`avs_planner.episode.run_episode`) when it exists;
+running. Episodes come from the real runner (`avs_planner.harness.run_episode`) when it exists;
 otherwise, or with --synthetic, from the synthetic runner below, in two flavours: streaming
 events but barely using the CPU, and keeping both cores busy. The output says which.
 

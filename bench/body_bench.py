@@ -14,9 +14,9 @@ import json
 import sys
 import time
 
-from avs_planner.episode import run_episode
-from avs_planner.episode.scenarios import builtin_scenarios, load_scenario
-from avs_planner.episode.worlds import generated_targets
+from avs_planner.harness import run_episode
+from avs_planner.harness.scenarios import builtin_scenarios, load_scenario
+from avs_planner.harness.worlds import generated_targets
 
 ROBOTS = ("pioneer", "pr2")
 

@@ -20,8 +20,8 @@ import statistics
 import time
 from pathlib import Path
 
-from avs_planner.episode import Episode, EpisodeSpec, run_episode
-from avs_planner.episode.scenarios import builtin_scenarios, load_scenario
+from avs_planner.harness import Episode, EpisodeSpec, run_episode
+from avs_planner.harness.scenarios import builtin_scenarios, load_scenario
 
 
 def reference_search(spec: dict, budget_s: float = 900.0) -> dict:

@@ -38,8 +38,8 @@ import numpy as np
 from matplotlib.path import Path as MplPath
 from scipy import stats
 
-from avs_planner.episode.robot import load_spec
-from avs_planner.episode.runner import run_episode
+from avs_planner.harness.runner import run_episode
+from avs_planner.harness.sim_robot import load_spec
 
 WORLD = "flap_two_rooms"
 TARGET = "stapler"  # the knowledge puts it on shelves and tables; the world has none

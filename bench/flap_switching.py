@@ -20,9 +20,9 @@ import sys
 import time
 from pathlib import Path
 
-from avs_planner.episode import run_episode
-from avs_planner.episode.scenarios import load_scenario
-from avs_planner.episode.worlds import generated_targets
+from avs_planner.harness import run_episode
+from avs_planner.harness.scenarios import load_scenario
+from avs_planner.harness.worlds import generated_targets
 
 VIEWS = ("cones", "flap")
 

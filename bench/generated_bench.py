@@ -22,8 +22,8 @@ import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
-from avs_planner.episode import run_episode
-from avs_planner.episode.worlds import generated_targets
+from avs_planner.harness import run_episode
+from avs_planner.harness.worlds import generated_targets
 
 STRATEGIES = ("switching", "exhaustive", "most-likely-room")
 

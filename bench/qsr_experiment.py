@@ -9,7 +9,7 @@ informed methods tie). Variant A: three cups where the default QSR knowledge say
 are; B: two of them removed; C: the remaining one moved to a non-QSR location. Table II runs the
 three methods (`random`, `supporting-planes`, `qsr`) on A; Table III runs `qsr` on A, B and C.
 Every cell is `--trials` searches for a cup (seeds 0..N-1) through
-`avs_planner.episode.run_episode`, learning switched off so that trials are independent.
+`avs_planner.harness.run_episode`, learning switched off so that trials are independent.
 
 As in the seed, time and poses are means over the successful trials only; "found" counts
 searches that ended with a confirmed cup that is a cup in the world. Time is the search
@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from avs_planner.episode import run_episode
+from avs_planner.harness import run_episode
 
 TABLE_II = {"random": (6, 68.5, 4.8), "supporting-planes": (10, 33.6, 2.3),
             "qsr": (10, 15.6, 1.1)}  # fmt: skip

@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from avs_planner.episode import run_episode
+from avs_planner.harness import run_episode
 
 
 def run(world: str, seed: int, mode: str) -> dict[str, Any]:

@@ -19,8 +19,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from avs_planner.episode import Episode, EpisodeSpec
-from avs_planner.episode.scenarios import load_scenario
+from avs_planner.harness import Episode, EpisodeSpec
+from avs_planner.harness.scenarios import load_scenario
 
 
 def one(scenario: str, seed: int, record: bool, out: Path) -> tuple[float, float, int, str]:

@@ -24,7 +24,7 @@ def read_worlds(settings: SettingsDep) -> WorldsPublic:
 @router.get("/strategies")
 def read_strategies() -> StrategiesPublic:
     """The search strategies a task may name, with their options and defaults."""
-    from avs_planner.episode.validate import strategies
+    from avs_planner.harness.validate import strategies
 
     data = [StrategyPublic.model_validate(s) for s in strategies()]
     return StrategiesPublic(data=data, count=len(data))

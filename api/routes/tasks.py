@@ -320,7 +320,7 @@ def read_explanation(task: TaskDep, settings: SettingsDep) -> dict[str, Any]:
     with its probabilities, and whether and by which observation it was confirmed or refuted),
     the reason for every replan, and for a give-up the room hypotheses tried; `avs explain`
     prints the same as text. Available once the task has ended."""
-    from avs_planner.episode.explain import FILE_NAME, ExplainError, load
+    from avs_planner.reporting.explain import FILE_NAME, ExplainError, load
 
     folder = settings.tasks_dir / task.id
     if not task.state.terminal:

@@ -29,7 +29,7 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from avs_planner.episode.explain import ExplainError, load, render
+    from avs_planner.reporting.explain import ExplainError, load, render
 
     try:
         explanation = load(Path(args.run_dir), rebuild=args.rebuild)

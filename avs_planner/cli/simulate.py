@@ -71,8 +71,9 @@ def register(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from avs_planner.episode import EpisodeError, EpisodeSpec, run_episode
-    from avs_planner.episode.scenarios import load_scenario
+    from avs_planner.episode import EpisodeError
+    from avs_planner.harness import EpisodeSpec, run_episode
+    from avs_planner.harness.scenarios import load_scenario
 
     try:
         base: dict[str, Any] = {}
@@ -100,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
 def _check_label(spec: Any) -> None:
     """With `--strict-labels`, a target the knowledge does not list is bad input."""
     if spec.strict_labels:
-        from avs_planner.episode.runner import target_knowledge
+        from avs_planner.harness.runner import target_knowledge
         from conceptual_map.knowledge import load_knowledge
 
         target_knowledge(load_knowledge(), spec.target, strict=True)
@@ -111,8 +112,8 @@ def _check_start(spec: Any) -> None:
     search from outside the building until its budget ran out)."""
     if spec.start is None or spec.world_text is not None:
         return  # an inline world file is checked by the runner
-    from avs_planner.episode.robot import generated_spec, load_spec
-    from avs_planner.episode.validate import start_problem
+    from avs_planner.harness.sim_robot import generated_spec, load_spec
+    from avs_planner.harness.validate import start_problem
 
     world = generated_spec(spec.generate) if spec.generate else load_spec(spec.world)
     problem = start_problem(world, spec.start, spec.robot or world.robot.model)

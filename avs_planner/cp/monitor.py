@@ -38,7 +38,7 @@ class MonitorReport:
     failed: tuple[str, ...] = field(default_factory=tuple)
     probability: float = 1.0
     # (label, probability in this state) of each assumptive step checked, in plan order (0.0
-    # for a contradicted one): what the assumption ledger (`episode.explain`) records
+    # for a contradicted one): what the assumption ledger (`reporting.explain`) records
     assumptions: tuple[tuple[str, float], ...] = ()
 
     @property

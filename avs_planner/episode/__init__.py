@@ -1,11 +1,11 @@
-"""One object-search episode: the switching planner in the loop with a simulated robot.
+"""One object-search episode as the robot's mind lives it: what it knows and how it acts.
 
-`run_episode(spec, emit, should_stop)` is the entry point the HTTP jobs and `avs simulate`
-call. Robot side: `robot.py` (the only module that talks to `sim`). Mind side: `mind.py`,
-`state_builder.py`, `viewcones.py`, `executor.py`, `loop.py`.
+Mind side only: `mind.py`, `state_builder.py`, `viewcones.py`, `executor.py`, `robot_api.py`
+(the robot as the mind sees it); nothing here imports the simulator. The wiring to `sim` and
+the entry point `run_episode(spec, emit, should_stop)` are in `avs_planner.harness`; the
+switching loop is the switching strategy's (`avs_planner.strategies.switching`).
 """
 
 from avs_planner.episode.errors import EpisodeError
-from avs_planner.episode.runner import Episode, EpisodeSpec, run_episode
 
-__all__ = ["Episode", "EpisodeError", "EpisodeSpec", "run_episode"]
+__all__ = ["EpisodeError"]

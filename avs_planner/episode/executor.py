@@ -133,7 +133,8 @@ class Executor(Driving):
         self.seen_while_moving: dict[str, set[Atom]] = {}
         self.dt_session: Any = None  # the last SEARCHFOROBJECT's DTSession (read by observers)
         self._unplaced: list[SeenLike] = []
-        self.qsr_cones: Any = None  # QSR-weighted support cones (episode/qsr_cones.install)
+        # QSR-weighted support cones (strategies/switching/qsr_cones.install)
+        self.qsr_cones: Any = None
         # the map's P(ObjectAt) of each cone set's location when it was made: a later
         # search of it starts from what looks since then have left (`cones_now`)
         self.cone_basis: dict[tuple[str, str, str], float] = {}

@@ -5,7 +5,7 @@ own pose, clock, odometry and body, its motions, and its sensors (laser scans, d
 detections, the place classifier). Nothing in it names the world.
 
 `fence(robot)` is how the episode hands a robot over: an object with exactly those members
-and nothing else, forwarding to the simulator adapter (`episode/robot.py`) through closures.
+and nothing else, forwarding to the simulator adapter (`harness/sim_robot.py`) through closures.
 The adapter holds the world (`world`, the simulated `robot`, `truth_of` for scoring); through
 the fence none of it can be reached by attribute, so a planner or strategy that tried to
 read an object's true pose or a room's true category fails with an AttributeError instead of

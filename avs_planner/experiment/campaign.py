@@ -214,7 +214,7 @@ def _robots(value: Any, where: Where) -> tuple[str | None, ...]:
         value = [value]
     if not isinstance(value, list) or not value:
         raise where.error("a non-empty list of robot models")
-    from avs_planner.episode.robot import ROBOT_MODELS
+    from avs_planner.harness.sim_robot import ROBOT_MODELS
 
     for i, robot in enumerate(value):
         if robot not in ROBOT_MODELS:

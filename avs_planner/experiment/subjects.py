@@ -37,7 +37,7 @@ class Subject:
 
 
 def scenario_subjects(value: Any, where: Where, base: Path) -> Iterator[Subject]:
-    from avs_planner.episode.scenarios import load_scenario
+    from avs_planner.harness.scenarios import load_scenario
 
     if isinstance(value, str):
         value = [value]
@@ -95,7 +95,7 @@ def _targets_for(entry: dict[str, Any], top: Any, key: str, at: Where, where: Wh
 
 def _from_file(entry: dict[str, Any], top: Any, at: Where, where: Where, base: Path
                ) -> Iterator[Subject]:
-    from avs_planner.episode.robot import load_spec
+    from avs_planner.harness.sim_robot import load_spec
 
     text = entry["world"]
     if not isinstance(text, str) or not text:
@@ -154,14 +154,14 @@ def _auto(seed: int, style: str, rooms: int | None, where: Where
 
 
 def generated_name(seed: int, style: str, rooms: int | None) -> str:
-    from avs_planner.episode.worlds import generated_name as name
+    from avs_planner.harness.worlds import generated_name as name
 
     return name(seed, style, rooms)
 
 
 def generated_targets(seed: int, style: str, rooms: int | None) -> list[tuple[str, bool]]:
     """The generator's (label, present in the world) targets for one generated world."""
-    from avs_planner.episode.worlds import generated_targets as targets
+    from avs_planner.harness.worlds import generated_targets as targets
 
     try:
         return list(targets(seed, style, rooms))

@@ -1,6 +1,6 @@
 """What runs in a worker process: one episode, its error caught and recorded, timed inside.
 
-Kept light at module level; the episode runner (`avs_planner.episode:run_episode` unless a
+Kept light at module level; the episode runner (`avs_planner.harness:run_episode` unless a
 test injects another `module:function` or `file.py:function`) is imported on first use or
 preloaded by the backend.
 """
@@ -17,8 +17,8 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-DEFAULT_RUNNER = "avs_planner.episode:run_episode"
-PRELOAD = ("avs_planner.episode", "avs_planner.episode.runner")
+DEFAULT_RUNNER = "avs_planner.harness:run_episode"
+PRELOAD = ("avs_planner.harness", "avs_planner.harness.runner")
 
 
 def execute(spec: Mapping[str, Any], out_dir: str | None, runner: str = DEFAULT_RUNNER

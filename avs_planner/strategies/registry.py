@@ -8,11 +8,11 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 from avs_planner.episode.errors import EpisodeError
-from avs_planner.episode.loop import LoopConfig
 from avs_planner.episode.outcome import SearchResult
 from avs_planner.errors import AvsError
 from avs_planner.strategies.context import SearchContext
 from avs_planner.strategies.qsr_options import OPTIONS as _QSR_OPTIONS
+from avs_planner.strategies.switching.loop import LoopConfig
 
 _QSR_CHECK = "avs_planner.strategies.qsr_options:check_options"
 
@@ -100,7 +100,7 @@ _SWITCHING_OPTIONS = {f.name: f.default for f in fields(LoopConfig)
 # the view cones of a search on a support: "cones" (2D, around it) or "flap" (FLAP's views in
 # the 3D map; avs_planner/strategies/flap_views.py)
 _SWITCHING_OPTIONS["views"] = "cones"
-# QSR-weighted cones when QSRs are known for the target: on|off|observe (strategies/switching.py)
+# QSR-weighted cones when QSRs are known for the target: on|off|observe (strategies/switching/)
 _SWITCHING_OPTIONS["qsr_cones"] = "off"
 
 _FLAP_OPTIONS = {  # avs_planner/strategies/flap.py

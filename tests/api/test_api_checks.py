@@ -109,8 +109,8 @@ def test_strategies_are_listed(client: TestClient) -> None:
 
 
 def test_default_robot_comes_from_the_world_file(tmp_path: Path) -> None:
-    from avs_planner.episode.robot import load_spec
-    from avs_planner.episode.runner import EpisodeSpec
+    from avs_planner.harness.runner import EpisodeSpec
+    from avs_planner.harness.sim_robot import load_spec
 
     world = tmp_path / "tiny.yaml"
     world.write_text(PR2_WORLD)
@@ -148,7 +148,7 @@ def test_a_qsr_field_of_the_wrong_shape_is_422_not_500(client: TestClient) -> No
 
 def test_a_task_with_qsr_descriptions_is_accepted_and_reaches_the_episode(
         client: TestClient) -> None:
-    from avs_planner.episode.runner import EpisodeSpec
+    from avs_planner.harness.runner import EpisodeSpec
 
     for qsr in ([CUP_RIGHT], {"descriptions": [CUP_RIGHT]}):
         accepted = client.post("/v1/tasks", json={"target": "cup", "world": "qsr_desks_a",
@@ -163,7 +163,7 @@ def test_a_task_with_qsr_descriptions_is_accepted_and_reaches_the_episode(
 
 
 def test_a_generated_building_is_accepted_and_reaches_the_episode(client: TestClient) -> None:
-    from avs_planner.episode.runner import EpisodeSpec
+    from avs_planner.harness.runner import EpisodeSpec
 
     accepted = client.post("/v1/tasks", json={"target": "stapler", "robot": "pr2",
                                               "generate": {"seed": 3, "style": "lab"}})

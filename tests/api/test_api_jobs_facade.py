@@ -21,14 +21,14 @@ from avs_planner import jobs
 
 
 def run(spec, emit, should_stop):
-    sys.modules["avs_planner.episode"] = None  # a trimmed install: the package is missing
+    sys.modules["avs_planner.harness"] = None  # a trimmed install: the package is missing
     return jobs.run_episode(spec, emit, should_stop)
 """
 
 
 def test_run_episode_says_the_runner_is_missing(monkeypatch: pytest.MonkeyPatch) -> None:
     assert jobs.episode_runner_available()
-    monkeypatch.setitem(sys.modules, "avs_planner.episode", None)
+    monkeypatch.setitem(sys.modules, "avs_planner.harness", None)
     assert not jobs.episode_runner_available()
     with pytest.raises(jobs.JobUnavailableError, match="episode runner .* not available yet"):
         jobs.run_episode({"target": "cup"}, lambda event: None, lambda: False)

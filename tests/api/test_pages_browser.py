@@ -31,8 +31,8 @@ import pytest
 
 from api.schemas import TaskState
 from api.store import TaskStore
-from avs_planner.episode.runner import run_episode
-from avs_planner.episode.scenarios import load_scenario
+from avs_planner.harness.runner import run_episode
+from avs_planner.harness.scenarios import load_scenario
 
 pytestmark = pytest.mark.browser
 

@@ -6,9 +6,9 @@ import pytest
 
 from avs_planner.episode.executor import Executor
 from avs_planner.episode.mind import Mind
-from avs_planner.episode.robot import load_spec, open_world
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.viewcones import CameraModel
+from avs_planner.harness.sim_robot import load_spec, open_world
 
 
 def _look_around_the_corridor():
@@ -44,7 +44,7 @@ def switching_loop():
     """Make a `SwitchingLoop` over an executor and state builder made without its settings:
     gives them the settings the loop decides first, as the episode builds them
     (`LoopConfig.executor_config`, `builder_config`)."""
-    from avs_planner.episode.loop import LoopConfig, SwitchingLoop
+    from avs_planner.strategies.switching.loop import LoopConfig, SwitchingLoop
 
     def make(builder, executor, trace, config=None, should_stop=None):  # noqa: ANN001, ANN202
         config = config or LoopConfig()

@@ -6,15 +6,15 @@ import math
 
 import pytest
 
-from avs_planner.episode import Episode, EpisodeSpec
 from avs_planner.episode.executor import Executor
-from avs_planner.episode.loop import SwitchingLoop, _signature
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import StepOutcome, StepStatus
-from avs_planner.episode.robot import load_spec, open_world
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.trace import Trace
 from avs_planner.episode.viewcones import CameraModel
+from avs_planner.harness import Episode, EpisodeSpec
+from avs_planner.harness.sim_robot import load_spec, open_world
+from avs_planner.strategies.switching.loop import SwitchingLoop, _signature
 
 _WORLD = """name: door_{w}
 size: [15.0, 5.0]

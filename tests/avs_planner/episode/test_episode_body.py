@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from avs_planner.episode.robot import load_spec, open_world
+from avs_planner.harness.sim_robot import load_spec, open_world
 
 
 @pytest.mark.parametrize("model", ["pioneer", "pr2"])

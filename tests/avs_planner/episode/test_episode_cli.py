@@ -7,7 +7,8 @@ from pathlib import Path
 import pytest
 
 from avs_planner.cli import main
-from avs_planner.episode import EpisodeError, run_episode
+from avs_planner.episode import EpisodeError
+from avs_planner.harness import run_episode
 
 
 @pytest.mark.parametrize(

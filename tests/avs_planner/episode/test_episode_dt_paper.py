@@ -13,9 +13,9 @@ from avs_planner.cli import main
 from avs_planner.dt import TravelCosts, ViewCone
 from avs_planner.episode import dt_search
 from avs_planner.episode.dt_search import PathLengths, ViewConeSearch, travel_costs
-from avs_planner.episode.robot import Seen
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.viewcones import CameraModel, ConeSet, aim_height, support_cones
+from avs_planner.harness.sim_robot import Seen
 from conceptual_map.conceptual import RelatedSpace
 from conceptual_map.metric import OccupancyGrid
 from conceptual_map.metric.path_planning import PathResult, PathStatus

@@ -1,4 +1,4 @@
-"""The assumption ledger (`episode.explain`): built from hand-made traces, from a real give-up
+"""The assumption ledger (`reporting.explain`): built from hand-made traces, from a real give-up
 (the seed's scenario c), for strategies without plans, and printed by `avs explain`."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 
 from avs_planner.cli import main
-from avs_planner.episode import explain
+from avs_planner.reporting import explain
 
 LEADS = "(assume-leads-to-room placeholder3 kitchen new-room1)"
 EXISTS_NEW = "(assume-obj-exists-in cerealbox new-room1 kitchen new-object1)"
@@ -189,8 +189,8 @@ def test_avs_explain_names_what_is_wrong(tmp_path: Path, capsys, content, messag
 
 @pytest.mark.slow
 def test_scenario_c_explains_every_room_hypothesis_it_gave_up_on(tmp_path: Path) -> None:
-    from avs_planner.episode import run_episode
-    from avs_planner.episode.scenarios import load_scenario
+    from avs_planner.harness import run_episode
+    from avs_planner.harness.scenarios import load_scenario
 
     spec = dict(load_scenario("c").spec, seed=1, output_dir=str(tmp_path))
     assert run_episode(spec)["outcome"] == "gave_up"

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import pytest
 
-from avs_planner.episode import EpisodeSpec
 from avs_planner.episode.robot_api import METHODS, PROPERTIES, Robot, RobotFence
-from avs_planner.episode.runner import Episode
+from avs_planner.harness import EpisodeSpec
+from avs_planner.harness.runner import Episode
 
 
 @pytest.fixture(scope="module")

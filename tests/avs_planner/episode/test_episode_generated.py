@@ -3,8 +3,8 @@ up, is for evaluation only: docs/experiments.md)."""
 
 import pytest
 
-from avs_planner.episode import run_episode
-from avs_planner.episode.worlds import generated_targets
+from avs_planner.harness import run_episode
+from avs_planner.harness.worlds import generated_targets
 
 
 def test_the_switching_planner_finds_an_object_in_a_generated_world() -> None:

@@ -10,9 +10,9 @@ import pytest
 
 from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep
 from avs_planner.episode.glimpses import Glimpses
-from avs_planner.episode.loop import LoopConfig, _explores, _search_rejected
 from avs_planner.episode.outcome import StepOutcome, StepStatus
 from avs_planner.episode.trace import Trace
+from avs_planner.strategies.switching.loop import LoopConfig, _explores, _search_rejected
 from conceptual_map.conceptual import ConceptualError, RelatedSpace
 from conceptual_map.conceptual.existence import ObjectLedger
 from conceptual_map.knowledge import load_knowledge

@@ -7,8 +7,8 @@ import json
 
 import pytest
 
-from avs_planner.episode import run_episode
-from avs_planner.episode.scenarios import load_scenario
+from avs_planner.harness import run_episode
+from avs_planner.harness.scenarios import load_scenario
 
 SUMMARY_FIELDS = {"outcome", "target", "object", "sim_time_s", "distance_m", "plans",
                   "cp_time_s", "dt_calls", "dt_decision_time_s", "views_processed", "seed"}
@@ -77,7 +77,7 @@ def test_a_report_beside_the_real_object_scores_as_that_object() -> None:
     confirmed detection may be a phantom beside the object the next frames saw)."""
     import math
 
-    from avs_planner.episode.runner import REPORT_TOLERANCE, Episode, EpisodeSpec
+    from avs_planner.harness.runner import REPORT_TOLERANCE, Episode, EpisodeSpec
 
     episode = Episode(EpisodeSpec.from_dict(load_scenario("a").episode_spec(seed=1)))
     try:

@@ -1,4 +1,4 @@
-"""The robot's map scored against the world file (`episode.map_score`): the pure scoring on
+"""The robot's map scored against the world file (`harness.scoring`): the pure scoring on
 hand-made maps with known answers, and `map_score` in a real episode's summary."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from avs_planner.episode.map_score import RobotMap, TrueRoom, score_map
-from avs_planner.episode.runner import run_episode
+from avs_planner.harness.runner import run_episode
+from avs_planner.harness.scoring import RobotMap, TrueRoom, score_map
 
 # the built-in office world's rooms (sim/worlds/office.yaml)
 OFFICE = [

@@ -1,6 +1,7 @@
-"""QSR-weighted view cones of the switching planner (avs_planner/episode/qsr_cones.py): on a
-constructed desk the cones follow the described side of the keyboard; landmarks come only from
-the robot's detections (the detector tap); the strategy option is checked."""
+"""QSR-weighted view cones of the switching planner
+(avs_planner/strategies/switching/qsr_cones.py): on a constructed desk the cones follow the
+described side of the keyboard; landmarks come only from the robot's detections (the detector
+tap); the strategy option is checked."""
 
 import math
 from dataclasses import dataclass
@@ -11,8 +12,8 @@ import pytest
 
 from avs_planner.episode.executor import ExecutorConfig
 from avs_planner.episode.mind import KnownObject, Mind
-from avs_planner.episode.qsr_cones import QsrCones, install, knowledge_for
 from avs_planner.episode.viewcones import CameraModel, support_cones
+from avs_planner.strategies.switching.qsr_cones import QsrCones, install, knowledge_for
 from conceptual_map.metric import OccupancyGrid
 from conceptual_map.qsr import load_qsr, parse_descriptions
 
@@ -147,7 +148,7 @@ def test_knowledge_for_prefers_the_task_and_falls_back_to_the_default():
 
 
 def test_the_switching_option_is_checked():
-    from avs_planner.episode import run_episode
+    from avs_planner.harness import run_episode
     from avs_planner.strategies.registry import StrategyError
 
     with pytest.raises(StrategyError, match="qsr_cones"):
@@ -159,7 +160,7 @@ def test_room_cones_keep_the_uniform_set_and_coverage_and_lean_half_on_the_densi
         monkeypatch):
     """In a room the cones and their coverage stay the uniform ones (a rejected room is no
     more certain than before); half of their probability follows the QSR density."""
-    import avs_planner.episode.qsr_cones as module
+    import avs_planner.strategies.switching.qsr_cones as module
     from avs_planner.dt import ViewCone
     from avs_planner.episode.viewcones import ConeSet
 

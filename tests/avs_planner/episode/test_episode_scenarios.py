@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from avs_planner.episode import run_episode
-from avs_planner.episode.scenarios import builtin_scenarios, load_scenario
+from avs_planner.harness import run_episode
+from avs_planner.harness.scenarios import builtin_scenarios, load_scenario
 
 DATA = Path(__file__).parent / "data"
 

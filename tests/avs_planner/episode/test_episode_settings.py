@@ -7,13 +7,13 @@ from __future__ import annotations
 import pytest
 
 from avs_planner.cp.search import DEFAULT_REWARD
-from avs_planner.episode import EpisodeSpec
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.executor import ExecutorConfig
-from avs_planner.episode.loop import LoopConfig, SwitchingLoop
-from avs_planner.episode.runner import Episode
 from avs_planner.episode.state_builder import BuilderConfig
 from avs_planner.episode.trace import Trace
+from avs_planner.harness import EpisodeSpec
+from avs_planner.harness.runner import Episode
+from avs_planner.strategies.switching.loop import LoopConfig, SwitchingLoop
 
 
 def _episode(strategy: str, **options):

@@ -11,9 +11,9 @@ from typing import Any
 
 import numpy as np
 
-from avs_planner.episode.runner import run_episode
-from avs_planner.episode.scenarios import load_scenario
-from avs_planner.episode.snapshots import MapSnapshots, coarsen, png_grey
+from avs_planner.harness.runner import run_episode
+from avs_planner.harness.scenarios import load_scenario
+from avs_planner.reporting.snapshots import MapSnapshots, coarsen, png_grey
 from conceptual_map.metric import CellState
 
 

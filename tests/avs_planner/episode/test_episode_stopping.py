@@ -1,4 +1,5 @@
-"""The building-level stopping rule (`episode/stopping.py`) on the office corridor's map."""
+"""The building-level stopping rule (`strategies/switching/stopping.py`) on the office
+corridor's map."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import numpy as np
 import pytest
 
 from avs_planner.body import JointRange, RobotBody
-from avs_planner.episode.stopping import Option, Remaining, look_cost, remaining
+from avs_planner.strategies.switching.stopping import Option, Remaining, look_cost, remaining
 from conceptual_map.conceptual.existence import ObjectLedger
 from conceptual_map.conceptual.placeholders import PlaceholderEvidence, p_label_beyond
 from conceptual_map.knowledge import load_knowledge

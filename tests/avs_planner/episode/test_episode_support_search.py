@@ -16,12 +16,12 @@ from avs_planner.dt.domain import ActionKind, DTAction
 from avs_planner.dt.session import DTResult, DTStatus, DTStep
 from avs_planner.episode.driving import TARGET_SEEN, _split_leg
 from avs_planner.episode.dt_search import ViewConeSearch
-from avs_planner.episode.loop import LoopConfig
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import StepOutcome, StepStatus
-from avs_planner.episode.robot import Seen
 from avs_planner.episode.trace import Trace
 from avs_planner.episode.viewcones import ConeSet
+from avs_planner.harness.sim_robot import Seen
+from avs_planner.strategies.switching.loop import LoopConfig
 
 OPTIONS = SearchOptions(weight=3.0, heuristic="hadd", node_limit=4000)
 

@@ -9,8 +9,9 @@ from pathlib import Path
 import pytest
 
 from avs_planner.cli import main
-from avs_planner.episode import EpisodeError, EpisodeSpec, run_episode
-from avs_planner.episode.validate import check_task
+from avs_planner.episode import EpisodeError
+from avs_planner.harness import EpisodeSpec, run_episode
+from avs_planner.harness.validate import check_task
 
 # flap_two_rooms holds two bottles (one on a table in room_a, one on a shelf in room_b); the
 # robot starts in room_b, facing room_a's door

@@ -6,9 +6,9 @@ import math
 
 from avs_planner.cp.search import PlanStep
 from avs_planner.dt import DTProblem, TravelCosts
-from avs_planner.episode.loop import assumed_categories
 from avs_planner.episode.mind import KnownObject
 from avs_planner.episode.viewcones import CameraModel, room_cones, support_cones
+from avs_planner.strategies.switching.loop import assumed_categories
 
 CAMERA = CameraModel(height=1.4, hfov=math.radians(60), detect_range=4.0)
 

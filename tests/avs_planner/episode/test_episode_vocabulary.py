@@ -3,7 +3,8 @@ every place reading becomes evidence or a warning in the trace, never silence.""
 
 import pytest
 
-from avs_planner.episode import Episode, EpisodeError, EpisodeSpec, run_episode
+from avs_planner.episode import EpisodeError
+from avs_planner.harness import Episode, EpisodeSpec, run_episode
 
 WORLD = """
 name: two-rooms

@@ -2,7 +2,7 @@
 DT search, and the planner hears of it through the monitor (it matches the plan's virtual
 object or settles the goal)."""
 
-from avs_planner.episode import Episode, EpisodeSpec, run_episode
+from avs_planner.harness import Episode, EpisodeSpec, run_episode
 
 WORLD = """
 name: in-view

@@ -213,7 +213,7 @@ def test_the_held_out_campaign_is_unseen_buildings_of_three_styles_by_both_robot
 
 def test_a_pr2_run_of_the_held_out_campaign_searches_the_world_generated_for_the_pr2():
     pytest.importorskip("sim.generate", reason="the world generator is not in this build")
-    from avs_planner.episode.robot import generated_spec
+    from avs_planner.harness.sim_robot import generated_spec
     from sim.generate import generate_world
 
     campaign = load_campaign("heldout")

@@ -4,8 +4,8 @@ import json
 
 import pytest
 
-from avs_planner.episode import run_episode
-from avs_planner.episode.scenarios import load_scenario
+from avs_planner.harness import run_episode
+from avs_planner.harness.scenarios import load_scenario
 
 
 @pytest.mark.parametrize("strategy", ["exhaustive", "most-likely-room"])
@@ -68,8 +68,8 @@ def test_a_phantom_confirmed_close_to_the_camera_is_verified_from_further_away_a
     (generated office world 23 reported a stapler that way)."""
     import math
 
-    from avs_planner.episode.robot import Seen
-    from avs_planner.episode.runner import Episode, EpisodeSpec
+    from avs_planner.harness.runner import Episode, EpisodeSpec
+    from avs_planner.harness.sim_robot import Seen
 
     spec = load_scenario("a").episode_spec(strategy="exhaustive", seed=1, time_budget_s=200)
     episode = Episode(EpisodeSpec.from_dict(spec))
@@ -116,7 +116,7 @@ def test_a_baseline_tries_blocked_spots_again_before_it_gives_up(strategy):
     box stands 7.5 m beyond it, out of the detector's range: the hall is searched within the
     blockage's retry time, and the baseline must try the door again before it calls the box
     absent (with no retries it gives up)."""
-    from avs_planner.episode import Episode, EpisodeSpec
+    from avs_planner.harness import Episode, EpisodeSpec
 
     def run(retries: int) -> dict:
         episode = Episode(EpisodeSpec.from_dict(
@@ -136,7 +136,7 @@ def test_exhaustive_squeezes_a_pr2_through_a_door_the_grid_draws_too_narrow(widt
     """A door of 0.74-0.78 m leaves the PR2 (0.68 m across) 3-5 cm a side, and the grid
     draws it narrower still: no full-margin path leads through it. The space behind it is a
     goal with the squeeze margin `drive_to` uses (it used to give up at once, 20 s in)."""
-    from avs_planner.episode import Episode, EpisodeSpec
+    from avs_planner.harness import Episode, EpisodeSpec
 
     world = _two_rooms(width)
     summary = Episode(EpisodeSpec.from_dict(

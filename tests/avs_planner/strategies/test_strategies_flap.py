@@ -5,7 +5,7 @@ import json
 import pytest
 
 from avs_planner.cli import main as avs_main
-from avs_planner.episode import run_episode
+from avs_planner.harness import run_episode
 from avs_planner.strategies import StrategyError, get_strategy
 
 # small cycles keep the tests quick; the experiment uses the defaults (200 views, 50 clusters)

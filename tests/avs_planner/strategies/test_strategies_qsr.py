@@ -7,8 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from avs_planner.episode import EpisodeError, run_episode
-from avs_planner.episode.runner import EpisodeSpec
+from avs_planner.episode import EpisodeError
+from avs_planner.harness import run_episode
+from avs_planner.harness.runner import EpisodeSpec
 from avs_planner.qsr import LandmarkTracker, open_side
 from avs_planner.strategies import get_strategy
 from avs_planner.strategies.qsr import forget_learnt
@@ -143,7 +144,7 @@ def test_pose_utility_option_is_checked():
 def _search_with_one_miss(relook: bool):
     """A qsr search on the desks whose camera misses the cup once, on the first frame of the
     first look (forced here); the summary, the trace and the robot's pose at every cup frame."""
-    from avs_planner.episode.runner import Episode
+    from avs_planner.harness.runner import Episode
 
     episode = Episode(EpisodeSpec.from_dict(_spec("qsr", options={"relook": relook})))
     robot, detect, asked = episode.robot, episode.robot.detect, []

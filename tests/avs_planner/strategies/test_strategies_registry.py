@@ -2,7 +2,7 @@
 
 import pytest
 
-from avs_planner.episode import EpisodeSpec
+from avs_planner.harness import EpisodeSpec
 from avs_planner.strategies import StrategyError, get_strategy, strategy_names
 
 

@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from avs_planner.cli import main
-from avs_planner.episode import EpisodeError, EpisodeSpec
+from avs_planner.episode import EpisodeError
+from avs_planner.harness import EpisodeSpec
 
 try:
     import rerun  # noqa: F401
@@ -32,8 +33,8 @@ def recorded(tmp_path_factory: pytest.TempPathFactory) -> Path:
     if not HAVE_RERUN:
         pytest.skip("rerun-sdk is not installed (the viewer extra: pip install "
                     "'avs-planner[viewer]')")
-    from avs_planner.episode import run_episode
-    from avs_planner.episode.scenarios import load_scenario
+    from avs_planner.harness import run_episode
+    from avs_planner.harness.scenarios import load_scenario
 
     out = tmp_path_factory.mktemp("recorded")
     spec = dict(load_scenario("a").spec, seed=1, output_dir=str(out), record=True)
@@ -70,8 +71,8 @@ def test_the_plan_text_marks_assumptive_steps(recorded: Path) -> None:
 
 @needs_rerun
 def test_recording_does_not_change_the_episode(recorded: Path, tmp_path: Path) -> None:
-    from avs_planner.episode import run_episode
-    from avs_planner.episode.scenarios import load_scenario
+    from avs_planner.harness import run_episode
+    from avs_planner.harness.scenarios import load_scenario
 
     run_episode(dict(load_scenario("a").spec, seed=1, output_dir=str(tmp_path)))
 
@@ -144,8 +145,8 @@ def test_a_live_view_without_a_display_is_refused_before_the_run(monkeypatch) ->
 @pytest.mark.slow
 def test_a_dt_search_records_its_cones_and_belief(tmp_path: Path) -> None:
     """Scenario f (the marker in the meeting room, one DT search over its view cones)."""
-    from avs_planner.episode import run_episode
-    from avs_planner.episode.scenarios import load_scenario
+    from avs_planner.harness import run_episode
+    from avs_planner.harness.scenarios import load_scenario
     from avs_planner.viewer.replay import contents
 
     spec = dict(load_scenario("f").spec, seed=1, output_dir=str(tmp_path), record=True)

@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from avs_planner.episode.explain import distribution_text
-from avs_planner.episode.explain_terms import with_article
+from avs_planner.reporting.explain import distribution_text
+from avs_planner.reporting.explain_terms import with_article
 
 
 def _p(value: Any) -> str:

@@ -1,12 +1,12 @@
-"""The switching planner (seed 003) as a strategy: the CP + DT loop of `episode.loop`.
+"""The switching planner (seed 003) as a strategy: the CP + DT loop of `loop.py`.
 
 Option `qsr_cones` (`off` by default): `on` makes view cones on a support, or in a room with
 a perceived landmark, follow the QSR mixture at the perceived landmarks instead of being
 uniform, when QSR descriptions are known for the target (the task's, else the default
-knowledge's; `avs_planner/episode/qsr_cones.py`; on a support only with `views=cones`, FLAP's
-views are left as they are). Off by default because it was not measured better: 4 desk and
-kitchen worlds x 10 seeds (`python -m bench.qsr_switching`), 42 views with `on` against 36 with
-`observe`. `observe`: landmarks are perceived as with `on` (the
+knowledge's; `avs_planner/strategies/switching/qsr_cones.py`; on a support only with
+`views=cones`, FLAP's views are left as they are). Off by default because it was not measured
+better: 4 desk and kitchen worlds x 10 seeds (`python -m bench.qsr_switching`), 42 views with
+`on` against 36 with `observe`. `observe`: landmarks are perceived as with `on` (the
 detector is asked for their labels too) but the cones stay uniform, which isolates the
 weighting in a comparison (the extra labels change the detector's noise draws)."""
 
@@ -17,13 +17,13 @@ from typing import Any
 
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.executor import ExecutorConfig
-from avs_planner.episode.loop import LoopConfig, SwitchingLoop
 from avs_planner.episode.outcome import SearchResult
-from avs_planner.episode.qsr_cones import install as install_qsr_cones
 from avs_planner.episode.state_builder import BuilderConfig
 from avs_planner.strategies.context import SearchContext
 from avs_planner.strategies.flap_views import VIEWS
 from avs_planner.strategies.flap_views import make as make_views
+from avs_planner.strategies.switching.loop import LoopConfig, SwitchingLoop
+from avs_planner.strategies.switching.qsr_cones import install as install_qsr_cones
 
 QSR_CONES = ("on", "off", "observe")
 OWN_OPTIONS = ("views", "qsr_cones")  # the strategy's own options; the rest are the loop's

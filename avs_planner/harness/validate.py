@@ -20,7 +20,7 @@ from typing import Any
 from matplotlib.path import Path as MplPath
 
 from avs_planner.episode.errors import EpisodeError
-from avs_planner.episode.robot import check_categories, free_spot, generated_spec
+from avs_planner.harness.sim_robot import check_categories, free_spot, generated_spec
 from avs_planner.strategies import get_strategy, strategy_names
 from conceptual_map.knowledge.loader import load_knowledge
 from conceptual_map.knowledge.model import Knowledge
@@ -102,7 +102,7 @@ def _check_qsr(task: Mapping[str, Any]) -> list[FieldProblem]:
     names the entry, e.g. `qsr: descriptions[1].of: unknown landmark label 'sofa' ...`)."""
     if task.get("qsr") is None:
         return []
-    from avs_planner.episode.runner import qsr_descriptions
+    from avs_planner.harness.runner import qsr_descriptions
 
     try:
         qsr_descriptions(task["qsr"], source="qsr")

@@ -18,8 +18,8 @@ from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.executor import Executor, ExecutorConfig
 from avs_planner.episode.outcome import Outcome, SearchResult, StepOutcome, StepStatus
 from avs_planner.episode.state_builder import AvsState, BuilderConfig, StateBuilder
-from avs_planner.episode.stopping import Remaining, look_cost, remaining
 from avs_planner.episode.trace import Trace
+from avs_planner.strategies.switching.stopping import Remaining, look_cost, remaining
 
 
 @dataclass(frozen=True)
@@ -73,7 +73,7 @@ class LoopConfig:
     # price moves and searches in the robot's own seconds (`BuilderConfig.seconds`)
     seconds: bool = False
     # give up when no continuation is worth its cost against the building-level belief
-    # (`episode/stopping.py`), not only when no single plan reaches the threshold
+    # (`stopping.py`), not only when no single plan reaches the threshold
     stop_rule: bool = True
 
     def executor_config(self, base: ExecutorConfig | None = None) -> ExecutorConfig:

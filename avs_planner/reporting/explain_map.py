@@ -1,4 +1,4 @@
-"""The robot's map as the trace's `map` events drew it (`episode/snapshots.py`), for the
+"""The robot's map as the trace's `map` events drew it (`reporting/snapshots.py`), for the
 explanations: which room the robot mapped behind a placeholder it explored, and which objects
 it found there (`explain.Ledger` judges room hypotheses by them)."""
 
@@ -18,7 +18,7 @@ FOUND_REACH = 3.0
 
 
 class MapState:
-    """The last value of each part of the trace's `map` events (`episode/snapshots.py`): the
+    """The last value of each part of the trace's `map` events (`reporting/snapshots.py`): the
     places with their rooms, every placeholder's last position, the rooms' category beliefs,
     the known objects, and when each room and object first appeared."""
 

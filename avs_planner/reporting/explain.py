@@ -27,8 +27,8 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
-from avs_planner.episode.explain_map import MapState
-from avs_planner.episode.explain_terms import (
+from avs_planner.reporting.explain_map import MapState
+from avs_planner.reporting.explain_terms import (
     Assumption,
     action_words,
     describe,
@@ -568,6 +568,6 @@ def _top(dist: Mapping[str, float], n: int = 4) -> dict[str, float]:
 
 def render(explanation: Mapping[str, Any]) -> str:
     """The explanation as readable text (what `avs explain` prints; `explain_text.py`)."""
-    from avs_planner.episode.explain_text import render as render_text
+    from avs_planner.reporting.explain_text import render as render_text
 
     return render_text(explanation)

@@ -2,7 +2,7 @@
 
 This is the wiring: it opens the simulated world (robot side), builds the mind, state builder,
 executor and switching loop (mind side), and writes trace.jsonl, summary.json, trajectory.png,
-explanation.json (`episode.explain`) and, when asked (`record`), recording.rrd (`viewer`).
+explanation.json (`reporting.explain`) and, when asked (`record`), recording.rrd (`viewer`).
 """
 
 from __future__ import annotations
@@ -19,18 +19,19 @@ from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.executor import Executor, ExecutorConfig
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import SearchResult
-from avs_planner.episode.robot import (
+from avs_planner.episode.robot_api import fence
+from avs_planner.episode.state_builder import SearchTask, StateBuilder
+from avs_planner.episode.trace import Trace, write_summary
+from avs_planner.episode.viewcones import CameraModel
+from avs_planner.harness.sim_robot import (
     SimRobot,
     check_categories,
     generated_spec,
     load_spec,
     open_world,
 )
-from avs_planner.episode.robot_api import fence
-from avs_planner.episode.snapshots import MapSnapshots
-from avs_planner.episode.state_builder import SearchTask, StateBuilder
-from avs_planner.episode.trace import Trace, write_summary
-from avs_planner.episode.viewcones import CameraModel
+from avs_planner.reporting.snapshots import MapSnapshots
+from avs_planner.strategies import SearchContext, Strategy, get_strategy
 from conceptual_map.knowledge import Knowledge, load_knowledge
 
 Emit = Callable[[dict[str, Any]], None]
@@ -83,8 +84,6 @@ class EpisodeSpec:
         if not isinstance(options, Mapping):
             raise EpisodeError(f"episode spec: 'strategy_options' must be a mapping, got "
                                f"{options!r}")
-        from avs_planner.strategies import get_strategy  # the registry imports this package
-
         strategy = get_strategy(str(spec.get("strategy") or "switching"))
         options = strategy.check_options(options)
         generate = spec.get("generate")
@@ -238,8 +237,6 @@ class Episode:
                                  replace(executor_config or ExecutorConfig(),
                                          dt_policy=spec.dt_policy), seed=spec.seed)
         self.trace.subscribe(MapSnapshots(self.executor, self._emit).observe)
-        from avs_planner.strategies import SearchContext
-
         self.context = SearchContext(
             robot=sensed, body=body, mind=self.mind, builder=self.builder,
             executor=self.executor, trace=self.trace, target=spec.target,
@@ -282,9 +279,7 @@ class Episode:
             except EpisodeError as exc:  # name the spec key, not the temporary file
                 raise EpisodeError(str(exc).replace(str(path), "world_file")) from None
 
-    def _strategy(self):  # noqa: ANN202 - a Strategy (imported late: it imports this package)
-        from avs_planner.strategies import get_strategy
-
+    def _strategy(self) -> Strategy:
         return get_strategy(self.spec.strategy)
 
     def _emit(self, type_: str, **fields: Any) -> None:
@@ -314,7 +309,7 @@ class Episode:
     def _pre_explore(self) -> tuple[float, float]:
         """Fig. 3f: build the maps first (frontier exploration), then start the clock."""
         if self.spec.pre_explore:
-            from avs_planner.episode.prebuilt import explore
+            from avs_planner.harness.prebuilt import explore
 
             prepare = self._strategy().load_prepare()
             if prepare is not None:
@@ -363,8 +358,8 @@ class Episode:
 
     def _map_score(self) -> dict[str, Any]:
         """{"map_score": ...}: the mind's rooms scored against the world file's (the harness
-        holds both; `map_score.py`); empty when the mind has no rooms."""
-        from avs_planner.episode.map_score import map_score
+        holds both; `scoring.py`); empty when the mind has no rooms."""
+        from avs_planner.harness.scoring import map_score
 
         score = map_score(self.world_spec, self.mind, self.executor.stats.path)
         return {} if score is None else {"map_score": score}
@@ -397,14 +392,14 @@ class Episode:
 
     def _explanation(self) -> None:
         """explanation.json: the assumption ledger of the trace, with the final beliefs."""
-        from avs_planner.episode import explain
+        from avs_planner.reporting import explain
 
         assert self.out is not None
         final = explain.final_beliefs(self.mind, self.spec.target)
         explain.write(self.out / explain.FILE_NAME, explain.build(self.trace.events, final))
 
     def _picture(self) -> None:
-        from avs_planner.episode.picture import draw_trajectory
+        from avs_planner.reporting.picture import draw_trajectory
 
         assert self.out is not None
         draw_trajectory(self.mind, self.executor.stats, self.out / "trajectory.png",
