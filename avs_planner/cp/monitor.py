@@ -8,7 +8,6 @@ at the end.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import Enum
@@ -103,7 +102,3 @@ def _broken(i: int, step: PlanStep, action, task: GroundTask, state: int,  # noq
     failed = _failed_conditions(action, task, state)
     return MonitorReport(status, i, step.label, "fails: " + " ".join(failed), failed,
                          probability=0.0, assumptions=assumed)
-
-
-def plan_probability(plan: Sequence[PlanStep]) -> float:
-    return math.prod(s.probability for s in plan)

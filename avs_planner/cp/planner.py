@@ -64,11 +64,6 @@ def _ground(pproblem: ProbabilisticProblem, options: SearchOptions,
     return task, symmetries
 
 
-def plan_task(task: GroundTask, options: SearchOptions | None = None) -> PlanResult:
-    """Search an already grounded task (e.g. a replan from a new initial bitset)."""
-    return _search(task, (options or SearchOptions()).check())
-
-
 def _search(task: GroundTask, options: SearchOptions, symmetries: Symmetries = NO_SYMMETRIES
             ) -> PlanResult:
     """The anytime schedule when asked for, else one (weighted A*) search."""

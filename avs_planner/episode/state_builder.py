@@ -517,9 +517,3 @@ class StateBuilder:
         belief = self.mind.cmap.room_category(room)
         top = sorted(belief.items(), key=lambda kv: -kv[1])[:3]
         return {c: round(float(p), 3) for c, p in top}
-
-    def search_detect(self, label: str, relation: str) -> float:
-        """The p-detect the problem uses for a search (the DT's evidence weight)."""
-        cfg = self.config
-        detect = cfg.target_detect if label == self.task.target else cfg.support_detect
-        return detect[RELATIONS.index(relation)]

@@ -130,14 +130,6 @@ def _read_atom(cur: _Cursor) -> Atom:
     return Atom(cur.text[start : cur.pos].lower(), line, column, start)
 
 
-def position_of(text: str, offset: int) -> tuple[int, int]:
-    """1-based (line, column) of a character offset in `text`."""
-    offset = max(0, min(offset, len(text)))
-    line = text.count("\n", 0, offset) + 1
-    column = offset - (text.rfind("\n", 0, offset) + 1) + 1
-    return line, column
-
-
 def is_number(text: str) -> bool:
     """True for PDDL numbers (`3`, `0.25`, `-1`) and fractions (`3/10`)."""
     parts = text.split("/")
