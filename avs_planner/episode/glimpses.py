@@ -42,7 +42,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from avs_planner.episode.mind import Mind
+from avs_planner.episode.mind import KnownObject, Mind
 from avs_planner.episode.viewcones import CameraModel, candidate_cells
 from conceptual_map.conceptual import RelatedSpace
 from conceptual_map.metric import CellState
@@ -124,8 +124,7 @@ class Glimpses:
             obj = self.mind.objects.get(oid)
             if obj is None:
                 continue
-            top = 2.0 * obj.position[2]  # the executor's rule: a support's centre is half-way
-            seen = self._top_in_view(obj.position[:2], pose, pan, tilt, top)
+            seen = self._top_in_view(obj.position[:2], pose, pan, tilt, _top(obj))
             if not seen.any():
                 continue
             looks = self.tops.setdefault((label, oid), [set() for _ in self._top_points])
@@ -148,10 +147,9 @@ class Glimpses:
         obj = self.mind.objects.get(oid)
         if obj is None:
             return None
-        top = 2.0 * obj.position[2]
         counts = np.zeros(len(self._top_points))
         for pose, pan, tilt, times in looks:
-            counts += times * self._top_in_view(obj.position[:2], pose, pan, tilt, top)
+            counts += times * self._top_in_view(obj.position[:2], pose, pan, tilt, _top(obj))
         return self._share(counts.tolist())
 
     def _top_in_view(self, centre: tuple[float, float], pose: tuple[float, float, float],
@@ -231,6 +229,12 @@ class Glimpses:
         blocked = ~clear & tail
         after_block = np.maximum.accumulate(blocked, axis=1)
         return np.all(clear | ~before, axis=1) & ~np.any(after_block & clear & tail, axis=1)
+
+
+def _top(obj: KnownObject) -> float:
+    """The height of a known support's top: the executor's rule, its detected centre is
+    half-way up."""
+    return 2.0 * obj.position[2]
 
 
 def _disc_points(radius: float, spacing_share: float = 1.0 / 3.0) -> np.ndarray:

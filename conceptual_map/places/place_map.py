@@ -76,10 +76,8 @@ class PlaceMap:
         points = self._trajectory(poses)
         events += self._grow_places(grid, points, time)
         events += self._find_doors(grid, points, time)
-        self._check_walls(grid)
-        self._mark_door_edges()
         events += self._refresh_placeholders(grid, poses[-1][:2], time)
-        events += self._refresh_rooms(grid, time)
+        events += self._refresh_rooms(grid, time)  # marks the door edges first
         return events
 
     def refresh(self, grid: OccupancyGrid, time: float = 0.0) -> list[MapEvent]:

@@ -8,7 +8,7 @@ episode gives up when no plan reaches the success threshold.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -92,7 +92,7 @@ class LoopConfig:
         pairs = [(executor.config, self.executor_config(executor.config)),
                  (builder.config, self.builder_config(builder.config))]
         return [f"{f}={getattr(have, f)!r} (the loop's settings say {getattr(want, f)!r})"
-                for have, want in pairs for f in have.__dataclass_fields__
+                for have, want in pairs for f in (x.name for x in fields(have))
                 if getattr(have, f) != getattr(want, f)]
 
 
