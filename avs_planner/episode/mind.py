@@ -236,7 +236,13 @@ class Mind:
                  p_detect: float) -> None:
         """A DT search looked through `coverage` of a location: the `label` objects not seen
         there are Poisson(lambda x remaining), whatever it found (Poisson thinning)."""
-        where = RelatedSpace(relation, location) if relation == "on" else location
+        if relation == "on":
+            where: str | RelatedSpace = RelatedSpace(relation, location)
+        else:
+            room = self.cmap.current_room(location)
+            if room is None:  # the map removed the room while the search ran: nothing to
+                return        # attach what it saw to (a merged room passes it to its heir)
+            where = room
         self.cmap.observe_search(label, where, min(1.0, coverage), p_detect)
 
     def _drop_stale_objects(self) -> None:

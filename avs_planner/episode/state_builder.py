@@ -19,7 +19,6 @@ from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.viewcones import p_at_support, support_spaces
 from avs_planner.pddl import ProbabilisticProblem
-from conceptual_map.conceptual import p_at_least_one
 
 RELATIONS = ("in", "on")
 
@@ -59,10 +58,13 @@ class BuilderConfig:
     # a search is given (up to 6 in a room, 4 around a support: `episode/viewcones.py`),
     # each a drive of `cone_spacing` m, a quarter turn and two frames (a look is two
     # detections). Without a body, the seed's numbers above, in its own units.
-    # Off by default (strategy option `seconds`): on development office worlds 0-7 (24
-    # episodes) it found 14/16 present objects but gave up on 4/8 absent ones within the
-    # budget, against 12/16 and 8/8 with the seed's costs; neither meets both targets.
-    seconds: bool = False
+    # On by default since each building's rate is learnt (conceptual_map/.../existence.py):
+    # with the seed's units a room search (120) for p = 0.5 x P(in room) is worth R = 500
+    # only where P > 0.54, and Fig. 3f (development seeds 0-19) gave up 5 times in 20 once
+    # one office searched in vain lowered P(markers in the other); priced in seconds, 2 in
+    # 20, each after the marker's own room was searched and missed. Before that it was off:
+    # with exact lambdas it found as many objects but gave up on fewer absent ones.
+    seconds: bool = True
     cone_spacing: tuple[float, float] = (2.0, 1.5)  # m between cones: in a room, on a support
     cones_per_search: tuple[int, int] = (6, 4)
 
@@ -332,7 +334,7 @@ class StateBuilder:
                 values[("p-placeholder-category", pid, c)] = self._prune(belief.get(c, 0.0))
         knowledge = cmap.knowledge
         for label in self.labels:
-            prior = p_at_least_one(knowledge.total_room_lambda(label))
+            prior = cmap.p_any(label, knowledge.total_room_lambda(label))
             for rid in [*rooms, *self._virtual("new-room", self.config.virtual_rooms)]:
                 # a known room: the target outside its known supports (their share is in
                 # p-find-on), the supports not found yet counted by the looks for them
@@ -365,7 +367,7 @@ class StateBuilder:
         if support not in knowledge.support_relations(self.task.target):
             return False
         lam = knowledge.support_lambda(self.task.target, support)
-        p = float(p_at_least_one(lam[knowledge.category_index(category)]))
+        p = float(self.mind.cmap.p_any(self.task.target, lam[knowledge.category_index(category)]))
         return p >= self.config.min_probability
 
     def _prune(self, p: float) -> float:
@@ -439,7 +441,7 @@ class StateBuilder:
                 or not cmap.graph.has_room(obj.room):
             return 1.0
         lam = cmap.knowledge.support_lambda(label, obj.label)
-        prior = float(cmap.room_marginal(obj.room) @ p_at_least_one(lam))
+        prior = float(cmap.room_marginal(obj.room) @ cmap.p_any(label, lam))
         if prior <= 0.0:
             return 1.0
         return min(1.0, p_at_support(self.mind, label, oid) / prior)
@@ -494,7 +496,8 @@ class StateBuilder:
         return round((prior + sum(timed)) / (1 + len(timed)), 3)
 
     def _statics(self, values: dict[Atom, float]) -> None:
-        knowledge, cfg = self.mind.cmap.knowledge, self.config
+        cmap, cfg = self.mind.cmap, self.config
+        knowledge = cmap.knowledge
         for label in self.labels:
             target = label == self.task.target
             detect = cfg.target_detect if target else cfg.support_detect
@@ -504,7 +507,7 @@ class StateBuilder:
             supports = knowledge.support_relations(label)
             for support in self.labels:
                 # on it and in it (`support_lambda`: zeros where the knowledge lists neither)
-                p = p_at_least_one(knowledge.support_lambda(label, support)) \
+                p = cmap.p_any(label, knowledge.support_lambda(label, support)) \
                     if support in supports else np.zeros(len(knowledge.categories))
                 for c in self._current_categories:
                     k = knowledge.category_index(c)

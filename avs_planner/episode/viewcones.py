@@ -90,7 +90,7 @@ def support_spaces(mind: Mind, label: str, oid: str) -> list[RelatedSpace]:
 
 def p_at_support(mind: Mind, label: str, oid: str) -> float:
     """P(at least one `label` on or in the known object `oid`, where the knowledge lists it),
-    after the looks so far: the Poisson lambdas left in its spaces add up under each room
+    after the looks so far: the lambdas left in its spaces add up under each room
     category before the category belief averages them (one space: the conceptual map's
     `p_object_at` of it)."""
     cmap = mind.cmap
@@ -99,9 +99,9 @@ def p_at_support(mind: Mind, label: str, oid: str) -> float:
                  for space in spaces]
     if len(per_space) == 1:
         return cmap.p_object_at(label, spaces[0], include_sublocations=False)
-    lam = sum(-np.log1p(-np.clip(p, 0.0, 1.0 - 1e-12)) for p in per_space)
+    lam = sum(cmap.mass(label, p) for p in per_space)
     room = cmap.objects.objects[oid].room
-    return float(cmap.room_marginal(room) @ (1.0 - np.exp(-lam)))
+    return float(cmap.room_marginal(room) @ cmap.p_any(label, lam))
 
 
 def aim_height(top: float, relations: tuple[str, ...]) -> float:

@@ -20,7 +20,6 @@ from avs_planner.episode.mind import KnownObject
 from avs_planner.episode.outcome import Outcome, SearchResult, StepStatus
 from avs_planner.strategies.context import SearchContext
 from avs_planner.strategies.looking import look_all_round
-from conceptual_map.conceptual import p_at_least_one
 from conceptual_map.metric import distance_field
 
 MAX_SWEEP_STOPS = 12  # standpoints per room sweep
@@ -107,7 +106,7 @@ def most_likely(ctx: SearchContext, swept: set[str]) -> tuple[str, str, float] |
     """The unswept room or untried placeholder with the highest P(target there)."""
     mind = ctx.mind
     cmap, pm = mind.cmap, mind.place_map
-    p_category = p_at_least_one(cmap.knowledge.total_room_lambda(ctx.target))
+    p_category = cmap.p_any(ctx.target, cmap.knowledge.total_room_lambda(ctx.target))
     names = cmap.knowledge.categories
     best: tuple[str, str, float] | None = None
     for rid in pm.rooms:

@@ -5,6 +5,17 @@ locations are independent, so lambdas add over a location and its sub-locations.
 covers a fraction `coverage` of L with detector reliability `p_detect` finds each object with
 q = coverage * p_detect; after failed searches the undetected count is Poisson(lambda * r) with
 r = prod(1 - q_i), and the failures have likelihood exp(-lambda * (1 - r)) (Poisson thinning).
+
+The lambdas are hand-set for buildings in general; one building may hold far fewer staplers
+than they say, or none. With a `rate_shape` a in the knowledge, a label's counts in this
+building are Poisson(s * lambda) with one multiplier s ~ Gamma(a, a) (mean 1) shared by all
+its locations. Finding n of them after looks that would have seen an expected E (the looked-at
+part of every location's lambda, over the category belief) leaves s ~ Gamma(a + n, a + E),
+and the count in an unseen expected mass m is negative binomial:
+P(n >= 1) = 1 - (beta / (beta + m))^alpha (`RatePosterior`). So six offices searched in vain
+make a stapler in the seventh less likely, which independent counts per room never do (the
+gamma-Poisson mixture; the count models of Göbelbecker et al., "A Planning Approach to Active
+Visual Search in Large Environments", with the rate itself uncertain).
 """
 
 from __future__ import annotations
@@ -56,6 +67,36 @@ def p_at_least_one(lam: np.ndarray | float) -> np.ndarray:
 def p_at_least(k: int, lam: np.ndarray | float) -> np.ndarray:
     """P(n >= k) for n ~ Poisson(lambda)."""
     return np.asarray(poisson.sf(k - 1, np.asarray(lam, dtype=float)), dtype=float)
+
+
+@dataclass(frozen=True)
+class RatePosterior:
+    """What one building's evidence says of a label's rate multiplier: Gamma(alpha, beta)."""
+
+    alpha: float
+    beta: float
+
+    @classmethod
+    def after(cls, shape: float, found: int, exposure: float) -> RatePosterior:
+        """Gamma(a, a) prior; `found` objects seen where looks had expected `exposure`."""
+        return cls(shape + found, shape + max(0.0, exposure))
+
+    @property
+    def mean(self) -> float:
+        return self.alpha / self.beta
+
+    def p_any(self, lam: np.ndarray | float) -> np.ndarray:
+        """P(n >= 1) for n ~ Poisson(s * lam), s ~ this posterior (negative binomial)."""
+        lam = np.asarray(lam, dtype=float)
+        return -np.expm1(-self.alpha * np.log1p(lam / self.beta))
+
+    def p_none(self, lam: np.ndarray | float) -> np.ndarray:
+        return 1.0 - self.p_any(lam)
+
+    def mass(self, p: np.ndarray | float) -> np.ndarray:
+        """The expected count whose `p_any` is `p` (its inverse): masses add, p's do not."""
+        p = np.clip(np.asarray(p, dtype=float), 0.0, 1.0 - 1e-12)
+        return self.beta * np.expm1(-np.log1p(-p) / self.alpha)
 
 
 def failed_search_likelihood(lam: np.ndarray | float, remaining: float) -> np.ndarray:
@@ -198,10 +239,50 @@ class ObjectLedger:
         for (lab, _relation, support), lam in knowledge.relation_lambda.items():
             if lab != label:
                 continue
-            looked = (room, support) in self._remaining or (room, support) in self._glimpsed
+            looked = self._looked_for(room, support)
             unseen = self.remaining(room, support if looked else label)
             total = total + knowledge.room_lambda(support) * unseen * lam
         return total
+
+    def searched_lambda(self, label: str, room: str) -> np.ndarray:
+        """Per category, the expected count of `label` in `room` that the looks for it there
+        would have seen: the exposure of the building's rate to this room's evidence. It is
+        the part of the prior count that `unsearched_lambda` thins by looks for `label`
+        itself: the room, supports not found yet while nothing has looked for their label
+        (once something has, their unseen count is thinned by those looks, which test how
+        many supports there are, not how many `label`s they hold), and the spaces of known
+        supports."""
+        self.require_label(label)
+        knowledge = self.knowledge
+        seen = 1.0 - self.remaining(room, label)
+        total = knowledge.room_lambda(label) * seen
+        for (lab, _relation, support), lam in knowledge.relation_lambda.items():
+            if lab == label and not self._looked_for(room, support):
+                total = total + knowledge.room_lambda(support) * seen * lam
+        for space in self.sublocations(room, label):
+            total = total + self.location_lambda(label, space) * (
+                1.0 - self.remaining(space, label))
+        return total
+
+    def _looked_for(self, room: str, label: str) -> bool:
+        return (room, label) in self._remaining or (room, label) in self._glimpsed
+
+    def looked_rooms(self, label: str) -> set[str]:
+        """Rooms where some look for `label` was recorded (searches, glimpses)."""
+        rooms = set()
+        for loc, lab in (*self._remaining, *self._glimpsed):
+            if lab != label:
+                continue
+            if isinstance(loc, RelatedSpace):
+                holder = self.objects.get(loc.object_id)
+                if holder is not None:  # a support taken back as a false detection: gone
+                    rooms.add(holder.room)
+            else:
+                rooms.add(loc)
+        return rooms
+
+    def found(self, label: str) -> int:
+        return sum(1 for r in self.objects.values() if r.label == label)
 
     def unsearched_lambda(self, label: str, room: str) -> np.ndarray:
         """Per category, the expected count of `label` in `room` that no look has ruled out:

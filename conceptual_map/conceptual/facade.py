@@ -19,6 +19,7 @@ from conceptual_map.conceptual.errors import ConceptualError
 from conceptual_map.conceptual.existence import (
     Location,
     ObjectLedger,
+    RatePosterior,
     RelatedSpace,
     p_at_least_one,
 )
@@ -47,6 +48,8 @@ class ConceptualMap:
         self._messages: dict[tuple[str, str], np.ndarray] = {}
         self._dirty = True
         self.last_result: BPResult | None = None
+        self._rates: dict[str, tuple[BPResult, RatePosterior]] = {}
+        self._merged: dict[str, str] = {}  # a merged room -> the room that took it
 
     # -- structure events ------------------------------------------------------------------
 
@@ -75,6 +78,7 @@ class ConceptualMap:
         """Two rooms turned out to be one: `gone`'s places, links, objects move to `keep`."""
         self.graph.merge_rooms(keep, gone)
         self.objects.move_room(gone, keep)
+        self._merged[gone] = keep
         for ph, evidence in self._placeholders.items():
             if evidence.room == gone:
                 self._placeholders[ph] = PlaceholderEvidence(
@@ -93,6 +97,17 @@ class ConceptualMap:
         for ph in [ph for ph, ev in self._placeholders.items() if ev.room == room]:
             del self._placeholders[ph]
         self._dirty = True
+
+    def current_room(self, room: str) -> str | None:
+        """The room `room` is now: itself, the room it was merged into (a search that began
+        in it may end after the map merged it), or None if it was removed."""
+        seen = set()
+        while not self.graph.has_room(room):
+            if room in seen or room not in self._merged:
+                return None
+            seen.add(room)
+            room = self._merged[room]
+        return room
 
     # -- placeholders ----------------------------------------------------------------------
 
@@ -172,8 +187,9 @@ class ConceptualMap:
         self, label: str, location: Location | tuple[str, str], coverage: float, p_detect: float
     ) -> None:
         """A search for `label` looked through `coverage` of `location` (x detection
-        probability); if nothing was found it is also evidence about the room's category."""
-        location = _as_location(location)
+        probability); if nothing was found it is also evidence about the room's category.
+        A room merged since is the room that took it (`current_room`)."""
+        location = self._current(_as_location(location))
         self.objects.record_search(label, location, coverage, p_detect)
         self._refresh_object_evidence(self._room_of(location))
 
@@ -182,9 +198,14 @@ class ConceptualMap:
     ) -> None:
         """Frames taken in passing have looked at `share` of `location` (x detection
         probability) without seeing `label`; replaces the last share given for it."""
-        location = _as_location(location)
+        location = self._current(_as_location(location))
         self.objects.record_glimpses(label, location, share)
         self._refresh_object_evidence(self._room_of(location))
+
+    def _current(self, location: Location) -> Location:
+        if isinstance(location, str):
+            return self.current_room(location) or location  # removed: require_room names it
+        return location
 
     def _refresh_object_evidence(self, room: str) -> None:
         self.graph.set_room_evidence(room, self.objects.room_likelihood(room))
@@ -245,6 +266,40 @@ class ConceptualMap:
         prediction = self.placeholder_prediction(placeholder)
         return {**prediction.any_room, NO_NEW_ROOM: prediction.no_new_room}
 
+    # -- existence ---------------------------------------------------------------------------
+
+    def rate_posterior(self, label: str) -> RatePosterior | None:
+        """This building's rate multiplier for `label` after everything seen (None when the
+        knowledge takes its lambdas as exact): Gamma(a + found, a + exposure), the exposure
+        being what the looks for `label` would have seen, over each room's category belief
+        (`ObjectLedger.searched_lambda`)."""
+        shape = self.knowledge.rate_shape
+        if shape is None:
+            return None
+        result = self.update()
+        cached = self._rates.get(label)
+        if cached is not None and cached[0] is result:
+            return cached[1]
+        exposure = sum(float(self.room_marginal(room) @ self.objects.searched_lambda(label, room))
+                       for room in self.objects.looked_rooms(label) if self.graph.has_room(room))
+        posterior = RatePosterior.after(shape, self.objects.found(label), exposure)
+        self._rates[label] = (result, posterior)
+        return posterior
+
+    def p_any(self, label: str, lam: np.ndarray | float) -> np.ndarray:
+        """P(at least one `label`) where the knowledge expects `lam` of them, in this building
+        (Poisson when the lambdas are exact, else negative binomial: `rate_posterior`)."""
+        posterior = self.rate_posterior(label)
+        return p_at_least_one(lam) if posterior is None else posterior.p_any(lam)
+
+    def mass(self, label: str, p: np.ndarray | float) -> np.ndarray:
+        """The expected count whose `p_any` is `p`: to add the probabilities of disjoint
+        spaces, add their masses (under a shared rate they are not independent)."""
+        posterior = self.rate_posterior(label)
+        if posterior is None:
+            return -np.log1p(-np.clip(np.asarray(p, dtype=float), 0.0, 1.0 - 1e-12))
+        return posterior.mass(p)
+
     def p_object_at(
         self, label: str, location: Location | tuple[str, str], include_sublocations: bool = True
     ) -> float:
@@ -258,7 +313,7 @@ class ConceptualMap:
         residual = self._residual(label, location, include_sublocations)
         if residual is None:
             return 1.0
-        return float(self.room_marginal(self._room_of(location)) @ p_at_least_one(residual))
+        return float(self.room_marginal(self._room_of(location)) @ self.p_any(label, residual))
 
     def p_object_at_per_category(
         self, label: str, location: Location | tuple[str, str], include_sublocations: bool = True
@@ -268,7 +323,7 @@ class ConceptualMap:
         residual = self._residual(label, _as_location(location), include_sublocations)
         if residual is None:
             return np.ones(len(self.knowledge.categories))
-        return p_at_least_one(residual)
+        return self.p_any(label, residual)
 
     def _residual(self, label: str, location: Location, include_sublocations: bool
                   ) -> np.ndarray | None:
@@ -291,7 +346,7 @@ class ConceptualMap:
         found yet, after the looks so far (`ObjectLedger.unexplained_lambda`). Objects of
         `label` already found do not count: this is about one more."""
         self.graph.require_room(room)
-        return p_at_least_one(self.objects.unexplained_lambda(label, room))
+        return self.p_any(label, self.objects.unexplained_lambda(label, room))
 
     def p_unsearched(self, label: str, room: str) -> float:
         """P(at least one `label` in `room` where no look has ruled it out: the room, its
@@ -299,14 +354,16 @@ class ConceptualMap:
         The building-level stopping rule sums this over rooms and placeholders."""
         self.graph.require_room(room)
         lam = self.objects.unsearched_lambda(label, room)
-        return float(self.room_marginal(room) @ p_at_least_one(lam))
+        return float(self.room_marginal(room) @ self.p_any(label, lam))
 
     def p_beyond_placeholder(self, label: str, placeholder: str) -> float:
         """P(at least one `label` in the new rooms a placeholder may lead to)
         (`placeholders.p_label_beyond`: the exploration hypotheses and their categories)."""
         evidence = self._placeholder(placeholder)
+        posterior = self.rate_posterior(label)
         return p_label_beyond(self.knowledge, self.room_marginal(evidence.room), evidence,
-                              self.objects.fresh_room_lambda(label))
+                              self.objects.fresh_room_lambda(label),
+                              None if posterior is None else posterior.p_none)
 
     def p_object_at_category(
         self, label: str, category: str, support_label: str | None = None, relation: str = "on"
@@ -320,7 +377,7 @@ class ConceptualMap:
                 lam = self.knowledge.relation_lambda_of(label, relation, support_label)
         except KeyError as exc:
             raise ConceptualError(str(exc.args[0])) from None
-        return float(p_at_least_one(lam[column]))
+        return float(self.p_any(label, lam[column]))
 
     def factors(
         self, explicit_properties: bool = False, merged: bool = False

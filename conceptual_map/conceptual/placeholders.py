@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import enum
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from types import MappingProxyType
 
@@ -139,16 +140,19 @@ def _two_rooms(knowledge: Knowledge, room_marginal: np.ndarray) -> tuple[np.ndar
 
 def p_label_beyond(
     knowledge: Knowledge, room_marginal: np.ndarray, evidence: PlaceholderEvidence,
-    room_lambda: np.ndarray,
+    room_lambda: np.ndarray, p_none: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> float:
     """P(at least one object in the new rooms behind the placeholder), where a new room of
     category c holds Poisson(`room_lambda[c]`) of them: each hypothesis's rooms with their
-    category posterior (one room, or the chain N1 - N2 jointly), weighted as in `predict`."""
+    category posterior (one room, or the chain N1 - N2 jointly), weighted as in `predict`.
+    `p_none(m)`: P(no object where m are expected), exp(-m) unless the building's rate is
+    uncertain (`ConceptualMap.rate_posterior`); two rooms share it, so their masses add."""
+    none_of = p_none or (lambda m: np.exp(-m))
     weights = hypothesis_weights(knowledge.placeholder, evidence)
-    none = np.exp(-np.asarray(room_lambda, dtype=float))
-    one = 1.0 - float(_one_room(knowledge, room_marginal) @ none)
+    lam = np.asarray(room_lambda, dtype=float)
+    one = 1.0 - float(_one_room(knowledge, room_marginal) @ none_of(lam))
     phi, prior = knowledge.connectivity, knowledge.prior
     joint = (prior * (room_marginal @ phi))[:, None] * phi * prior[None, :]
-    two = 1.0 - float(none @ (joint / joint.sum()) @ none)
+    two = 1.0 - float(np.sum(joint / joint.sum() * none_of(lam[:, None] + lam[None, :])))
     by_rooms = {0: 0.0, 1: one, 2: two}
     return sum(w * by_rooms[h.new_rooms] for h, w in weights.items())

@@ -119,7 +119,7 @@ def parse_knowledge(data: Any, source: str = "<knowledge>") -> Knowledge:
                                                     "objects", "relations", "placeholders"},
                 optional={"version", "unknown_labels"})
     categories, prior = _categories(reader, root["categories"])
-    object_lambda, default_object = _objects(reader, root["objects"], categories)
+    object_lambda, default_object, rate_shape = _objects(reader, root["objects"], categories)
     relation_lambda, default_relation = _relations(
         reader, root["relations"], categories, frozenset(object_lambda)
     )
@@ -135,6 +135,7 @@ def parse_knowledge(data: Any, source: str = "<knowledge>") -> Knowledge:
         default_relation_lambda=default_relation,
         placeholder=_placeholder(reader, root["placeholders"]),
         unknown=_unknown_labels(reader, root.get("unknown_labels"), frozenset(object_lambda)),
+        rate_shape=rate_shape,
     )
 
 
@@ -226,16 +227,19 @@ def _connectivity(reader: _Reader, value: Any, categories: tuple[str, ...]) -> n
 
 def _objects(
     reader: _Reader, value: Any, categories: tuple[str, ...]
-) -> tuple[dict[str, np.ndarray], float]:
+) -> tuple[dict[str, np.ndarray], float, float | None]:
     spec = reader.mapping(value, "objects")
-    _check_keys(reader, spec, "objects", {"default_lambda", "lambda"}, set())
+    _check_keys(reader, spec, "objects", {"default_lambda", "lambda"}, {"rate_shape"})
     default = reader.number(spec["default_lambda"], "objects.default_lambda", 0.0)
+    shape = spec.get("rate_shape")
+    if shape is not None:
+        shape = reader.positive(shape, "objects.rate_shape")
     table = reader.mapping(spec["lambda"], "objects.lambda")
     lambdas = {
         str(label): reader.category_vector(row, f"objects.lambda.{label}", categories, default)
         for label, row in table.items()
     }
-    return lambdas, default
+    return lambdas, default, shape
 
 
 def _relations(

@@ -63,6 +63,11 @@ class Knowledge:
     default_relation_lambda: float
     placeholder: PlaceholderModel
     unknown: UnknownLabelModel = field(default_factory=UnknownLabelModel)
+    rate_shape: float | None = None
+    """Shape a of the Gamma(a, a) prior on a building's rate multiplier (mean 1): each
+    label's counts in one building are Poisson(s x lambda) with s shared by its rooms, so
+    looks that find nothing lower the expected count everywhere (`conceptual/existence.py`).
+    None: the lambdas are taken as exact (independent Poisson counts per location)."""
     _category_index: dict[str, int] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:

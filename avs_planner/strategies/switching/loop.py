@@ -70,8 +70,9 @@ class LoopConfig:
     glimpses: bool = True
     # directions the detector looks in at each new place (`Executor.look_around`)
     look_headings: int = 6
-    # price moves and searches in the robot's own seconds (`BuilderConfig.seconds`)
-    seconds: bool = False
+    # price moves and searches in the robot's own seconds (`BuilderConfig.seconds`), the
+    # unit R is in (docs/results.md, "Development worlds, 2026-11-28: a building's rate")
+    seconds: bool = True
     # give up when no continuation is worth its cost against the building-level belief
     # (`stopping.py`), not only when no single plan reaches the threshold
     stop_rule: bool = True

@@ -4,7 +4,7 @@ The switching planner's plans each carry one chain of assumptions, so "no plan a
 threshold" says little about the building as a whole, and a plan that explores is never
 judged worth its cost (`SwitchingLoop._worth_it`): a robot looking for something that is not
 there explored every frontier and ran out of time. Here the conceptual map answers for the
-whole building: P(target in space not yet searched | everything seen), from its Poisson
+whole building: P(target in space not yet searched | everything seen), from its
 existence model over known rooms (their floors, supports not found yet, the spaces of known
 supports, all thinned by every look, glimpses included) and over what placeholders may lead
 to (the exploration hypotheses of Göbelbecker et al., "A Planning Approach to Active Visual
@@ -105,8 +105,10 @@ def remaining(mind: Mind, builder: StateBuilder, here: tuple[float, float],
         p = cmap.p_beyond_placeholder(label, pid)
         cost = _travel(mind, field_, here, [ph.position]) / speed + search.fresh
         options.append(Option("placeholder", pid, p, cost))
-    none_left = math.prod(1.0 - o.p for o in options)
-    return Remaining(1.0 - none_left, tuple(options))
+    # the spaces are disjoint: their expected counts add (under an uncertain building rate
+    # their probabilities are not independent, so 1 - prod(1 - p) would overstate P)
+    mass = sum(float(cmap.mass(label, o.p)) for o in options)
+    return Remaining(float(cmap.p_any(label, mass)) if options else 0.0, tuple(options))
 
 
 @dataclass(frozen=True)

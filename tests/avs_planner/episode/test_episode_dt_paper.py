@@ -82,8 +82,9 @@ def test_reward_option_reaches_the_dt(tmp_path, monkeypatch) -> None:
         return session(*args, **kwargs)
 
     monkeypatch.setattr(dt_search, "DTSession", recording)
-    code = main(["simulate", "--world", "flap_two_rooms", "--target", "bottle", "--seed", "0",
-                 "--start", "7.5,2.5,3.14", "--option", "reward=777", "--out", str(tmp_path)])
+    # Fig. 3d: the run that searches with the DT (on every development seed)
+    code = main(["simulate", "--scenario", "d", "--seed", "0", "--option", "reward=777",
+                 "--out", str(tmp_path)])
     assert code == 0 and rewards
     assert {(r.miss_penalty, r.false_confirm_penalty) for r in rewards} == {(777.0, 777.0)}
 

@@ -8,7 +8,6 @@ import math
 import re
 from dataclasses import replace
 
-import numpy as np
 import pytest
 
 from avs_planner.dt import ViewCone
@@ -114,9 +113,10 @@ def test_a_searched_support_is_planned_with_what_is_left_on_it(corridor) -> None
     mind.searched("cerealbox", "on", table.id, coverage=0.9, p_detect=0.64)
     after = mind.cmap.p_object_at("cerealbox", where, include_sublocations=False)
     assert 0.0 < after < before
-    # over the prior under the room's category belief now (the failed search moved it too)
+    # over the prior under the room's category belief and the building's cereal-box rate
+    # now (the failed search moved both)
     lam = mind.cmap.knowledge.relation_lambda_of("cerealbox", "on", "table")
-    prior = float(mind.cmap.room_marginal(table.room) @ (1.0 - np.exp(-lam)))
+    prior = float(mind.cmap.room_marginal(table.room) @ mind.cmap.p_any("cerealbox", lam))
     found = builder.build().values[("p-find-on", "cerealbox", table.id)]
     assert found == pytest.approx(rate * after / prior, rel=1e-3)
     assert found < rate

@@ -96,3 +96,18 @@ def test_a_look_around_costs_a_full_turn_and_a_frame_per_heading() -> None:
     assert look_cost(None, 6) == 0.0
     assert look_cost(body, 6) == pytest.approx(2.0 * math.pi + 6 * 0.5)
     assert look_cost(body, 1) == pytest.approx(2.0 * math.pi + 2 * 0.5)  # at least two
+
+
+def test_the_building_belief_adds_the_spaces_expected_counts(corridor) -> None:  # noqa: ANN001
+    """The options' spaces are disjoint and share the building's rate: P is that of their
+    summed expected counts, below the independent 1 - prod(1 - p) once looks have lowered the
+    rate (a room searched in vain makes every other less likely too)."""
+    mind, builder, executor = corridor
+    cmap, label = mind.cmap, builder.task.target
+    for rid in mind.place_map.rooms:
+        cmap.observe_search(label, rid, coverage=0.9, p_detect=0.9)
+    belief = remaining(mind, builder, executor.robot.pose[:2])
+    masses = sum(float(cmap.mass(label, o.p)) for o in belief.options)
+    assert belief.p == pytest.approx(float(cmap.p_any(label, masses)))
+    assert cmap.rate_posterior(label).beta > cmap.knowledge.rate_shape  # the looks count
+    assert belief.p < 1.0 - math.prod(1.0 - o.p for o in belief.options)

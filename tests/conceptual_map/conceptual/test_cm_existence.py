@@ -1,6 +1,10 @@
-"""Object existence: Poisson probabilities, hierarchical sums, Bayes after failed searches."""
+"""Object existence: Poisson probabilities, hierarchical sums, Bayes after failed searches.
+
+With the lambdas taken as exact (`rate_shape` None); the uncertain building rate is tested in
+test_cm_building_rate.py."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -8,6 +12,8 @@ from scipy.stats import poisson
 
 from conceptual_map.conceptual import ConceptualError, ConceptualMap, RelatedSpace, p_at_least_one
 from conceptual_map.knowledge import load_knowledge
+
+EXACT = replace(load_knowledge(), rate_shape=None)
 
 
 def _posterior_by_enumeration(prior: np.ndarray, lam: np.ndarray, detect: list[float]) -> float:
@@ -25,7 +31,7 @@ def test_p_at_least_one_is_one_minus_exp_minus_lambda():
 
 @pytest.mark.parametrize("searches", [[(0.5, 0.8)], [(0.9, 0.8)], [(0.5, 0.8), (0.7, 0.9)]])
 def test_failed_search_posterior_is_bayes_rule(searches):
-    cmap = ConceptualMap()
+    cmap = ConceptualMap(EXACT)
     cmap.add_room("kitchen1")
     prior_p = cmap.p_object_at("table", "kitchen1", include_sublocations=False)
     for coverage, p_detect in searches:
@@ -40,7 +46,7 @@ def test_failed_search_posterior_is_bayes_rule(searches):
 
 
 def test_failed_search_is_also_evidence_about_the_room_category():
-    cmap = ConceptualMap()
+    cmap = ConceptualMap(EXACT)
     cmap.add_room("r")
     before = cmap.room_category("r")["kitchen"]
     cmap.observe_search("counter", "r", coverage=1.0, p_detect=0.9)
@@ -48,7 +54,7 @@ def test_failed_search_is_also_evidence_about_the_room_category():
 
 
 def test_repeated_searches_of_a_table_keep_lowering_the_probability():
-    cmap = ConceptualMap()
+    cmap = ConceptualMap(EXACT)
     cmap.add_place("p", "k")
     cmap.observe_property("p", "appearance", "kitchen_like")
     table = cmap.observe_object("table", "k")
@@ -61,7 +67,7 @@ def test_repeated_searches_of_a_table_keep_lowering_the_probability():
 
 
 def test_room_probability_adds_lambdas_of_its_related_spaces():
-    cmap = ConceptualMap()
+    cmap = ConceptualMap(EXACT)
     cmap.add_room("r")
     table = cmap.observe_object("table", "r")
     shelf = cmap.observe_object("shelf", "r")
@@ -79,7 +85,7 @@ def test_room_probability_adds_lambdas_of_its_related_spaces():
 
 
 def test_a_detected_object_makes_its_location_certain():
-    cmap = ConceptualMap()
+    cmap = ConceptualMap(EXACT)
     cmap.add_room("r")
     table = cmap.observe_object("table", "r")
     cmap.observe_object("cup", "r", on=table)
@@ -89,7 +95,7 @@ def test_a_detected_object_makes_its_location_certain():
 
 
 def test_abstract_location_probabilities_come_from_default_knowledge():
-    cmap = ConceptualMap()
+    cmap = ConceptualMap(EXACT)
     knowledge = load_knowledge()
     kitchen = knowledge.category_index("kitchen")
     assert cmap.p_object_at_category("table", "kitchen") == pytest.approx(
@@ -117,7 +123,7 @@ def test_abstract_location_probabilities_come_from_default_knowledge():
     ],
 )
 def test_bad_object_input_raises_clear_errors(action, message):
-    cmap = ConceptualMap()
+    cmap = ConceptualMap(EXACT)
     cmap.add_room("r")
     cmap.observe_object("table", "r")
     with pytest.raises(ConceptualError, match=message):
@@ -127,7 +133,7 @@ def test_bad_object_input_raises_clear_errors(action, message):
 def test_a_forgotten_object_leaves_the_beliefs_as_if_never_seen():
     """A detection that proved false is taken back: room category beliefs return to what
     they were before it, and a support still holding an object cannot be forgotten."""
-    cmap = ConceptualMap()
+    cmap = ConceptualMap(EXACT)
     cmap.add_room("room1")
     before = cmap.room_category("room1")
     oid = cmap.observe_object("cerealbox", "room1")
@@ -149,7 +155,7 @@ def test_the_room_hypothesis_counts_supports_not_found_yet_not_the_prior_number(
     lambda. A room whose desks were all looked for, and found, no longer holds the prior
     number of desks' worth of keyboards (which kept a searched office worth another room
     search: the known desks' keyboards are in their own `on` spaces)."""
-    cmap = ConceptualMap()
+    cmap = ConceptualMap(EXACT)
     cmap.add_room("office1")
     knowledge = cmap.knowledge
     prior = cmap.p_object_in_room_per_category("keyboard", "office1")
@@ -167,3 +173,21 @@ def test_the_room_hypothesis_counts_supports_not_found_yet_not_the_prior_number(
     thinned = cmap.p_object_in_room_per_category("keyboard", "office1")
     np.testing.assert_allclose(thinned, p_at_least_one(
         expected - 0.5 * knowledge.room_lambda("keyboard")))
+
+
+def test_a_search_that_ends_after_its_room_was_merged_counts_for_the_room_that_took_it():
+    """The map may merge the room a DT search began in before the search ends (a door
+    hypothesis dropped): its evidence goes to the merged room, not to an unknown room."""
+    cmap = ConceptualMap(EXACT)
+    cmap.add_room("room1")
+    cmap.add_room("room10")
+    cmap.merge_rooms("room1", "room10")
+    before = cmap.p_object_at("cerealbox", "room1")
+    cmap.observe_search("cerealbox", "room10", coverage=0.9, p_detect=0.9)
+    assert cmap.current_room("room10") == "room1"
+    assert cmap.p_object_at("cerealbox", "room1") < before
+    cmap.add_room("room2")
+    cmap.remove_room("room2")
+    assert cmap.current_room("room2") is None
+    with pytest.raises(ConceptualError, match="unknown room 'room2'"):
+        cmap.observe_search("cerealbox", "room2", coverage=0.9, p_detect=0.9)

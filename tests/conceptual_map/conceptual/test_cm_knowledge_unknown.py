@@ -28,8 +28,9 @@ def test_an_unknown_label_gets_the_same_rate_in_every_category_spread_over_suppo
     assert with_bottle.category_index("office") == knowledge.category_index("office")
     assert knowledge.with_label("cup") is knowledge  # listed: unchanged
     cmap = ConceptualMap(with_bottle)  # the conceptual map takes it as any label
-    cmap.graph.add_room("r")
-    assert cmap.p_object_at("bottle", "r") == pytest.approx(1 - np.exp(-0.25))
+    cmap.graph.add_room("r")  # a room's own lambda, under the building-rate prior Gamma(a, a)
+    a = with_bottle.rate_shape
+    assert cmap.p_object_at("bottle", "r") == pytest.approx(1 - (a / (a + 0.25)) ** a)
 
 
 def test_the_knowledge_file_sets_the_uninformed_prior(tmp_path):
