@@ -5,6 +5,10 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # unified-planning loads with the reader: import it when the command runs
+    from avs_planner.pddl import Diagnostic
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -15,8 +19,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "check",
         help="lint a domain and its problems",
         description="Report mistakes as FILE:LINE:COL: error|warning: message. "
-        "Exit 0 when there are no errors, 1 otherwise (with --strict, warnings count as "
-        "errors).",
+        "A problem without errors is also read and grounded as `avs plan` does, so what the "
+        "planner refuses there is reported too. Exit 0 when there are no errors, 1 otherwise "
+        "(with --strict, warnings count as errors).",
     )
     parser.add_argument("domain", help="the domain file")
     parser.add_argument("problems", nargs="*", help="problem files to check with it")
@@ -32,6 +37,7 @@ def run(args: argparse.Namespace) -> int:
     from avs_planner.pddl import check
 
     diagnostics = check(args.domain, args.problems)
+    diagnostics += _grounding(args.domain, args.problems, diagnostics)
     if args.strict:
         diagnostics = [d.as_error() for d in diagnostics]
     if args.json:
@@ -43,3 +49,25 @@ def run(args: argparse.Namespace) -> int:
         warnings = len(diagnostics) - errors
         print(f"{errors} error(s), {warnings} warning(s)", file=sys.stderr)
     return 1 if any(d.is_error for d in diagnostics) else 0
+
+
+def _grounding(domain: str, problems: list[str], found: list[Diagnostic]) -> list[Diagnostic]:
+    """What `avs plan` refuses past the checks, found by reading and grounding each problem
+    the checks passed (e.g. more state-dependent effect conditions than a ground action may
+    have: that depends on the objects), at the action's or goal's position."""
+    from avs_planner.cp.grounding import grounding_diagnostics
+    from avs_planner.errors import PddlError
+    from avs_planner.pddl import Diagnostic, read_files
+
+    failed = {d.file for d in found if d.is_error}
+    if domain in failed:
+        return []
+    extra: list[Diagnostic] = []
+    for problem in problems:
+        if problem in failed:
+            continue
+        try:
+            extra += grounding_diagnostics(read_files(domain, problem))
+        except PddlError as exc:  # what unified-planning's reader refuses
+            extra.append(Diagnostic.from_error(exc, "unsupported"))
+    return extra

@@ -27,6 +27,14 @@ _IMPLIES, _FORALL, _EXISTS = OperatorKind.IMPLIES, OperatorKind.FORALL, Operator
 _BOOL, _EQUALS = OperatorKind.BOOL_CONSTANT, OperatorKind.EQUALS
 _PARAM, _VARIABLE, _OBJECT = (OperatorKind.PARAM_EXP, OperatorKind.VARIABLE_EXP,
                               OperatorKind.OBJECT_EXP)
+_TERMS = (_PARAM, _VARIABLE, _OBJECT)
+_COMPARISONS = (OperatorKind.LT, OperatorKind.LE)  # UP reads > and >= as < and <= swapped
+
+
+def unsupported_condition(node: FNode, what: str) -> str:
+    """The message for a condition the grounder cannot take, naming its kind."""
+    return (f"unsupported condition {node} ({what}; conditions are atoms, equality of "
+            "objects, and, or, not, imply, forall and exists)")
 
 
 class FormulaGrounder:
@@ -78,13 +86,16 @@ class FormulaGrounder:
             value = node.bool_constant_value()
             return lambda binding, positive: TRUE if value == positive else FALSE
         if kind is _EQUALS:
+            if not all(a.node_type in _TERMS for a in node.args):
+                raise PlanningError(unsupported_condition(node, "numeric equality"))
             left, right = _term(node.arg(0)), _term(node.arg(1))
 
             def equals(binding, positive):
                 return TRUE if (_value(left, binding) == _value(right, binding)) == positive \
                     else FALSE
             return equals
-        raise PlanningError(f"unsupported condition {node}")
+        what = "a numeric comparison" if kind in _COMPARISONS else kind.name.lower()
+        raise PlanningError(unsupported_condition(node, what))
 
     def _fluent(self, node: FNode) -> _Grounding:
         name = node.fluent().name

@@ -31,7 +31,9 @@ from avs_planner.cp.schema import LiftedSchema, compile_schemas
 from avs_planner.cp.settled import SettledAtoms, settled_atoms
 from avs_planner.cp.structure import GroundStructure, bitset, build_structure
 from avs_planner.cp.task import Atom, GroundTask, TaskArrays, WorldState
-from avs_planner.errors import PlanningError
+from avs_planner.cp.unsupported import UnsupportedError
+from avs_planner.errors import PlanningError, SourcePosition
+from avs_planner.pddl.diagnostics import Diagnostic, Severity
 from avs_planner.pddl.model import ProbabilisticProblem
 
 
@@ -116,33 +118,42 @@ def _goal_literals(problem: Problem) -> tuple[list[tuple[Atom, bool]], bool]:
     naming it. Also whether a part of it can never hold (a `forall` over a false body)."""
     literals: list[tuple[Atom, bool]] = []
     grounder, impossible = None, False
-    for goal in problem.goals:
-        for cond in _flatten(goal):
-            negated = cond.is_not()
-            inner = cond.arg(0) if negated else cond
-            if inner.is_fluent_exp() and all(a.is_object_exp() for a in inner.args):
-                literals.append(((inner.fluent().name, *(a.object().name for a in inner.args)),
-                                 negated))
-                continue
-            if grounder is None:
-                grounder = FormulaGrounder(
-                    frozenset(), set(), lambda t: [o.name for o in problem.objects(t)])
-            try:
-                cnf = grounder.cnf(cond, {})
-            except PlanningError as exc:
-                raise PlanningError(f"unsupported goal condition {cond}: {exc}") from None
-            if cnf == FALSE:
-                impossible = True
-                continue
-            for clause in cnf:
-                if len(clause) != 1:
-                    raise PlanningError(
-                        f"unsupported goal condition {cond}: it grounds to a disjunction "
-                        f"({' or '.join(_literal(a, p) for a, p in sorted(clause))}); goals "
-                        "must ground to a conjunction of literals")
-                (atom, positive), = clause
-                literals.append((atom, not positive))
+    conds = [cond for goal in problem.goals for cond in _flatten(goal)]
+    for part, cond in enumerate(conds):
+        negated = cond.is_not()
+        inner = cond.arg(0) if negated else cond
+        if inner.is_fluent_exp() and all(a.is_object_exp() for a in inner.args):
+            literals.append(((inner.fluent().name, *(a.object().name for a in inner.args)),
+                             negated))
+            continue
+        if grounder is None:
+            grounder = FormulaGrounder(
+                frozenset(), set(), lambda t: [o.name for o in problem.objects(t)])
+        try:
+            cnf = grounder.cnf(cond, {})
+        except PlanningError as exc:
+            raise UnsupportedError(_goal_message(cond, str(exc)),
+                                   goal_part=(part, len(conds))) from None
+        if cnf == FALSE:
+            impossible = True
+            continue
+        for clause in cnf:
+            if len(clause) != 1:
+                raise UnsupportedError(
+                    f"unsupported goal condition {cond}: it grounds to a disjunction "
+                    f"({' or '.join(_literal(a, p) for a, p in sorted(clause))}); goals "
+                    "must ground to a conjunction of literals", goal_part=(part, len(conds)))
+            (atom, positive), = clause
+            literals.append((atom, not positive))
     return literals, impossible
+
+
+def _goal_message(cond: FNode, detail: str) -> str:
+    """`detail` about the goal conjunct `cond`, without naming it twice."""
+    own = f"unsupported condition {cond} "
+    if detail.startswith(own):  # the conjunct itself is the construct refused
+        return "unsupported goal condition " + detail.removeprefix("unsupported condition ")
+    return f"unsupported goal condition {cond}: {detail}"
 
 
 def _literal(atom: Atom, positive: bool) -> str:
@@ -346,9 +357,33 @@ def ground(
     state: WorldState | None = None,
     cache: GroundingCache | None = None,
 ) -> GroundTask:
-    """Ground the task from `state` (default: the problem's :init) into a `GroundTask`."""
+    """Ground the task from `state` (default: the problem's :init) into a `GroundTask`.
+    What it cannot take raises `UnsupportedError` at the action's or goal's position when
+    the task was read from PDDL (the reader's own finding, if it made one)."""
+    if pproblem.not_grounded:
+        first = pproblem.not_grounded[0]
+        raise UnsupportedError(first.message,
+                               position=SourcePosition(first.file, first.line, first.column))
     with gc_paused():
-        return _ground(pproblem, state, cache)
+        try:
+            return _ground(pproblem, state, cache)
+        except UnsupportedError as exc:
+            raise exc.located(pproblem.sources) from None
+
+
+def grounding_diagnostics(pproblem: ProbabilisticProblem) -> list[Diagnostic]:
+    """What grounding the task from its :init refuses (what `avs plan` would stop at after
+    the reader's checks, e.g. more state-dependent effect conditions than a ground action
+    may have), as one error Diagnostic at the action's or goal's position, else []."""
+    try:
+        ground(pproblem, cache=GroundingCache(size=1))
+    except UnsupportedError as exc:
+        where = exc.position or SourcePosition(pproblem.problem_file, 1, 1)
+        return [Diagnostic(where.file, where.line, where.column, Severity.ERROR,
+                           "unsupported", exc.message)]
+    except PlanningError as exc:  # a limit or a value of the problem, not one construct
+        return [Diagnostic(pproblem.problem_file, 1, 1, Severity.ERROR, "grounding", str(exc))]
+    return []
 
 
 def _ground(

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from unified_planning.model import (
+    Action,
     FNode,
     InstantaneousAction,
     MinimizeActionCosts,
@@ -20,6 +21,8 @@ from unified_planning.model import (
 from avs_planner.cp.conditional import CondEffect, compile_effect
 from avs_planner.cp.encoding import VectorExpr, compile_vector
 from avs_planner.cp.encoding import term as _term
+from avs_planner.cp.formulas import unsupported_condition
+from avs_planner.cp.unsupported import in_action
 from avs_planner.errors import PlanningError
 from avs_planner.pddl.model import ProbabilisticProblem
 
@@ -72,6 +75,8 @@ def _split_preconditions(action: InstantaneousAction, static: set[str]) -> dict[
             key = ("s" if atom[0] in static else "d") + ("n" if negated else "p")
             parts[key].append(atom)
         elif inner.is_equals():
+            if not all(a.is_parameter_exp() or a.is_object_exp() for a in inner.args):
+                raise PlanningError(unsupported_condition(inner, "numeric equality"))
             parts["ne" if negated else "eq"].append((_term(inner.arg(0)), _term(inner.arg(1))))
         elif inner.is_bool_constant():
             if inner.bool_constant_value() == negated:
@@ -89,6 +94,9 @@ def _split_effects(action: InstantaneousAction) -> tuple[list, list, list]:
         if eff.is_conditional() or eff.is_forall():
             conditional.append(compile_effect(action.name, eff))
             continue
+        if eff.is_increase() or eff.is_decrease():
+            raise PlanningError(f"action {action.name}: numeric effect {eff} is not supported "
+                                "(numeric fluents are read as costs and probabilities only)")
         if not eff.is_assignment():
             raise PlanningError(f"action {action.name}: unsupported effect {eff}")
         if not eff.fluent.fluent().type.is_bool_type():
@@ -123,25 +131,32 @@ def compile_schemas(
     has_metric = bool(costs)
     schemas = []
     for action in problem.actions:
-        if not isinstance(action, InstantaneousAction):
-            raise PlanningError(f"action {action.name}: only instantaneous actions are supported")
-        parts = _split_preconditions(action, static)
-        add, delete, conditional = _split_effects(action)
-        cost = compile_vector(costs.get(action.name), f"cost of {action.name}",
-                              0.0 if has_metric else 1.0)
-        prob = compile_vector(pproblem.success.get(action.name),
-                              f"success probability of {action.name}", 1.0)
-        schemas.append(
-            LiftedSchema(
-                name=action.name,
-                params=tuple("?" + p.name for p in action.parameters),
-                param_types=tuple(p.type for p in action.parameters),
-                static_pos=tuple(parts["sp"]), static_neg=tuple(parts["sn"]),
-                pre_pos=tuple(parts["dp"]), pre_neg=tuple(parts["dn"]),
-                equal=tuple(parts["eq"]), not_equal=tuple(parts["ne"]),
-                add=tuple(add), delete=tuple(delete),
-                cost=cost, probability=prob, never=bool(parts["never"]),
-                complex=tuple(parts["complex"]), conditional=tuple(conditional),
-            )
-        )
+        try:
+            schemas.append(_compile(pproblem, action, static, costs, has_metric))
+        except PlanningError as exc:  # name the action, so the reader can place it
+            raise in_action(action.name, exc) from None
     return tuple(schemas)
+
+
+def _compile(pproblem: ProbabilisticProblem, action: Action, static: set[str] | frozenset[str],
+             costs: dict[str, FNode], has_metric: bool) -> LiftedSchema:
+    """One action as a `LiftedSchema`; raises PlanningError on what is unsupported."""
+    if not isinstance(action, InstantaneousAction):
+        raise PlanningError(f"action {action.name}: only instantaneous actions are supported")
+    parts = _split_preconditions(action, static)
+    add, delete, conditional = _split_effects(action)
+    cost = compile_vector(costs.get(action.name), f"cost of {action.name}",
+                          0.0 if has_metric else 1.0)
+    prob = compile_vector(pproblem.success.get(action.name),
+                          f"success probability of {action.name}", 1.0)
+    return LiftedSchema(
+        name=action.name,
+        params=tuple("?" + p.name for p in action.parameters),
+        param_types=tuple(p.type for p in action.parameters),
+        static_pos=tuple(parts["sp"]), static_neg=tuple(parts["sn"]),
+        pre_pos=tuple(parts["dp"]), pre_neg=tuple(parts["dn"]),
+        equal=tuple(parts["eq"]), not_equal=tuple(parts["ne"]),
+        add=tuple(add), delete=tuple(delete),
+        cost=cost, probability=prob, never=bool(parts["never"]),
+        complex=tuple(parts["complex"]), conditional=tuple(conditional),
+    )

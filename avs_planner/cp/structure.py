@@ -27,6 +27,7 @@ from avs_planner.cp.formulas import FormulaGrounder
 from avs_planner.cp.schema import LiftedSchema
 from avs_planner.cp.settled import NO_KEY, NOTHING_SETTLED, Key, SettledAtoms
 from avs_planner.cp.task import Atom
+from avs_planner.cp.unsupported import UnsupportedError, in_action
 from avs_planner.errors import PlanningError
 
 try:  # the compiled join, encoding and numbering; the numpy code computes the same
@@ -215,10 +216,14 @@ def _complex_rows(
     else:
         distinct, inverse = np.zeros((1, 0), dtype=np.int64), np.zeros(rows, dtype=np.int64)
     names = space.names
-    grounded = [
-        _ground_cnf(schema, space, formulas, {p: names[i] for p, i in zip(read, ids, strict=True)})
-        for ids in distinct.tolist()
-    ]
+    try:
+        grounded = [
+            _ground_cnf(schema, space, formulas,
+                        {p: names[i] for p, i in zip(read, ids, strict=True)})
+            for ids in distinct.tolist()
+        ]
+    except PlanningError as exc:  # name the action, so the reader can place it
+        raise in_action(schema.name, exc) from None
     keep = np.array([g[0] for g in grounded], dtype=bool)[inverse]
     pos = _pad([g[1] for g in grounded], _PAD_TRUE)[inverse]
     neg = _pad([g[2] for g in grounded], _PAD_NONE)[inverse]
@@ -272,8 +277,8 @@ def expand_conditional(
                             space.names_of)
         except PlanningError as exc:  # name the ground action it is about
             args = " ".join(binding[p] for p in schema.params if p in binding)
-            raise PlanningError(f"action {schema.name}, as ({schema.name} {args}): {exc}"
-                                ) from None
+            raise UnsupportedError(f"action {schema.name}, as ({schema.name} {args}): {exc}",
+                                   action=schema.name) from None
 
     index, found = expand_rows(schema.params, columns, rows, space.names, per_binding)
     pre, neg, add, delete = (a[index] for a in arrays)

@@ -18,6 +18,7 @@ from avs_planner.pddl.problem_checks import NEGATIVE_INIT, check_problem
 from avs_planner.pddl.requirements import check_requirements
 from avs_planner.pddl.sexpr import parse_sexprs
 from avs_planner.pddl.structure import Domain, Report, find_define, read_domain
+from avs_planner.pddl.support import UNSUPPORTED_CONDITION, UNSUPPORTED_EFFECT, check_action
 
 
 @dataclass(frozen=True)
@@ -42,6 +43,9 @@ Source = PddlSource | str | Path
 NAME_CLASH = "name-clash"
 # Warnings about what the reader accepts or repairs (what `avs plan` passes on to the user)
 LENIENT = {"missing-requirement", NAME_CLASH, "duplicate-type", "either-type", NEGATIVE_INIT}
+# Errors about what the planner cannot ground in an action, not about the PDDL: the reader
+# still reads the task (other engines may take it); the planner refuses it at that position
+NOT_GROUNDED = {UNSUPPORTED_CONDITION, UNSUPPORTED_EFFECT}
 
 
 @dataclass(frozen=True)
@@ -53,7 +57,14 @@ class Checked:
 
     @property
     def first_error(self) -> Diagnostic | None:
-        return next((d for d in self.diagnostics if d.is_error), None)
+        """The first error the reader stops at (not one only the planner stops at)."""
+        return next((d for d in self.diagnostics if d.is_error and d.code not in NOT_GROUNDED),
+                    None)
+
+    @property
+    def not_grounded(self) -> tuple[Diagnostic, ...]:
+        """The errors about what the planner cannot ground (`NOT_GROUNDED`)."""
+        return tuple(d for d in self.diagnostics if d.is_error and d.code in NOT_GROUNDED)
 
     @property
     def lenient(self) -> tuple[Diagnostic, ...]:
@@ -126,6 +137,7 @@ def _check_domain(domain: Domain, report: Report, usage: Usage) -> None:
             checker.goal(action.precondition, scope)
         if action.effect is not None:
             checker.effect(action.effect, scope)
+        check_action(action, report)
     for name, node in usage.changed_functions:
         if name in usage.probability_fluents:
             report.add(

@@ -15,9 +15,30 @@ from fractions import Fraction
 
 from unified_planning.model import FNode, Problem
 
+from avs_planner.errors import SourcePosition
 from avs_planner.pddl.diagnostics import Diagnostic
 
 ASSUMPTIVE_PREFIX = "assume-"
+
+
+@dataclass(frozen=True)
+class SourceMap:
+    """Where the reader found each action and the goal, so that what the grounder refuses
+    is named with FILE:LINE:COL (a task built in unified-planning directly has none)."""
+
+    actions: Mapping[str, SourcePosition] = field(default_factory=dict)  # by lower-case name
+    goal: SourcePosition | None = None  # the :goal's formula
+    goal_parts: tuple[SourcePosition, ...] = ()  # its conjuncts, nested `and`s flattened
+
+    def action(self, name: str) -> SourcePosition | None:
+        return self.actions.get(name.lower())
+
+    def goal_part(self, index: int, count: int) -> SourcePosition | None:
+        """Conjunct `index` of `count` (as the grounder flattens the goal): its own position
+        when the text has as many conjuncts, else the goal's."""
+        if count == len(self.goal_parts) and 0 <= index < count:
+            return self.goal_parts[index]
+        return self.goal
 
 
 @dataclass(frozen=True)
@@ -30,6 +51,10 @@ class ProbabilisticProblem:
     problem_file: str = "<problem>"
     # What the reader accepted or repaired (undeclared requirements, shared names, ...)
     warnings: tuple[Diagnostic, ...] = ()
+    sources: SourceMap = field(default_factory=SourceMap)
+    # What the reader's checks found that the planner cannot ground (the reader still reads
+    # it, as unified-planning does); the planner refuses the first, at its position
+    not_grounded: tuple[Diagnostic, ...] = ()
 
     def is_assumptive(self, action_name: str) -> bool:
         """Assumptive actions only set beliefs; the executor does not run them, it watches them."""

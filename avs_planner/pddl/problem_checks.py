@@ -19,8 +19,10 @@ from avs_planner.pddl.structure import (
     find_define,
     read_problem,
 )
+from avs_planner.pddl.support import numeric_conditions, shown
 
 NEGATIVE_INIT = "negative-init"  # a (not ...) in :init: a warning, then ignored
+CONTRADICTORY_INIT = "contradictory-init"  # (not A) and A both in :init: an error
 
 if TYPE_CHECKING:
     from avs_planner.pddl.check import PddlSource
@@ -46,6 +48,7 @@ def check_problem(domain: Domain, source: PddlSource, usage: Usage) -> list[Diag
     if problem.goal is not None:
         FormulaChecker(domain, report, names, usage).goal(problem.goal, {})
         _disjunctive_goal(problem.goal, True, report)
+        numeric_conditions(problem.goal, report, "unsupported-goal", "the goal")
         _goal_true_in_init(problem, values.atoms, report)
     if problem.metric is not None:
         _check_metric(problem.metric, init_checker)
@@ -71,7 +74,10 @@ def _check_header(domain: Domain, problem: Problem, report: Report) -> None:
             f"problem is for domain '{ref.text}' but the domain is '{domain.name.text}'",
         )
     checker = FormulaChecker(domain, report, {}, Usage())
-    taken = set(domain.predicates) | set(domain.functions) | set(domain.actions)
+    taken = {**dict.fromkeys(domain.actions, "an action"),
+             **dict.fromkeys(domain.functions, "a function"),
+             **dict.fromkeys(domain.predicates, "a predicate"),
+             **dict.fromkeys(domain.type_atoms, "a type")}
     object_used = _object_type_used(domain)
     for name, entry in problem.objects.items():
         checker.known_type(entry.type_node, entry.type)
@@ -84,12 +90,12 @@ def _check_header(domain: Domain, problem: Problem, report: Report) -> None:
             )
         if name in domain.constants:
             report.add(entry.atom, "duplicate", f"object '{name}' is already a domain constant")
-        elif name in taken or name in domain.type_atoms:
+        elif name in taken:
             report.add(
                 entry.atom,
                 "name-clash",
-                f"object '{name}' has the same name as a type, predicate, function or action "
-                "(read as Fast Downward reads it: the names live apart)",
+                f"object '{name}' has the same name as {taken[name]} (read as Fast Downward "
+                "reads it: the names live apart)",
                 warning=True,
             )
 
@@ -104,6 +110,8 @@ def _object_type_used(domain: Domain) -> bool:
 
 def _check_init(problem: Problem, checker: FormulaChecker) -> InitValues:
     values = InitValues()
+    positive: dict[GroundAtom, SList] = {}  # each true atom where it is first listed
+    negative: list[tuple[SList, SList]] = []  # (the (not ...), its atom)
     for fact in problem.init:
         if not isinstance(fact, SList) or not fact.items:
             checker.report.add(fact, "syntax", "expected a ground atom or (= (f ...) VALUE)")
@@ -115,15 +123,28 @@ def _check_init(problem: Problem, checker: FormulaChecker) -> InitValues:
                 checker.report.add(fact, "syntax", "expected (not (PREDICATE OBJECT ...))")
                 continue
             checker.atom(inner, {})
-            # as Fast Downward and unified-planning read it: under the closed world a fact
-            # not listed is false, so a negative literal says nothing more
-            checker.report.add(fact, NEGATIVE_INIT, "a negative literal in :init is ignored: "
-                               "under the closed world a fact is false unless listed",
-                               warning=True)
+            negative.append((fact, inner))
         else:
             checker.atom(fact, {})
             values.atoms.add(_ground(fact))
+            positive.setdefault(_ground(fact), fact)
+    for fact, inner in negative:
+        _negative_literal(fact, positive.get(_ground(inner)), checker.report)
     return values
+
+
+def _negative_literal(fact: SList, contradicted: SList | None, report: Report) -> None:
+    """As Fast Downward reads it: under the closed world a fact not listed is false, so a
+    negative literal says nothing more (a warning); one whose atom is also listed true
+    contradicts it (an error naming both places)."""
+    if contradicted is None:
+        report.add(fact, NEGATIVE_INIT, "a negative literal in :init is ignored: under the "
+                   "closed world a fact is false unless listed", warning=True)
+        return
+    report.add(fact, CONTRADICTORY_INIT, f"{shown(fact)} at {report.file}:{fact.line}:"
+               f"{fact.column} contradicts {shown(contradicted)} at {report.file}:"
+               f"{contradicted.line}:{contradicted.column}: :init cannot make an atom both "
+               "true and false")
 
 
 def _init_assignment(fact: SList, checker: FormulaChecker, values: InitValues) -> None:

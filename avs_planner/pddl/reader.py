@@ -19,11 +19,12 @@ from unified_planning.io import PDDLReader
 from unified_planning.model import Action, FNode, Problem
 from unified_planning.shortcuts import get_environment
 
-from avs_planner.errors import PddlError
+from avs_planner.errors import PddlError, SourcePosition
 from avs_planner.pddl.check import NAME_CLASH, PddlSource, check_read
-from avs_planner.pddl.model import ProbabilisticProblem
+from avs_planner.pddl.model import ProbabilisticProblem, SourceMap
 from avs_planner.pddl.probabilistic import translate_domain
 from avs_planner.pddl.sexpr import Atom, Node, SList, is_number, parse_sexprs
+from avs_planner.pddl.structure import Domain, Report, find_define, read_problem
 
 _UP_POSITION = re.compile(r"line:?\s*(\d+),\s*col:?\s*(\d+)", re.IGNORECASE)
 
@@ -62,7 +63,32 @@ def read_text(
         name: _success_expression(problem, name, nodes, domain_name)
         for name, nodes in translation.probabilities.items()
     }
-    return ProbabilisticProblem(problem, success, domain_name, problem_name, checked.lenient)
+    sources = _sources(checked.domain, problem_text, domain_name, problem_name)
+    return ProbabilisticProblem(problem, success, domain_name, problem_name, checked.lenient,
+                                sources, checked.not_grounded)
+
+
+def _sources(domain: Domain | None, problem_text: str, domain_name: str, problem_name: str
+             ) -> SourceMap:
+    """Where each action's name and the goal (and each of its conjuncts) are written."""
+    actions = {} if domain is None else {
+        name: SourcePosition(domain_name, a.atom.line, a.atom.column)
+        for name, a in domain.actions.items()}
+    report = Report(problem_name)  # the text passed the checks: nothing is reported here
+    define = find_define(parse_sexprs(problem_text, problem_name), "problem", report)
+    goal = None if define is None else read_problem(define, report).goal
+    if goal is None:
+        return SourceMap(actions)
+    parts = [SourcePosition(problem_name, n.line, n.column) for n in _conjuncts(goal)]
+    return SourceMap(actions, SourcePosition(problem_name, goal.line, goal.column),
+                     tuple(parts))
+
+
+def _conjuncts(node: Node) -> list[Node]:
+    """The goal's conjuncts with nested `and`s flattened, as the grounder reads them."""
+    if isinstance(node, SList) and node.head() == "and":
+        return [c for child in node.items[1:] for c in _conjuncts(child)]
+    return [node]
 
 
 def apply_repairs(text: str, repairs: list[tuple[int, int, str]]) -> str:

@@ -9,6 +9,7 @@ import pytest
 
 from avs_planner.errors import PddlError
 from avs_planner.pddl import PddlSource, check, read_text
+from avs_planner.pddl.check import NOT_GROUNDED
 
 DATA = Path(__file__).parent / "data"
 DOMAIN = (DATA / "base-domain.pddl").read_text()
@@ -17,6 +18,9 @@ CASES = json.loads((DATA / "broken.json").read_text())
 ERRORS = [c for c in CASES if c.get("severity", "error") == "error"]
 # What the reader accepts, as Fast Downward does, or repairs: a warning, never an error
 LENIENT = [c for c in CASES if c.get("severity") == "warning"]
+# Errors the reader stops at, and those only the planner stops at (the reader still reads)
+READER_ERRORS = [c for c in ERRORS if c["code"] not in NOT_GROUNDED]
+PLANNER_ERRORS = [c for c in ERRORS if c["code"] in NOT_GROUNDED]
 
 
 def mutate(case: dict) -> tuple[str, str, tuple[str, int, int]]:
@@ -63,7 +67,7 @@ def test_reader_reads_on_and_passes_the_warning(case: dict) -> None:
                for w in task.warnings)
 
 
-@pytest.mark.parametrize("case", ERRORS, ids=lambda c: c["name"])
+@pytest.mark.parametrize("case", READER_ERRORS, ids=lambda c: c["name"])
 def test_reader_raises_the_first_error(case: dict) -> None:
     domain, problem, _ = mutate(case)
     found = check(PddlSource("domain.pddl", domain), [PddlSource("problem.pddl", problem)])
@@ -76,3 +80,12 @@ def test_reader_raises_the_first_error(case: dict) -> None:
         first.column,
     )
     assert str(exc.value).startswith(f"{first.file}:{first.line}:{first.column}: ")
+
+
+@pytest.mark.parametrize("case", PLANNER_ERRORS, ids=lambda c: c["name"])
+def test_reader_reads_what_only_the_planner_refuses_and_keeps_where_it_is(case: dict) -> None:
+    domain, problem, where = mutate(case)
+    task = read_text(domain, problem, "domain.pddl", "problem.pddl")
+    assert task.problem.actions
+    assert [(d.file, d.line, d.column, d.code) for d in task.not_grounded] == [
+        (*where, case["code"])]
