@@ -24,6 +24,7 @@ from avs_planner.episode.mind import KnownObject, Mind
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
 from avs_planner.episode.robot_api import Robot
 from avs_planner.episode.state_builder import AvsState, StateBuilder
+from avs_planner.episode.verifying import step_back, verify_distance
 from avs_planner.episode.viewcones import (
     CameraModel,
     ConeSet,
@@ -278,6 +279,26 @@ class Executor(Driving):
                 frames, extended = k + cfg.confirm_extra, True
         return False
 
+    def verify_report(self, obj) -> bool:  # noqa: ANN001 - a known object or a Seen
+        """`verify` from a camera distance where frames agree by accident at most
+        `MAX_ACCIDENTAL` of the time (`episode/verifying.py`): stepping back there first when
+        the robot stands closer and can reach such a spot. Without a body: `verify`."""
+        body = self.mind.body
+        if body is None:
+            return self.verify(obj)
+        x, y, _ = self.robot.pose
+        distance = math.dist((x, y, body.camera_height), obj.position)
+        needed = min(verify_distance(self.config.agree[0], body.hfov, body.vfov),
+                     0.9 * body.detect_range)
+        if distance < needed:
+            stand = step_back(self.mind.grid, self.mind.config.robot_radius, self.robot.pose,
+                              body.camera_height, obj.position, needed)
+            self.emit("action", action="(step-back)", status="start" if stand else "failed",
+                      distance=round(distance, 2), needed=round(needed, 2))
+            if stand is not None:
+                self.drive_to(stand)
+        return self.verify(obj)
+
     def verify(self, obj: KnownObject) -> bool:
         """Face `obj` and look at it: True when one of `verify_frames` frames sees its label
         within `agree` m of where it was found (always True with 0 frames)."""
@@ -378,7 +399,7 @@ class Executor(Driving):
             obj = self.mind.objects.get(step.args[0])
             if obj is None:
                 return StepOutcome(StepStatus.FAILED, f"{step.args[0]} is not a known object")
-            if obj.label == self.builder.task.target and not self.verify(obj):
+            if obj.label == self.builder.task.target and not self.verify_report(obj):
                 # a false detection: forgotten, so the planner searches on without it
                 self.mind.forget_object(obj.id)
                 self.found_sids.pop(obj.id, None)

@@ -2,36 +2,26 @@
 (`Executor.confirm`), verify before reporting (`verify_report`); a confirmed and verified
 detection becomes a known object (the baselines' and FLAP's only way to find).
 
-Why the verification. A phantom (the detector's false positive, `fp_rate` of frames) lands
-where a random ray through the image meets a surface. Frames agree on a spot when they see the
-label within `agree` (0.25 m) of it, and the chance that a phantom does so by accident is the
-share of the view's cross-section at that distance within `agree` of the spot. Two metres
-away that is about 5% of a 60 x 45 degree view; facing a wall 0.4 m away the whole view is
-within 0.25 m of every point on it, so every phantom agrees and "two of three frames" only
-asks for phantoms in two more frames. One search in 50 generated office worlds reported a
-stapler that way (`most-likely-room`, world 23: a phantom at 0.39 m, on the wall in front of
-the robot, repeated in the next two frames). So before a report the robot steps back to where
-agreement means something (`accidental_agreement` at most `MAX_ACCIDENTAL`) when it can
-reach such a spot, faces the detection and looks again (`Executor.verify`: one of
-`verify_frames` frames must see it within `agree`), as the switching loop verifies.
+Why the verification: in frames taken close to a surface, phantoms land within the agreement
+radius of each other (`episode/verifying.py`), so before a report the robot steps back to where agreement means
+something and looks again (`Executor.verify_report`), as the switching loop's REPORTPOSITION
+does.
 """
 
 from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from avs_planner.episode.mind import KnownObject
+from avs_planner.episode.verifying import (  # noqa: F401 - re-exported for the baselines
+    MAX_ACCIDENTAL,
+    accidental_agreement,
+    verify_distance,
+)
 from avs_planner.strategies.context import SearchContext
-from conceptual_map.metric import PathQueryError, distance_field
 
 LOOK_DISTANCE = 2.0  # m: where the camera's centre line meets support height
 SUPPORT_HEIGHT = 0.7  # m: a typical table top
-MAX_ACCIDENTAL = 0.1  # a report's verification must come from where a phantom agrees by
-# chance at most this often (see the module's doc)
-STEP_BACK_TURNS = (0.0, 0.5, -0.5, 1.0, -1.0, 1.5, -1.5)  # rad off the line from the object
-# to the robot, tried in this order for the standpoint of a verification from further away
 
 
 def known_target(ctx: SearchContext) -> KnownObject | None:
@@ -101,62 +91,11 @@ def _look(ctx: SearchContext) -> KnownObject | None:
     return obj if obj is not None and checked(ctx, obj) else None
 
 
-def accidental_agreement(distance: float, agree: float, hfov: float, vfov: float) -> float:
-    """The chance that a phantom in a view lands within `agree` m of a point `distance` m
-    from the camera (the disc's share of the view's cross-section there, at most 1)."""
-    section = 4.0 * distance**2 * math.tan(hfov / 2.0) * math.tan(vfov / 2.0)
-    return 1.0 if section <= 0.0 else min(1.0, math.pi * agree**2 / section)
-
-
-def verify_distance(agree: float, hfov: float, vfov: float,
-                    accidental: float = MAX_ACCIDENTAL) -> float:
-    """The camera distance beyond which `accidental_agreement` is at most `accidental`."""
-    return agree * math.sqrt(math.pi / (4.0 * accidental * math.tan(hfov / 2.0)
-                                        * math.tan(vfov / 2.0)))
-
-
 def verify_report(ctx: SearchContext, seen) -> bool:  # noqa: ANN001 - a Seen or known object
     """Before a confirmed detection is reported: from a camera distance where frames agree by
-    accident at most `MAX_ACCIDENTAL` of the time (stepping back there first when the robot
-    stands closer and can reach such a spot), face it and look again (`Executor.verify`)."""
-    body, ex = ctx.body, ctx.executor
-    agree = ex.config.agree[0]
-    x, y, _ = ctx.robot.pose
-    camera = (x, y, body.camera_height)
-    needed = min(verify_distance(agree, body.hfov, body.vfov), 0.9 * body.detect_range)
-    if math.dist(camera, seen.position) < needed:
-        stand = _step_back(ctx, seen.position, needed)
-        ctx.trace.emit("action", action="(step-back)", status="start" if stand else "failed",
-                       distance=round(math.dist(camera, seen.position), 2),
-                       needed=round(needed, 2))
-        if stand is not None:
-            ex.drive_to(stand)
-    return ex.verify(seen)
-
-
-def _step_back(ctx: SearchContext, position, distance: float  # noqa: ANN001 - xyz
-               ) -> tuple[float, float] | None:
-    """A reachable free spot whose camera is `distance` m from `position`, on the robot's
-    side of it (the line from it to the robot, turned by `STEP_BACK_TURNS` in turn)."""
-    mind, body = ctx.mind, ctx.body
-    grid = mind.grid
-    x, y, _ = ctx.robot.pose
-    dz = body.camera_height - position[2]
-    flat = math.sqrt(max(distance**2 - dz**2, 0.0))
-    if flat <= 0.0:
-        return None
-    try:
-        reach = distance_field(grid, (x, y), mind.config.robot_radius)
-    except PathQueryError:  # the robot off the map: no step back
-        return None
-    away = math.atan2(y - position[1], x - position[0])
-    for turn in STEP_BACK_TURNS:
-        goal = (position[0] + flat * math.cos(away + turn),
-                position[1] + flat * math.sin(away + turn))
-        cell = grid.cell_of(goal)
-        if grid.contains(cell) and np.isfinite(reach[tuple(cell)]):
-            return goal
-    return None
+    accident at most `MAX_ACCIDENTAL` of the time, face it and look again
+    (`Executor.verify_report`, as the switching loop's REPORTPOSITION does)."""
+    return ctx.executor.verify_report(seen)
 
 
 def _confirm(ctx: SearchContext, seen) -> KnownObject | None:  # noqa: ANN001 - a Seen

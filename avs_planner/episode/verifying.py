@@ -1,0 +1,64 @@
+"""Where a report's verification means something: a phantom's chance to agree by accident.
+
+A phantom (the detector's false positive, `fp_rate` of frames) lands where a random ray
+through the image meets a surface. Frames agree on a spot when they see the label within
+`agree` (0.25 m) of it, and the chance that a phantom does so by accident is the share of the
+view's cross-section at that distance within `agree` of the spot. Two metres away that is
+about 5% of a 60 x 45 degree view; facing a wall 0.4 m away the whole view is within 0.25 m
+of every point on it, so every phantom agrees and "two of three frames" only asks for
+phantoms in two more frames (generated office 23, `most-likely-room`: a phantom stapler at
+0.39 m; development apartment 325, the switching planner: a phantom book at 0.49 m). So
+before a report the robot steps back to where agreement means something (at most
+`MAX_ACCIDENTAL`) when it can reach such a spot (`Executor.verify_report`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from conceptual_map.metric import PathQueryError, distance_field
+
+MAX_ACCIDENTAL = 0.1  # a report's verification must come from where a phantom agrees by
+# chance at most this often
+STEP_BACK_TURNS = (0.0, 0.5, -0.5, 1.0, -1.0, 1.5, -1.5)  # rad off the line from the object
+# to the robot, tried in this order for the standpoint of a verification from further away
+
+
+def accidental_agreement(distance: float, agree: float, hfov: float, vfov: float) -> float:
+    """The chance that a phantom in a view lands within `agree` m of a point `distance` m
+    from the camera (the disc's share of the view's cross-section there, at most 1)."""
+    section = 4.0 * distance**2 * math.tan(hfov / 2.0) * math.tan(vfov / 2.0)
+    return 1.0 if section <= 0.0 else min(1.0, math.pi * agree**2 / section)
+
+
+def verify_distance(agree: float, hfov: float, vfov: float,
+                    accidental: float = MAX_ACCIDENTAL) -> float:
+    """The camera distance beyond which `accidental_agreement` is at most `accidental`."""
+    return agree * math.sqrt(math.pi / (4.0 * accidental * math.tan(hfov / 2.0)
+                                        * math.tan(vfov / 2.0)))
+
+
+def step_back(grid, robot_radius: float, pose: tuple[float, float, float],  # noqa: ANN001
+              camera_height: float, position, distance: float  # noqa: ANN001 - xyz
+              ) -> tuple[float, float] | None:
+    """A reachable free spot whose camera is `distance` m from `position`, on the robot's
+    side of it (the line from it to the robot, turned by `STEP_BACK_TURNS` in turn)."""
+    x, y, _ = pose
+    dz = camera_height - position[2]
+    flat = math.sqrt(max(distance**2 - dz**2, 0.0))
+    if flat <= 0.0:
+        return None
+    try:
+        reach = distance_field(grid, (x, y), robot_radius)
+    except PathQueryError:  # the robot off the map: no step back
+        return None
+    away = math.atan2(y - position[1], x - position[0])
+    for turn in STEP_BACK_TURNS:
+        goal = (position[0] + flat * math.cos(away + turn),
+                position[1] + flat * math.sin(away + turn))
+        cell = grid.cell_of(goal)
+        if grid.contains(cell) and np.isfinite(reach[tuple(cell)]):
+            return goal
+    return None
