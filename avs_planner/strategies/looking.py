@@ -3,9 +3,9 @@
 detection becomes a known object (the baselines' and FLAP's only way to find).
 
 Why the verification: in frames taken close to a surface, phantoms land within the agreement
-radius of each other (`episode/verifying.py`), so before a report the robot steps back to where agreement means
-something and looks again (`Executor.verify_report`), as the switching loop's REPORTPOSITION
-does.
+radius of each other (`episode/verifying.py`), so before a report the robot steps back to
+where agreement means something and looks again (`Executor.verify_report`), as the
+switching loop's REPORTPOSITION does.
 """
 
 from __future__ import annotations
