@@ -1,6 +1,6 @@
 """The robot's map as the trace's `map` events drew it (`reporting/snapshots.py`), for the
 explanations: which room the robot mapped behind a placeholder it explored, and which objects
-it found there (`explain.Ledger` judges room hypotheses by them)."""
+it found there (`explain_ledger.Ledger` judges room hypotheses by them)."""
 
 from __future__ import annotations
 

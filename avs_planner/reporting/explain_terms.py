@@ -1,6 +1,6 @@
 """The assumptions of an explanation and the words for them: what an `assume-*` step means
 ("a kitchen lies behind placeholder10"), what observation settled it, and why it was refuted
-(the ledger itself: `explain.py`)."""
+(the ledger itself: `explain_ledger.py`)."""
 
 from __future__ import annotations
 

@@ -1,12 +1,12 @@
-"""Explanations as readable text: what `avs explain` prints (the data: `explain.py`)."""
+"""Explanations as readable text: what `avs explain` prints (the data:
+`explain_document.py`)."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 from typing import Any
 
-from avs_planner.reporting.explain import distribution_text
-from avs_planner.reporting.explain_terms import with_article
+from avs_planner.reporting.explain_terms import distribution_text, with_article
 
 
 def _p(value: Any) -> str:
