@@ -332,7 +332,7 @@ def run(
     """Run the C search: (status name, action indices of the plan, expanded, generated, why
     the best plan so far was returned: one of STOP_NAMES). `threads`: 1 or 2 evaluating
     threads, None for the core's choice (two for large tasks on a multi-CPU machine).
-    `lazy`: one of search.py's EAGER, DEFERRED, DEFERRED_UNHELPFUL. `preferred`,
+    `lazy`: one of search_modes.py's EAGER, DEFERRED, DEFERRED_UNHELPFUL. `preferred`,
     `goal_count` and not `commute` go to the core as the bits 1, 2 and 4 of its queue
     flags (the core's QF_*)."""
     packed = pack_task(task)

@@ -4,15 +4,21 @@ It depends only on the domain, the objects and the static atoms (`GroundingCache
 Atoms are integer codes (`encoding.AtomSpace`); a schema's bindings are joined over its static
 preconditions as columns of object ids; the ground actions' conditions and effects are rows of
 fact-id arrays that the per-call stage (`grounding.ground`) runs its fixpoints over.
+
+This module builds the structure: `build_structure` joins and encodes each schema's rows, then
+`_assemble` stacks them and numbers the atom codes they use as fact ids. Every choice between
+the compiled `_ground` and the numpy code is made here, so one switch (`_ground = None`) runs
+the whole build on numpy. What it builds and how rows are read is `ground_structure.py`;
+complex conditions and conditional effects are compiled by `condition_rows.py`; the row
+layouts and bitsets are `fact_rows.py`. Their public names are re-exported here.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
-from unified_planning.model import FNode, Problem
+from unified_planning.model import Problem
 
 from avs_planner.cp.bindings import (
     DENSE_CODES,
@@ -21,13 +27,14 @@ from avs_planner.cp.bindings import (
     encode_numpy,
     join_numpy,
 )
-from avs_planner.cp.conditional import Variant, expand_rows, variants
-from avs_planner.cp.encoding import AtomSpace, Columns
+from avs_planner.cp.condition_rows import _complex_rows, expand_conditional
+from avs_planner.cp.encoding import AtomSpace
+from avs_planner.cp.fact_rows import _PAD_NONE, _PAD_TRUE, bit_words, bitset, fact_matrix
 from avs_planner.cp.formulas import FormulaGrounder
+from avs_planner.cp.ground_structure import GroundStructure, _Block
 from avs_planner.cp.schema import LiftedSchema
 from avs_planner.cp.settled import NO_KEY, NOTHING_SETTLED, Key, SettledAtoms
 from avs_planner.cp.task import Atom
-from avs_planner.cp.unsupported import UnsupportedError, in_action
 from avs_planner.errors import PlanningError
 
 try:  # the compiled join, encoding and numbering; the numpy code computes the same
@@ -35,264 +42,19 @@ try:  # the compiled join, encoding and numbering; the numpy code computes the s
 except ImportError:
     _ground = None
 
+__all__ = [
+    "MAX_BINDINGS",
+    "MAX_GROUND_ACTIONS",
+    "GroundStructure",
+    "bit_words",
+    "bitset",
+    "build_structure",
+    "expand_conditional",
+    "fact_matrix",
+]
+
 MAX_GROUND_ACTIONS = 2_000_000
 MAX_BINDINGS = 20_000_000  # partial bindings of one schema while joining its static atoms
-_PAD_TRUE = -1  # padding code of precondition arrays (an always-true fact)
-_PAD_NONE = -2  # padding code of the other arrays (a fact nothing reads or makes true)
-
-
-@dataclass(frozen=True)
-class _Block:
-    """The ground actions of one schema: rows start..stop of the structure's arrays."""
-
-    schema: LiftedSchema
-    start: int
-    stop: int
-    columns: Mapping[str, np.ndarray]  # parameter -> object id, one per row
-    assumptive: bool
-
-    def select(self, mask: np.ndarray, params: frozenset[str] | None = None
-               ) -> tuple[Columns, int]:
-        """Columns (all, or those of `params`) of the rows where `mask` (over this block's
-        rows) is true."""
-        columns = self.columns.items()
-        if params is not None:
-            columns = [(p, c) for p, c in columns if p in params]
-        return {p: np.compress(mask, c) for p, c in columns}, int(np.count_nonzero(mask))
-
-
-@dataclass(frozen=True)
-class GroundStructure:
-    """The cached part of grounding: fact table and every statically possible ground action.
-
-    Rows of `pre`, `pre_neg`, `add`, `delete` are ground actions, entries fact ids; padding is
-    fact id `len(facts)` in `pre` (read as true) and `len(facts) + 1` elsewhere (never true)."""
-
-    facts: tuple[Atom, ...]
-    fact_index: Mapping[Atom, int]
-    space: AtomSpace
-    blocks: tuple[_Block, ...]
-    pre: np.ndarray
-    pre_neg: np.ndarray
-    add: np.ndarray
-    delete: np.ndarray
-    clauses: Mapping[int, tuple[tuple[tuple[int, ...], tuple[int, ...]], ...]]
-    arg_ids: np.ndarray  # (rows, max arity) object ids of the arguments, padded with -1
-    _rows: dict[int, tuple] = field(default_factory=dict, compare=False, repr=False)
-    memo: dict[str, object] = field(default_factory=dict, compare=False, repr=False)
-    """Arrays other modules derive from the structure (`derived.derived`), kept with it so
-    they are freed when the grounding cache drops the structure."""
-
-    @property
-    def size(self) -> int:
-        return len(self.pre)
-
-    def block_of(self, row: int) -> _Block:
-        for block in self.blocks:
-            if block.start <= row < block.stop:
-                return block
-        raise IndexError(row)
-
-    def label(self, row: int) -> str:
-        block = self.block_of(row)
-        names = self.space.names
-        args = (names[int(block.columns[p][row - block.start])] for p in block.schema.params)
-        return "(" + " ".join((block.schema.name, *args)) + ")"
-
-    def rows(self, rows: list[int]) -> list[tuple]:
-        """Per row: (name, args, pre, pre_neg, add, delete, pre_facts, add_facts, clauses,
-        assumptive, signature) of the ground action, built once per structure."""
-        known = self._rows
-        missing = [r for r in rows if r not in known]
-        if missing:
-            self._build_rows(missing)
-        return [known[r] for r in rows]
-
-    def _build_rows(self, missing: list[int]) -> None:
-        n = len(self.facts)
-        names = self.space.names
-        at = np.array(missing, dtype=np.int64)
-        if len(missing) <= _FEW_ROWS:  # a plan's steps: Python lists beat numpy's per-call cost
-            pre_rows, add_rows, neg_ids, delete_ids = (
-                [sorted({f for f in row if f < n}) for row in a[at].tolist()]
-                for a in (self.pre, self.add, self.pre_neg, self.delete))
-            pre_masks, add_masks, neg_masks, delete_masks = (
-                [bitset(ids) for ids in rows]
-                for rows in (pre_rows, add_rows, neg_ids, delete_ids))
-            pre_count, add_count = [len(r) for r in pre_rows], [len(r) for r in add_rows]
-        else:
-            pre, neg, add, delete = (fact_matrix(a[at], n, None)
-                                     for a in (self.pre, self.pre_neg, self.add, self.delete))
-            pre_masks, neg_masks, add_masks, delete_masks = (
-                _row_masks(m, n) for m in (pre, neg, add, delete)
-            )
-            pre_count = (pre >= 0).sum(axis=1).tolist()
-            add_count = (add >= 0).sum(axis=1).tolist()
-            pre_rows, add_rows = pre.tolist(), add.tolist()
-        arg_rows = self.arg_ids[at].tolist()
-        starts = np.array([b.start for b in self.blocks], dtype=np.int64)
-        block_rows = (np.searchsorted(starts, at, side="right") - 1).tolist()
-        lowered = [x.lower() for x in names]
-        clause_rows = self.clauses
-        for k, row in enumerate(missing):
-            block = self.blocks[block_rows[k]]
-            schema = block.schema
-            ids = arg_rows[k][: len(schema.params)]
-            clauses = ()
-            if row in clause_rows:
-                clauses = tuple((bitset(pos), bitset(neg)) for pos, neg in clause_rows[row])
-            self._rows[row] = (
-                schema.name, tuple([names[v] for v in ids]), pre_masks[k], neg_masks[k],
-                add_masks[k], delete_masks[k], tuple(pre_rows[k][: pre_count[k]]),
-                tuple(add_rows[k][: add_count[k]]), clauses, block.assumptive,
-                (schema.name.lower(), *[lowered[v] for v in ids]),
-            )
-
-
-_FEW_ROWS = 64  # up to this many rows are built from Python lists (same result as numpy)
-
-
-def _row_masks(matrix: np.ndarray, n: int) -> list[int]:
-    """Each row's fact ids (>= 0; -1 is padding) as a Python int bitset."""
-    words = bit_words(matrix, n)
-    data, size = words.tobytes(), words.shape[1] * 8
-    return [int.from_bytes(data[i:i + size], "little") for i in range(0, len(data), size)]
-
-
-def bit_words(matrix: np.ndarray, n_facts: int) -> np.ndarray:
-    """Each row's fact ids (>= 0; -1 is padding) as little-endian uint64 words, one spare bit
-    so that n_facts = 0 still has a word (the native core's layout)."""
-    words = n_facts // 64 + 1
-    out = np.zeros((matrix.shape[0], words), dtype="<u8")
-    rows, cols = np.nonzero(matrix >= 0)
-    facts = matrix[rows, cols]
-    np.bitwise_or.at(out, (rows, facts >> 6),
-                     np.left_shift(np.uint64(1), (facts & 63).astype(np.uint64)))
-    return out
-
-
-def bitset(ids) -> int:
-    """A Python int bitset of fact ids."""
-    bits = 0
-    for i in ids:
-        bits |= 1 << i
-    return bits
-
-
-def _pad(lists: list[list[int]], pad: int) -> np.ndarray:
-    width = max((len(x) for x in lists), default=0)
-    out = np.full((len(lists), width), pad, dtype=np.int64)
-    for i, x in enumerate(lists):
-        out[i, : len(x)] = x
-    return out
-
-
-def _read_params(nodes: Sequence[FNode]) -> frozenset[str]:
-    """The schema parameters the conditions mention: their CNF depends on nothing else."""
-    stack, read = list(nodes), set()
-    while stack:
-        node = stack.pop()
-        if node.is_parameter_exp():
-            read.add("?" + node.parameter().name)
-        stack.extend(node.args)
-    return frozenset(read)
-
-
-def _complex_rows(
-    schema: LiftedSchema, space: AtomSpace, columns: Columns, rows: int,
-    formulas: FormulaGrounder,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[tuple]]:
-    """Per binding: CNF of the quantified/disjunctive conditions. Unit clauses become extra
-    pre/pre_neg codes; longer ones are kept per row. Rows with an empty clause are dropped.
-    The CNF is grounded once per distinct binding of the parameters the conditions read
-    (e.g. `?r` of createviewcones-in, not `?l`): grounding a quantifier walks the formula
-    once per object; copying its result to the rows that share it is one array gather."""
-    mentioned = _read_params(schema.complex)
-    read = [p for p in schema.params if p in mentioned]
-    if read:
-        keys = np.stack([columns[p] for p in read], axis=1)
-        distinct, inverse = np.unique(keys, axis=0, return_inverse=True)
-        inverse = inverse.reshape(-1)
-    else:
-        distinct, inverse = np.zeros((1, 0), dtype=np.int64), np.zeros(rows, dtype=np.int64)
-    names = space.names
-    try:
-        grounded = [
-            _ground_cnf(schema, space, formulas,
-                        {p: names[i] for p, i in zip(read, ids, strict=True)})
-            for ids in distinct.tolist()
-        ]
-    except PlanningError as exc:  # name the action, so the reader can place it
-        raise in_action(schema.name, exc) from None
-    keep = np.array([g[0] for g in grounded], dtype=bool)[inverse]
-    pos = _pad([g[1] for g in grounded], _PAD_TRUE)[inverse]
-    neg = _pad([g[2] for g in grounded], _PAD_NONE)[inverse]
-    longer = [g[3] for g in grounded]
-    return keep, pos, neg, [longer[g] for g in inverse.tolist()]
-
-
-def _ground_cnf(
-    schema: LiftedSchema, space: AtomSpace, formulas: FormulaGrounder,
-    binding: Mapping[str, str],
-) -> tuple[bool, list[int], list[int], tuple]:
-    """(satisfiable, unit positive codes, unit negative codes, longer clauses as code pairs)
-    of the schema's complex conditions under one binding of the parameters they read."""
-
-    def code(atom: Atom) -> int:
-        c = space.encode(atom)
-        if c is None:
-            raise PlanningError(f"action {schema.name}: cannot ground condition atom {atom}")
-        return c
-
-    cnf = [c for node in schema.complex for c in formulas.cnf(node, binding)]
-    pos: list[int] = []
-    neg: list[int] = []
-    longer = []
-    for literals in sorted(map(sorted, cnf)):  # each clause's literals sorted once
-        if not literals:
-            return False, pos, neg, tuple(longer)
-        if len(literals) == 1:
-            ((atom, positive),) = literals
-            (pos if positive else neg).append(code(atom))
-        else:
-            longer.append((
-                tuple(code(a) for a, positive in literals if positive),
-                tuple(code(a) for a, positive in literals if not positive),
-            ))
-    return True, pos, neg, tuple(longer)
-
-
-def expand_conditional(
-    schema: LiftedSchema, space: AtomSpace, columns: Columns, rows: int, keep: np.ndarray,
-    arrays: tuple[np.ndarray, ...], clauses: list[tuple] | None,
-    statics: tuple[frozenset[Atom], frozenset[str]],
-) -> tuple[Columns, int, np.ndarray, tuple[np.ndarray, ...], list[tuple]]:
-    """The schema's rows with its conditional effects compiled in (`conditional.py`): a row
-    per copy, copies of one ground action next to each other."""
-    static, static_names = statics
-
-    def per_binding(binding: dict[str, str]) -> list[Variant]:
-        try:
-            return variants(schema.conditional, binding, space.encode, static, static_names,
-                            space.names_of)
-        except PlanningError as exc:  # name the ground action it is about
-            args = " ".join(binding[p] for p in schema.params if p in binding)
-            raise UnsupportedError(f"action {schema.name}, as ({schema.name} {args}): {exc}",
-                                   action=schema.name) from None
-
-    index, found = expand_rows(schema.params, columns, rows, space.names, per_binding)
-    pre, neg, add, delete = (a[index] for a in arrays)
-    extra = [[v.pre for v in found], [v.neg for v in found], [v.add for v in found],
-             [v.delete for v in found]]
-    pads = (_PAD_TRUE, _PAD_NONE, _PAD_NONE, _PAD_NONE)
-    pre, neg, add, delete = (np.concatenate([a, _pad(e, pad)], axis=1)
-                             for a, e, pad in zip((pre, neg, add, delete), extra, pads,
-                                                  strict=True))
-    old = clauses if clauses is not None else [()] * rows
-    merged = [tuple(old[r]) + tuple(v.clauses) for r, v in zip(index.tolist(), found,
-                                                             strict=True)]
-    expanded = {p: c[index] for p, c in columns.items()}
-    return expanded, len(index), keep[index], (pre, neg, add, delete), merged
 
 
 def build_structure(
@@ -490,21 +252,3 @@ def _fact_numbering(
         return out
 
     return codes, renumber
-
-
-def fact_matrix(ids: np.ndarray, n: int, read: np.ndarray | None) -> np.ndarray:
-    """Rows of fact ids sorted and unique, padding (ids >= n) and, if `read` is given,
-    facts nothing reads replaced by -1 at the end of the row."""
-    big = np.iinfo(np.int64).max
-    valid = ids < n
-    if read is not None:
-        valid[valid] = read[ids[valid]]
-    out = np.where(valid, ids, big)
-    out.sort(axis=1)
-    if out.shape[1] > 1:
-        dup = np.zeros(out.shape, dtype=bool)
-        dup[:, 1:] = out[:, 1:] == out[:, :-1]
-        out[dup] = big
-        out.sort(axis=1)
-    out[out == big] = -1
-    return out

@@ -174,7 +174,7 @@ def test_a_few_rows_are_built_as_the_numpy_path_builds_them(monkeypatch):
     both give the same actions, on every AVS example problem and IPC instance-1."""
     import random
 
-    from avs_planner.cp import structure
+    from avs_planner.cp import ground_structure
 
     from .conftest import avs_and_ipc_makers
 
@@ -184,8 +184,8 @@ def test_a_few_rows_are_built_as_the_numpy_path_builds_them(monkeypatch):
         st, rows = table._st, table._rows.tolist()
         sample = random.Random(name).sample(rows, min(40, len(rows)))
         built = []
-        for few in (structure._FEW_ROWS, -1):
-            monkeypatch.setattr(structure, "_FEW_ROWS", few)
+        for few in (ground_structure._FEW_ROWS, -1):
+            monkeypatch.setattr(ground_structure, "_FEW_ROWS", few)
             st._rows.clear()
             built.append(st.rows(sample))
         assert built[0] == built[1], name

@@ -28,7 +28,8 @@ from avs_planner.pddl import read_text
 from bench.avs_generator import AvsSize, generate
 
 ROOT = Path(__file__).resolve().parents[3]
-search_module = importlib.import_module("avs_planner.cp.search")  # the package exports search()
+# the Python engine, whose loop reads STALL (the package exports a function named search)
+search_module = importlib.import_module("avs_planner.cp.python_search")
 OPTIONS = SearchOptions(reward=500.0, weight=2.0, heuristic="ff")
 
 
