@@ -10,6 +10,7 @@ probability `fn_rate`; each queried label gets a phantom with probability `fp_ra
 from __future__ import annotations
 
 import math
+import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -68,19 +69,26 @@ def depth_frame(client: BulletClient, view: CameraView, size: tuple[int, int], s
 def detect_objects(client: BulletClient, view: CameraView, things: Sequence[Detectable],
                    config: DetectorConfig, rng: np.random.Generator, time: float,
                    labels: Sequence[str] | None = None) -> DetectionFrame:
-    """Report the visible `things` (of `labels`, or all), with misses and phantoms."""
+    """Report the visible `things` (of `labels`, or all), with misses and phantoms.
+
+    A frame takes one number from `rng`; each object's miss and noise and each label's
+    phantom come from their own stream seeded by it, so what the camera reports of a label
+    does not depend on which other labels it was asked for (a strategy that also looks for
+    furniture sees the same target detections, frame for frame)."""
     wanted = set(labels) if labels is not None else None
+    frame = int(rng.integers(2**63))
     found = []
     for thing in things:
         if wanted is not None and thing.label not in wanted:
             continue
         fraction = visible_fraction(client, view, thing)
-        if fraction < max(config.min_visible_fraction, 1e-9) or rng.random() < config.fn_rate:
+        own = _stream(frame, f"object {thing.name}")
+        if fraction < max(config.min_visible_fraction, 1e-9) or own.random() < config.fn_rate:
             continue
-        found.append(_true_detection(view, thing, fraction, config, rng, time))
+        found.append(_true_detection(view, thing, fraction, config, own, time))
     vocabulary = sorted({t.label for t in things})
-    for label in _phantom_labels(labels, vocabulary, config.fp_rate, rng):
-        found.append(_phantom(client, view, label, config, rng, time))
+    for label, own in _phantom_labels(labels, vocabulary, config.fp_rate, frame):
+        found.append(_phantom(client, view, label, config, own, time))
     queried = tuple(labels) if labels is not None else None
     return DetectionFrame(view=view, detections=tuple(found), time=time, queried=queried)
 
@@ -116,13 +124,21 @@ def _true_detection(view: CameraView, thing: Detectable, fraction: float,
                      view=view, visible_fraction=fraction, truth_name=thing.name)
 
 
+def _stream(frame: int, key: str) -> np.random.Generator:
+    """The random stream of one object or label in one frame."""
+    return np.random.default_rng([frame, zlib.crc32(key.encode())])
+
+
 def _phantom_labels(labels: Sequence[str] | None, vocabulary: list[str], fp_rate: float,
-                    rng: np.random.Generator) -> list[str]:
-    """Per queried label a phantom with probability fp_rate; unqueried: one per call at most."""
+                    frame: int) -> list[tuple[str, np.random.Generator]]:
+    """Per queried label a phantom with probability fp_rate; unqueried: one per call at most.
+    Each with the stream its position is drawn from."""
     if labels is not None:
-        return [label for label in labels if rng.random() < fp_rate]
-    if vocabulary and rng.random() < fp_rate:
-        return [vocabulary[int(rng.integers(len(vocabulary)))]]
+        streams = [(label, _stream(frame, f"phantom {label}")) for label in labels]
+        return [(label, own) for label, own in streams if own.random() < fp_rate]
+    own = _stream(frame, "phantom")
+    if vocabulary and own.random() < fp_rate:
+        return [(vocabulary[int(own.integers(len(vocabulary)))], own)]
     return []
 
 

@@ -131,6 +131,20 @@ def test_sensors_are_deterministic_by_seed() -> None:
     assert not np.array_equal(a[0], c[0])
 
 
+def test_what_the_camera_reports_of_a_label_does_not_depend_on_the_other_labels_asked() -> None:
+    """Asking for more labels (furniture as well as the target) leaves the target's misses,
+    noise and phantoms frame for frame as they were: two runs differ only in what they ask."""
+    def cups(extra: list[str]) -> list[tuple[str, tuple[float, ...]]]:
+        with _sensor_room(seed=3, fp_rate=0.3) as world:
+            frames = [world.robot.detect(["cup", "banana", *extra]) for _ in range(40)]
+        return [(d.label, tuple(np.round(d.position, 9))) for f in frames
+                for d in f.detections if d.label in ("cup", "banana")]
+
+    alone, among = cups([]), cups(["table", "chair", "stapler", "book"])
+    assert alone == among
+    assert {label for label, _ in alone} == {"cup", "banana"}  # hits and phantoms both
+
+
 def test_detector_config_rejects_bad_rates() -> None:
     with pytest.raises(SimError, match="fn_rate"):
         DetectorConfig(fn_rate=1.5)
