@@ -8,7 +8,7 @@ across on its way was searched from scratch, and on an absent target the budget 
 before the building's hypotheses did. Here every such frame counts:
 
 - **Rooms.** The cells a room search would cover (`viewcones.candidate_cells`: occupied or
-  unknown cells next to free space, nearest to one of the room's places) count as looked at
+  unknown cells bordering the room's free floor, all of it) count as looked at
   when a frame had them in view: inside the camera's horizontal field of view, between 0.5 m
   and 0.9 x the recognition range (the room cones' own limits), an object at the assumed
   support height inside the vertical field of view, and a free line of sight on the
@@ -80,7 +80,7 @@ class Glimpses:
         self.frames += 1
         stand = (round(pose[0] / STANDPOINT), round(pose[1] / STANDPOINT))
         changed: dict[str, dict[str, float]] = {}
-        points, rooms = (candidate_cells(self.mind, self.max_range + 1.0) if labels
+        points, rooms = (candidate_cells(self.mind) if labels
                          else (np.zeros((0, 2)), np.zeros(0, dtype=object)))
         if len(points):
             seen = self._in_view(points, pose, pan, tilt, self.camera.support_height)

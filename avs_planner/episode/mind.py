@@ -74,6 +74,8 @@ class Mind:
     failed_moves: dict[tuple[str, str], frozenset[str]] = field(default_factory=dict)
     blocked_retries: int = 0  # times the blocked spots were forgotten (`retry_blocked`)
     clock: float = 0.0  # s: the time of the last scan sensed
+    # (grid and rooms key, `viewcones.candidate_cells`' result): recomputed when either changes
+    cell_cache: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         self.grid = OccupancyGrid(resolution=self.resolution)

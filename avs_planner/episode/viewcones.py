@@ -1,12 +1,17 @@
 """CREATEVIEWCONES: candidate views for (label, relation, location), weighted and covering.
 
-In a room, views stand at the room's places and look in eight directions; the occupied and
-unknown cells near the room's places are where objects (and their supports) may be, and a
-greedy covering set keeps the views that add the most such cells, each weighted by the share
-it adds of P(ObjectAt). On a support, views stand around it, facing it, head tilted at where
-the knowledge puts the label there: its top (`on`), its inside (`in`: a cup in a shelf), or
-between the two when it lists both (`support_relations`); a search of a support looks for the
-label on it and in it.
+In a room, views stand at the room's places, and on its free floor a metre apart, and look in
+eight directions; the occupied and unknown cells bordering the room's free floor are where
+objects (and their supports) may be, and a greedy covering set keeps the views that add the
+most such cells, each weighted by the share it adds of P(ObjectAt). The cells are the whole
+room's, however far from where the robot has stood: when they were only those within the
+camera's range of the room's places, a kitchen whose places lay along one wall was "searched"
+without its far counter, the miss lowered P(cup in kitchen) as if the whole room had been
+looked at, and the robot left the cup behind.
+
+On a support, views stand around it, facing it, head tilted at where the knowledge puts the
+label there: its top (`on`), its inside (`in`: a cup in a shelf), or between the two when it
+lists both (`support_relations`); a search of a support looks for the label on it and in it.
 """
 
 from __future__ import annotations
@@ -48,9 +53,8 @@ class ConeSet:
 def room_cones(mind: Mind, room: str, label: str, p_total: float, camera: CameraModel,
                key: str, max_cones: int = 6, min_gain: float = 0.03) -> ConeSet:
     """Greedy covering set of views from the room's places over its candidate cells."""
-    pm = mind.place_map
-    places = [pm.places[p].position for p in sorted(pm.rooms[room].places) if p in pm.places]
-    cells = _room_cells(mind, room, camera.detect_range)
+    places = standpoints(mind, room)
+    cells = _room_cells(mind, room)
     if not places or len(cells) == 0:
         return ConeSet((), 0.0, p_total)
     tilt = -math.atan2(camera.height - camera.support_height, camera.look_distance)
@@ -140,35 +144,67 @@ def support_cones(mind: Mind, support: KnownObject, p_total: float, camera: Came
     return ConeSet(cones, 0.9 if picked else 0.0, p_total)
 
 
-def _room_cells(mind: Mind, room: str, reach: float) -> np.ndarray:
-    """World centres of occupied/unknown cells next to free space, nearest to this room."""
-    points, rooms = candidate_cells(mind, reach)
+def standpoints(mind: Mind, room: str, spacing: float = 1.0) -> list[tuple[float, float]]:
+    """Where a room's views may stand: its places, then the points of its free floor
+    (`PlaceMap.room_extents`) on a `spacing` lattice where the robot's body fits. The far
+    side of a room the robot has only looked into from one end is seen from there; the DT
+    leaves out a view no path reaches."""
+    pm, grid = mind.place_map, mind.grid
+    places = [pm.places[p].position for p in sorted(pm.rooms[room].places) if p in pm.places]
+    owner, ids = pm.room_extents(grid)
+    if room not in ids:
+        return places
+    step = max(1, round(spacing / grid.resolution))
+    lattice = np.zeros(owner.shape, dtype=bool)
+    lattice[::step, ::step] = True
+    floor = (owner == ids.index(room) + 1) & lattice & grid.traversable(mind.config.robot_radius)
+    extra = grid.to_world(np.argwhere(floor))
+    return places + [(float(x), float(y)) for x, y in extra]
+
+
+def _room_cells(mind: Mind, room: str) -> np.ndarray:
+    """World centres of the occupied/unknown cells bordering this room's free floor."""
+    points, rooms = candidate_cells(mind)
     return points[rooms == room][::2]
 
 
-def candidate_cells(mind: Mind, reach: float) -> tuple[np.ndarray, np.ndarray]:
+def candidate_cells(mind: Mind) -> tuple[np.ndarray, np.ndarray]:
     """Where objects (and their supports) may be: the centres of occupied/unknown cells next
-    to free space, within `reach` of a place, each with the room of its nearest place
-    (an object array of room ids, None where the place has no room)."""
+    to free space, each with the room whose free floor it borders (`PlaceMap.room_extents`:
+    the free space, split at the doors, that the room's places stand in), however far from
+    the places (an object array of room ids). A cell bordering two rooms' floors (a thin
+    wall) is listed for each; one bordering only free space no room holds (a room seen
+    through a door but not entered) is not listed: a look at it is no evidence about the
+    rooms the robot has been in. Cached until the grid or the rooms change."""
     grid, pm = mind.grid, mind.place_map
-    states = grid.state_grid()
-    free = states == CellState.FREE
-    near_free = np.zeros_like(free)
-    near_free[1:, :] |= free[:-1, :]
-    near_free[:-1, :] |= free[1:, :]
-    near_free[:, 1:] |= free[:, :-1]
-    near_free[:, :-1] |= free[:, 1:]
-    idx = np.argwhere(near_free & ~free)
-    if len(idx) == 0 or not pm.places:
+    if not pm.rooms:
         return np.zeros((0, 2)), np.zeros(0, dtype=object)
-    points = grid.to_world(idx)
-    ids = sorted(pm.places)
-    centres = np.array([pm.places[p].position for p in ids])
-    dist = np.linalg.norm(points[:, None, :] - centres[None, :, :], axis=2)
-    nearest = dist.argmin(axis=1)
-    room_of = np.array([pm.room_of(p) for p in ids], dtype=object)
-    keep = dist.min(axis=1) <= reach
-    return points[keep], room_of[nearest[keep]]
+    owner, ids = pm.room_extents(grid)
+    key = (id(grid), grid.version, id(owner), tuple(ids))
+    if mind.cell_cache is not None and mind.cell_cache[0] == key:
+        return mind.cell_cache[1]
+    edge = grid.state_grid() != CellState.FREE
+    found = []
+    for axis, shift in ((0, 1), (0, -1), (1, 1), (1, -1)):
+        beside = np.zeros_like(owner)  # the owner of the neighbour in this direction
+        if axis == 0 and shift == 1:
+            beside[:-1, :] = owner[1:, :]
+        elif axis == 0:
+            beside[1:, :] = owner[:-1, :]
+        elif shift == 1:
+            beside[:, :-1] = owner[:, 1:]
+        else:
+            beside[:, 1:] = owner[:, :-1]
+        mask = edge & (beside > 0)
+        found.append(np.column_stack([np.argwhere(mask), beside[mask]]))
+    rows = np.unique(np.concatenate(found), axis=0) if found else np.zeros((0, 3), int)
+    if len(rows) == 0:
+        result = (np.zeros((0, 2)), np.zeros(0, dtype=object))
+    else:
+        names = np.array(ids, dtype=object)
+        result = (grid.to_world(rows[:, :2]), names[rows[:, 2] - 1])
+    mind.cell_cache = (key, result)
+    return result
 
 
 def _in_wedge(points: np.ndarray, pose: tuple[float, float, float],

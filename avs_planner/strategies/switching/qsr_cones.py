@@ -185,7 +185,7 @@ class QsrCones:
             return None
         mind, camera = self.ex.mind, self.ex.camera
         made = room_cones(mind, room, label, p_total, camera, key)
-        cells = _room_cells(mind, room, camera.detect_range)
+        cells = _room_cells(mind, room)
         if not made.cones or len(cells) == 0 or made.coverage <= 0.0:
             return None
         near = [lm for lm in self.landmarks() if mind.room_at((lm.x, lm.y)) == room]
