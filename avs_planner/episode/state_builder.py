@@ -3,6 +3,11 @@
 Follows domains/README.md ("What the state builder fills in"). Only a few places enter the
 problem (the robot's place, the places placeholders hang off, one place per room), connected
 by their shortest path lengths in the place graph, so replans stay small as the map grows.
+
+This module assembles the problem: its objects and atoms, and which labels, categories,
+rooms and places enter. Its numbers come from two neighbours: the probability fluents from
+the conceptual map (`probabilities.py`) and the prices of moves and searches in the robot's
+seconds (`pricing.py`, whose `RELATIONS` is re-exported here).
 """
 
 from __future__ import annotations
@@ -14,13 +19,13 @@ import networkx as nx
 import numpy as np
 
 from avs_planner.cp.task import Atom, WorldState
+from avs_planner.episode import pricing
 from avs_planner.episode.domain import build_problem, planning_problem
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.mind import Mind
-from avs_planner.episode.viewcones import p_at_support, support_spaces
+from avs_planner.episode.pricing import RELATIONS, SearchTimes
+from avs_planner.episode.probabilities import Probabilities
 from avs_planner.pddl import ProbabilisticProblem
-
-RELATIONS = ("in", "on")
 
 
 @dataclass(frozen=True)
@@ -130,7 +135,7 @@ class StateBuilder:
         self._current_categories = list(self.categories)
         self.failed_on: dict[tuple[str, str], int] = {}
         self.failed_in: dict[tuple[str, str], int] = {}
-        self.search_times: dict[tuple[bool, str], list[float]] = {}
+        self.search_times: SearchTimes = {}
         self.revision = 0
 
     def _supports(self) -> list[str]:
@@ -291,8 +296,8 @@ class StateBuilder:
             d = lengths.get(node, math.inf)
             if node == hub or not math.isfinite(d) or self.mind.move_withheld(hub, node):
                 continue
-            cost = d / self._speed()
-            values[("move-cost", hub, node)] = values[("move-cost", node, hub)] = round(cost, 3)
+            cost = pricing.move_cost(d, self.mind.body, self.config)
+            values[("move-cost", hub, node)] = values[("move-cost", node, hub)] = cost
             atoms |= {("connected", hub, node), ("connected", node, hub)}
         for p in nodes:
             atoms.add(("in-room", p, pm.room_of(p)))
@@ -317,35 +322,26 @@ class StateBuilder:
 
     def _rooms(self, rooms: list[str], placeholders: set[str], atoms: set[Atom],
                values: dict[Atom, float]) -> None:
-        cmap = self.mind.cmap
+        """Known rooms' certain categories, the virtual rooms, and room searches given up
+        on; their category and object numbers are `Probabilities`'."""
+        virtual = self._virtual("new-room", self.config.virtual_rooms)
         for rid in rooms:
-            belief = cmap.room_category(rid)
+            belief = self.mind.cmap.room_category(rid)
             best = max(belief, key=belief.get)
             if belief[best] >= self.certain_category:
                 atoms |= {("has-category", rid, best), ("defined-category", rid)}
-            for c in self._current_categories:
-                values[("p-room-category", rid, c)] = self._prune(belief[c])
-        for rid in self._virtual("new-room", self.config.virtual_rooms):
-            atoms.add(("virtual", rid))
-            values |= {("p-room-category", rid, c): 0.0 for c in self._current_categories}
-        for pid in placeholders:
-            belief = cmap.placeholder_category(pid)
-            for c in self._current_categories:
-                values[("p-placeholder-category", pid, c)] = self._prune(belief.get(c, 0.0))
-        knowledge = cmap.knowledge
+        atoms |= {("virtual", rid) for rid in virtual}
+        chances, categories = self._probabilities(), self._current_categories
+        chances.categories(rooms, virtual, placeholders, categories, values)
+        chances.objects_in(self.labels, rooms, virtual, categories, values)
         for label in self.labels:
-            prior = cmap.p_any(label, knowledge.total_room_lambda(label))
-            for rid in [*rooms, *self._virtual("new-room", self.config.virtual_rooms)]:
-                # a known room: the target outside its known supports (their share is in
-                # p-find-on), the supports not found yet counted by the looks for them
-                p = cmap.p_object_in_room_per_category(label, rid) if rid in rooms else prior
-                for c in self._current_categories:
-                    k = knowledge.category_index(c)
-                    useful = label == self.task.target or self._support_useful(label, c)
-                    p_in = self._prune(p[k]) if useful else 0.0
-                    values[("p-obj-in", label, rid, c)] = self._restrict(c, p_in)
+            for rid in [*rooms, *virtual]:
                 if self.failed_in.get((label, rid), 0) >= self.config.max_failed_room_searches:
                     atoms.add(("defined-exists", label, "in", rid))
+
+    def _probabilities(self) -> Probabilities:
+        """The probability fluents over the mind's beliefs, with the current settings."""
+        return Probabilities(self.mind, self.task, self.config)
 
     def _relevant_rooms(self) -> list[str]:
         """Rooms worth a planner's thought: the robot's, those holding known objects or
@@ -361,25 +357,9 @@ class StateBuilder:
                     keep.add(rid)
         return sorted(r for r in keep if r is not None and cmap.graph.has_room(r))
 
-    def _support_useful(self, support: str, category: str) -> bool:
-        """Finding `support` in a room of `category` helps only if the target may be on it."""
-        knowledge = self.mind.cmap.knowledge
-        if support not in knowledge.support_relations(self.task.target):
-            return False
-        lam = knowledge.support_lambda(self.task.target, support)
-        p = float(self.mind.cmap.p_any(self.task.target, lam[knowledge.category_index(category)]))
-        return p >= self.config.min_probability
-
-    def _prune(self, p: float) -> float:
-        """Probabilities below `min_probability` become 0: the planner drops such actions."""
-        return float(p) if p >= self.config.min_probability else 0.0
-
-    def _restrict(self, category: str, p: float) -> float:
-        wanted = self.task.category
-        return p if wanted is None or wanted == category else 0.0
-
     def _objects(self, objects: list[str], rooms: list[str], atoms: set[Atom],
                  values: dict[Atom, float]) -> None:
+        chances = self._probabilities()
         for oid in objects:
             obj = self.mind.objects[oid]
             atoms |= {("label-of", oid, obj.label), ("detected", oid)}
@@ -396,7 +376,7 @@ class StateBuilder:
                 if self.failed_on.get((label, oid), 0) >= self.config.max_failed_support_searches:
                     atoms.add(("defined-exists", label, "on", oid))
             target = self.task.target
-            if obj.support is None and self._settled_on(target, oid):
+            if obj.support is None and chances.settled_on(target, oid):
                 atoms.add(("defined-exists", target, "on", oid))
         for oid in self._virtual("new-object", self.config.virtual_objects):
             atoms.add(("virtual", oid))
@@ -404,66 +384,22 @@ class StateBuilder:
             if loc in objects or loc in rooms:
                 atoms.add(("viewcones", label, rel, loc))
 
-    def _settled_on(self, label: str, oid: str) -> bool:
-        """The map's belief that `label` is on the known object `oid` (its lambda thinned by
-        the searches and glimpses there, over the room's category belief) is below the
-        planner's threshold: the `p-obj-on` numbers are per support label and category, so
-        this instance's own evidence reaches the planner as "settled"."""
-        cmap = self.mind.cmap
-        if self.mind.objects[oid].label not in cmap.knowledge.support_relations(label):
-            return False
-        if all(cmap.objects.remaining(where, label) >= 1.0
-               for where in support_spaces(self.mind, label, oid)):
-            return False
-        return p_at_support(self.mind, label, oid) < self.config.min_probability
-
     def _find_on(self, objects: list[str], values: dict[Atom, float]) -> None:
-        """`p-find-on L S`: the chance a search on S finds the L the plan assumed there. The
-        assumption's `p-obj-on` is the prior for any support of S's label in a room of the
-        category; this object's own looks (searches, glimpses) are in the share of L on it
-        still unseen, so a desk searched once is not planned as if it never had been."""
+        """`p-find-on`: a search's detection rate times the share of its label on a known
+        support still unseen (`Probabilities.find_on`)."""
         virtual = self._virtual("new-object", self.config.virtual_objects)
-        for label in self.labels:
-            rate = values[("p-detect", label, "on")]
-            for oid in [*objects, *virtual]:
-                share = self._unseen_share(label, oid) if oid in self.mind.objects else 1.0
-                values[("p-find-on", label, oid)] = round(rate * share, 6)
-
-    def _unseen_share(self, label: str, oid: str) -> float:
-        """P(L on `oid` now) over its prior: Poisson thinning by the looks at it so far,
-        averaged over the room's category belief (1 when nothing has looked at it)."""
-        cmap = self.mind.cmap
-        obj = self.mind.objects[oid]
-        if obj.label not in cmap.knowledge.support_relations(label):
-            return 1.0
-        if all(cmap.objects.remaining(where, label) >= 1.0
-               for where in support_spaces(self.mind, label, oid)) \
-                or not cmap.graph.has_room(obj.room):
-            return 1.0
-        lam = cmap.knowledge.support_lambda(label, obj.label)
-        prior = float(cmap.room_marginal(obj.room) @ cmap.p_any(label, lam))
-        if prior <= 0.0:
-            return 1.0
-        return min(1.0, p_at_support(self.mind, label, oid) / prior)
+        self._probabilities().find_on(self.labels, objects, virtual, values)
 
     def could_hold(self, room: str) -> bool:
         """Under some category, the target may still be in `room` (on its known supports
         included) with at least the planner's `min_probability`, after the looks there so
         far. A room where it may not, whatever its category, cannot enter a plan: reading
         its category again is not worth a visit."""
-        cmap = self.mind.cmap
-        if not cmap.graph.has_room(room):
-            return False
-        p = cmap.p_object_at_per_category(self.task.target, room)
-        return float(np.max(p)) >= self.config.min_probability
+        return self._probabilities().could_hold(room)
 
     def travel_speed(self) -> float:
         """Metres per unit of move cost (the body's speed when costs are seconds, else 1)."""
-        return self._speed()
-
-    def _speed(self) -> float:
-        body = self.mind.body
-        return body.linear_speed if self.config.seconds and body is not None else 1.0
+        return pricing.travel_speed(self.mind.body, self.config)
 
     def cannot_search(self, label: str, relation: str, location: str) -> None:
         """The robot has no view of `location` to search it for `label` from, or the DT
@@ -482,36 +418,21 @@ class StateBuilder:
 
     def search_cost(self, label: str, relation: str) -> float:
         """The prior cost of a search of this kind, averaged with the ones timed so far
-        (the prior counts as one of them)."""
-        target = label == self.task.target
-        cfg = self.config
-        k = RELATIONS.index(relation)
-        prior = (cfg.target_search_cost if target else cfg.support_search_cost)[k]
-        body = self.mind.body
-        if cfg.seconds and body is not None:
-            per_cone = (cfg.cone_spacing[k] / body.linear_speed + body.turn_time(math.pi / 2)
-                        + 2.0 * body.sensing_time)
-            prior = cfg.cones_per_search[k] * per_cone
-        timed = self.search_times.get((target, relation), []) if cfg.seconds else []
-        return round((prior + sum(timed)) / (1 + len(timed)), 3)
+        (the prior counts as one of them; `pricing.search_cost`)."""
+        return pricing.search_cost(self.mind.body, self.config, self.search_times,
+                                   label == self.task.target, relation)
 
     def _statics(self, values: dict[Atom, float]) -> None:
-        cmap, cfg = self.mind.cmap, self.config
-        knowledge = cmap.knowledge
+        """Per label: each kind of search's cost and detection rate, then `p-obj-on`."""
+        cfg = self.config
+        chances = self._probabilities()
         for label in self.labels:
             target = label == self.task.target
             detect = cfg.target_detect if target else cfg.support_detect
             for k, rel in enumerate(RELATIONS):
                 values[("search-cost", label, rel)] = self.search_cost(label, rel)
                 values[("p-detect", label, rel)] = detect[k]
-            supports = knowledge.support_relations(label)
-            for support in self.labels:
-                # on it and in it (`support_lambda`: zeros where the knowledge lists neither)
-                p = cmap.p_any(label, knowledge.support_lambda(label, support)) \
-                    if support in supports else np.zeros(len(knowledge.categories))
-                for c in self._current_categories:
-                    k = knowledge.category_index(c)
-                    values[("p-obj-on", label, support, c)] = self._restrict(c, self._prune(p[k]))
+            chances.objects_on(label, self.labels, self._current_categories, values)
 
     def category_belief(self, room: str) -> dict[str, float]:
         """The room's category belief, rounded, most likely first (for traces)."""

@@ -4,21 +4,27 @@ Assumptive steps stay in the plan and are re-checked by the monitor against ever
 state; physical and sensing steps are executed and removed. The CP replans when the monitor
 reports a broken plan (a placeholder explored, a search rejected, a probability moved) and the
 episode gives up when no plan reaches the success threshold.
+
+This module holds the loop and its settings (`LoopConfig`); what it does when a CP call gives
+it no plan worth executing (the anytime retry, the worth test, exploring, re-classifying,
+doubting categories, retrying blocked spots) is `recovery.py`'s, re-exported here where the
+loop's tests and callers knew it.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
-from pathlib import Path
 from typing import Any
 
 from avs_planner.cp.continual import ContinualPlanner, Decision
-from avs_planner.cp.search import DEFAULT_REWARD, PlanResult, PlanStatus, PlanStep, SearchOptions
+from avs_planner.cp.search import DEFAULT_REWARD, PlanResult, PlanStep, SearchOptions
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.executor import Executor, ExecutorConfig
 from avs_planner.episode.outcome import Outcome, SearchResult, StepOutcome, StepStatus
 from avs_planner.episode.state_builder import AvsState, BuilderConfig, StateBuilder
 from avs_planner.episode.trace import Trace
+from avs_planner.strategies.switching.recovery import Recovery, _timed_out
+from avs_planner.strategies.switching.recovery import _explores as _explores  # re-exported
 from avs_planner.strategies.switching.stopping import Remaining, look_cost, remaining
 
 
@@ -188,30 +194,8 @@ class SwitchingLoop:
 
     def _fallback(self, result: PlanResult) -> PlanResult:
         """A search that ran out of time is retried with the fallback heuristic, greedier
-        and with a larger expansion limit."""
+        and with a larger expansion limit; a plan worth less than it costs is none."""
         return self._worth_it(self._retry(result))
-
-    def _worth_it(self, result: PlanResult) -> PlanResult:
-        """The CP minimises c(pi) + R (1 - p(pi)); giving up costs R. A plan with
-        R p(pi) < c(pi) is worse than giving up, by the planner's own objective, and is not
-        executed: the result becomes "no plan above the threshold" (the loop then tries what
-        it tries before giving up). Only plans that search what is already mapped are
-        judged: a plan that explores is one chain of assumptions about what lies beyond a
-        placeholder, while exploring also reveals every other room and object there, so its
-        p(pi) undervalues it. For the same reason, when no such plan is worth its cost the
-        robot explores the nearest placeholder left before it gives up (`_recover`)."""
-        if not (self.config.worth_test and result.solved) or _explores(result.plan):
-            return result
-        value = self.config.reward * result.probability
-        if value >= result.cost:
-            return result
-        self.trace.emit("belief", not_worth=[s.label for s in result.plan if not s.assumptive],
-                        probability=round(result.probability, 5), cost=round(result.cost, 2),
-                        reward=self.config.reward)
-        return replace(result, status=PlanStatus.NO_PLAN_ABOVE_THRESHOLD, plan=(),
-                       extra={**result.extra, "not_worth": True,
-                              "best_probability": result.probability,
-                              "best_cost": result.cost})
 
     def _hopeless(self) -> str | None:
         """Why going on is worse than giving up by the building-level belief
@@ -240,36 +224,6 @@ class SwitchingLoop:
                     f"{result.extra['best_cost']:.0f} (reward {self.config.reward:g} x p < cost)")
         return (f"no plan above the success threshold {self.config.min_success:g} "
                 f"({result.status.value})")
-
-    def _retry(self, result: PlanResult) -> PlanResult:
-        assert self.planner is not None
-        if not _timed_out(result):
-            return result
-        # a CP call that ran out of nodes is a call too: `plans` counts the `plan` events,
-        # one per entry of `cp_time_s`
-        self.result.plans += 1
-        self.result.cp_times.append(result.planning_time_s)
-        dumped = self._dump_problem()
-        self.trace.emit("plan", why="timeout", status=result.status.value, plan=[],
-                        planning_time_s=round(result.planning_time_s, 4), problem=dumped)
-        options = self.planner.options
-        cfg = self.config
-        self.planner.options = replace(options, heuristic=cfg.fallback_heuristic,
-                                       weight=cfg.fallback_weight,
-                                       node_limit=cfg.fallback_node_limit,
-                                       anytime=cfg.fallback_anytime)
-        try:
-            return self.planner.replan()
-        finally:
-            self.planner.options = options
-
-    def _dump_problem(self) -> str | None:
-        """Keep a problem the CP could not solve in time (for `avs plan`), if asked to."""
-        if self.config.dump_dir is None:
-            return None
-        path = Path(self.config.dump_dir) / f"timeout-{self.result.plans + 1}.pddl"
-        path.write_text(self.builder.build().to_pddl(), encoding="utf-8")
-        return str(path)
 
     def _options(self) -> SearchOptions:
         cfg = self.config
@@ -327,64 +281,40 @@ class SwitchingLoop:
         self._record_plan(result, why)
         return result
 
+    # ---- the remedies (`recovery.py`), as the loop's own steps ---------------------------------
+
+    def _remedies(self) -> Recovery:
+        """The remedies over the loop's current state builder, executor, trace and settings."""
+        return Recovery(self.builder, self.executor, self.trace, self.config)
+
+    def _worth_it(self, result: PlanResult) -> PlanResult:
+        """A mapped-only plan worth less than it costs becomes none (`Recovery.worth_it`)."""
+        return self._remedies().worth_it(result)
+
+    def _retry(self, result: PlanResult) -> PlanResult:
+        """A timed-out CP call, retried once in anytime mode (`Recovery.retry`)."""
+        assert self.planner is not None
+        return self._remedies().retry(self.planner, result, self.result)
+
     def _visit_uncertain_room(self) -> bool:
-        """No plan is good enough: the place classifier may have misled the room category
-        beliefs (an elongated office reads as a corridor). Visit the places of the nearest
-        room whose category is uncertain, once per room, so it is classified again; only
-        rooms that could still hold the target under some category (`could_hold`)."""
-        certain = self.builder.certain_category
-        room = self.executor.uncertain_room(certain, self.visited_rooms,
-                                            self.builder.could_hold)
-        if room is None:
-            return False
-        self.visited_rooms.add(room)
-        self.trace.emit("action", action=f"(classify {room})", status="start")
-        outcome = self.executor.visit_room(room)
-        self.trace.emit("action", action=f"(classify {room})", status=outcome.status.value,
-                        detail=outcome.detail, category=self.builder.category_belief(room))
-        return True
+        """Re-classify the nearest uncertain room (`Recovery.visit_uncertain_room`)."""
+        return self._remedies().visit_uncertain_room(self.visited_rooms)
 
     def _doubt_categories(self) -> bool:
-        """No plan is good enough and no uncertain room is left to look at again: the place
-        classifier may be confidently wrong about a room (readings taken in an office's
-        doorway see the corridor). Once per episode, rooms believed up to `doubt_category`
-        become uncertain again, so the planner may assume another category for them (and
-        `_visit_uncertain_room` may re-classify them)."""
-        doubt = self.config.doubt_category
-        if not self.builder.doubt_categories(doubt):
-            return False
-        self.trace.emit("belief", doubt_categories=doubt, reason="no plan above the threshold")
-        return True
+        """Once, doubt categories believed certain (`Recovery.doubt_categories`)."""
+        return self._remedies().doubt_categories()
 
     def _retry_blocked(self) -> bool:
-        """No plan is good enough while blocked spots are kept out of: try them again before
-        giving up, at most `retry_blocked` times (each touch there widens the berth)."""
-        gone = self.executor.mind.retry_blocked(self.config.retry_blocked)
-        if not gone:
-            return False
-        self.trace.emit("belief", retry_blocked=[b.id for b in gone],
-                        reason="no plan above the threshold")
-        return True
+        """Try blocked spots again (`Recovery.retry_blocked`)."""
+        return self._remedies().retry_blocked()
 
     def _shrink(self) -> bool:
-        """Nothing to explore: plan with one support label fewer (a smaller problem)."""
-        dropped = self.builder.drop_support()
-        if dropped is None:
-            return False
-        self.trace.emit("belief", dropped_support=dropped, reason="planner timed out")
-        return True
+        """Plan with one support label fewer (`Recovery.shrink`)."""
+        return self._remedies().shrink()
 
     def _explore_instead(self) -> bool:
-        """The CP ran out of time: drive to the nearest placeholder (more map, smaller
-        uncertainty) and plan again. False if no placeholder is left."""
-        target = self.executor.nearest_placeholder()
-        if target is None:
-            return False
-        self.trace.emit("action", action=f"(explore {target})", status="start")
-        outcome = self.executor.move(target, self.builder.build())
-        self.trace.emit("action", action=f"(explore {target})", status=outcome.status.value,
-                        detail=outcome.detail)
-        return True
+        """Drive to the nearest placeholder (`Recovery.explore_instead`)."""
+        return self._remedies().explore_instead()
 
     def _monitor(self, state: AvsState, outcome: StepOutcome,
                  settled: str | None = None) -> PlanResult | None:
@@ -484,20 +414,10 @@ def _signature(state: AvsState) -> int:
     return hash((state.atoms, frozenset(state.values.items())))
 
 
-def _explores(plan: tuple[PlanStep, ...]) -> bool:
-    """The plan drives to a placeholder or assumes what lies beyond one."""
-    return any(s.name == "assume-leads-to-room" or
-               (s.name == "move" and s.args[1].startswith("placeholder")) for s in plan)
-
-
 def _search_rejected(step: PlanStep, outcome: StepOutcome) -> bool:
     """A SEARCHFOROBJECT that ran and whose DT session rejected the location."""
     return step.name.startswith("searchforobject") and outcome.status is StepStatus.DONE \
         and outcome.detail.startswith("rejected")
-
-
-def _timed_out(result: PlanResult) -> bool:
-    return result.status in (PlanStatus.TIMEOUT, PlanStatus.NODE_LIMIT)
 
 
 def assumed_categories(plan: tuple[PlanStep, ...] | list[PlanStep]) -> dict[str, str]:
