@@ -13,7 +13,7 @@ import pytest
 from avs_planner.harness import run_episode
 from avs_planner.harness.scenarios import builtin_scenarios, load_scenario
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "episode" / "data"  # the hand-made worlds of the episode tests
 
 
 def test_all_six_seed_runs_are_scenario_files() -> None:
@@ -23,20 +23,10 @@ def test_all_six_seed_runs_are_scenario_files() -> None:
                         "e": "gave_up", "f": "found"}
 
 
-# Fig. 3f, noise seed 1: two room searches of office1 look at the markers' desk without a
-# detection (a 3 cm box flat on the top), and after them (and office2 searched in vain, which
-# lowers the building's marker rate) no plan is worth its cost (docs/results.md, "a
-# building's rate")
-_F1 = pytest.mark.xfail(strict=True,
-                        reason="the markers on office1's desk go undetected (Fig. 3f, seed 1)")
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("seed", [1, 2, 3])
 @pytest.mark.parametrize("name", ["a", "b", "c", "d", "e", "f"])
-def test_seed_scenario_behaves_as_in_the_seed(name: str, seed: int, request) -> None:  # noqa: ANN001
-    if (name, seed) == ("f", 1):
-        request.applymarker(_F1)
+def test_seed_scenario_behaves_as_in_the_seed(name: str, seed: int) -> None:
     scenario = load_scenario(name)
     summary = run_episode(scenario.episode_spec(seed=seed), None, None)
     assert summary["outcome"] == scenario.expected, summary["reason"]
