@@ -4,6 +4,9 @@ MOVE drives A* legs on the robot's own grid, scanning and growing the maps after
 (`episode/driving.py`);
 CREATEVIEWCONES samples cones; SEARCHFOROBJECT runs a DT session against the detector;
 REPORTPOSITION ends the task. Assumptive steps never reach the executor.
+Sensing along the way (the first look around a place, the scan after each leg, the watch for
+the target, confirming and verifying a detection) is `episode/sensing.py`'s; the methods
+here that other parts call hand off to it.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ from typing import Any
 from avs_planner.cp.search import DEFAULT_REWARD, PlanStep
 from avs_planner.cp.task import Atom
 from avs_planner.dt import DetectorModel
+from avs_planner.episode import sensing
 from avs_planner.episode.driving import TARGET_SEEN, Driving
 from avs_planner.episode.dt_search import ViewConeSearch
 from avs_planner.episode.glimpses import Glimpses
@@ -24,7 +28,6 @@ from avs_planner.episode.mind import KnownObject, Mind
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
 from avs_planner.episode.robot_api import Robot
 from avs_planner.episode.state_builder import AvsState, StateBuilder
-from avs_planner.episode.verifying import step_back, verify_distance
 from avs_planner.episode.viewcones import (
     CameraModel,
     ConeSet,
@@ -149,226 +152,49 @@ class Executor(Driving):
                                  1.0 - self.config.detector.false_negative,
                                  support_body=self.config.support_radius)
 
-    # ---- sensing along the way --------------------------------------------------------------
+    # ---- sensing along the way (`episode/sensing.py`) ---------------------------------------
 
     def look_around(self) -> None:
-        """Scan, turn half round, scan again: the first view of a place (the place map is
-        updated once, after both scans). The detector watches in `look_headings` directions
-        spread evenly over the turn (2: ahead and behind)."""
-        headings = max(2, self.config.look_headings)
-        yaw = self.robot.pose[2]
-        self.mind.integrate(self.robot.scan())
-        found = self.watch()
-        half = headings // 2
-        for k in range(1, headings):
-            if found is not None and k > half:  # the target is here: the map is done
-                break
-            self.robot.turn_to(yaw + 2.0 * math.pi * k / headings)
-            if k == half:
-                found = self._sense([self.robot.pose], watch=True) or found
-            elif found is None:
-                found = self.watch()
+        """The first view of a place: scans both ways, the detector watching
+        (`sensing.look_around`)."""
+        sensing.look_around(self)
 
     def _sense(self, poses: list[tuple[float, float, float]], watch: bool = False
                ) -> KnownObject | None:
-        """Integrate a scan from `poses`; the detector watches when asked or at a new place.
-        Returns the target the watch confirmed, if any."""
-        before = self.mind.place_map.current_place
-        events = self.mind.sense(self.robot.scan(), poses, self.robot.clock)
-        place = self.mind.place_map.current_place
-        if place is not None and (place != before or place not in self.mind.classified):
-            self._classify()
-        seen = None
-        if watch or (place is not None and place != before):
-            seen = self.watch()
-        if self._unplaced:
-            self._place_seen()
-        if events:
-            kinds: dict[str, int] = {}
-            for e in events:
-                key = f"{e.kind.value}_{e.change.value}"
-                kinds[key] = kinds.get(key, 0) + 1
-            self.emit("belief", map_events=kinds)
-        self._record_pose()
-        return seen
+        """A scan from `poses`, the detector watching when asked or at a new place
+        (`sensing.sense`); the target the watch confirmed, if any."""
+        return sensing.sense(self, poses, watch)
 
     def watch(self) -> KnownObject | None:
-        """Keep the detector on while moving: look ahead for the target (a second frame must
-        repeat a detection); a new confirmed target becomes a known object whose atoms reach
-        the monitor with the next step's outcome (it may match a virtual object). The same
-        frame looks for the supports the problem knows of: a new one, confirmed, becomes a
-        known object too, and a frame that shows none of a label is evidence where it looked
-        (`episode/glimpses.py`)."""
-        if not self.watching:
-            return None
-        label = self.builder.task.target
-        self.robot.look(0.0, self._ahead_tilt)
-        labels = [label, *self.builder.supports] if self.glimpses is not None else [label]
-        frame = self.robot.detect(labels)
-        first = [s for s in frame if s.label == label]
-        if self.glimpses is not None:
-            self._glimpse(frame, labels)
-        if not first or self.known_near(first[0]):
-            return None
-        seen = first[0]
-        again = self.confirm(seen)
-        self.emit("observation", label=label, detected=bool(again), watching=True,
-                  position=[round(v, 2) for v in seen.position])
-        if not again:
-            return None
-        self._unplaced.append(seen)
-        return self._place_seen()
-
-    def _glimpse(self, frame: list[SeenLike], labels: list[str]) -> None:
-        """What one frame taken in passing says: the labels it did not show are less likely
-        where it looked; supports it shows (seen again in a second frame) become known."""
-        assert self.glimpses is not None
-        target = self.builder.task.target
-        shown = {s.label for s in frame}
-        unseen = [lab for lab in labels if lab not in shown]
-        changed = self.glimpses.frame(self.robot.pose, 0.0, self._ahead_tilt, unseen,
-                                      self._supports_of(target) if target in unseen else (),
-                                      tops_label=target)
-        if changed:
-            self.emit("belief", glimpsed=changed)
-        for seen in frame:
-            if seen.label == target or self.known_near(seen):
-                continue
-            if self.mind.room_at(seen.position[:2]) is None:
-                continue
-            if not self.confirm(seen, needed=1, frames=1, agree=self.config.agree[1]):
-                continue
-            obj = self.mind.add_object(seen.label, seen.position)
-            self.seen_while_moving[obj.id] = {
-                ("label-of", obj.id, seen.label), ("detected", obj.id),
-                ("related", obj.id, "in", obj.room)}
-            self.emit("observation", label=seen.label, detected=True, watching=True,
-                      position=[round(v, 2) for v in seen.position], object=obj.id)
+        """One look ahead for the target and the known supports (`sensing.watch`)."""
+        return sensing.watch(self)
 
     def _supports_of(self, label: str) -> list[str]:
-        """Known objects `label` may lie on (the knowledge lists the relation)."""
-        listed = self.mind.cmap.knowledge.relation_lambda
-        return [oid for oid, obj in self.mind.objects.items()
-                if (label, "on", obj.label) in listed]
+        """Known objects `label` may lie on (`sensing.supports_of`)."""
+        return sensing.supports_of(self.mind, label)
 
     def confirm(self, seen: SeenLike, needed: int | None = None,
                 frames: int | None = None, agree: float | None = None) -> bool:
-        """`needed` more frames (default `confirm_needed`) of up to `frames` (default
-        `confirm_frames`) see the label again within `agree` metres. Without the DT's belief,
-        a report rests on this: a phantom (5% of frames, anywhere in view) that repeats twice
-        at the same spot is practically never seen, while a real object missed in 1 frame of
-        5 still passes 9 times in 10. One short with some frame agreeing is ambiguous: up to
-        `confirm_extra` more frames are taken (once)."""
-        cfg = self.config
-        agree = cfg.agree[0] if agree is None else agree
-        needed = cfg.confirm_needed if needed is None else needed
-        frames = cfg.confirm_frames if frames is None else frames
-        hits = k = 0
-        extended = False
-        while k < frames:
-            if any(s.label == seen.label and math.dist(s.position, seen.position) <= agree
-                   for s in self.robot.detect([seen.label])):
-                hits += 1
-            k += 1
-            if hits >= needed:
-                return True
-            if hits + frames - k < needed:
-                if extended or hits == 0 or hits < needed - 1 or cfg.confirm_extra <= 0:
-                    return False
-                # one short, and some frame agreed: ambiguous, so look again
-                frames, extended = k + cfg.confirm_extra, True
-        return False
+        """More frames see `seen`'s label again where it was (`sensing.confirm`)."""
+        return sensing.confirm(self.robot, self.config, seen, needed, frames, agree)
 
     def verify_report(self, obj) -> bool:  # noqa: ANN001 - a known object or a Seen
-        """`verify` from a camera distance where frames agree by accident at most
-        `MAX_ACCIDENTAL` of the time (`episode/verifying.py`): stepping back there first when
-        the robot stands closer and can reach such a spot. Without a body: `verify`."""
-        body = self.mind.body
-        if body is None:
-            return self.verify(obj)
-        x, y, _ = self.robot.pose
-        distance = math.dist((x, y, body.camera_height), obj.position)
-        needed = min(verify_distance(self.config.agree[0], body.hfov, body.vfov),
-                     0.9 * body.detect_range)
-        if distance < needed:
-            stand = step_back(self.mind.grid, self.mind.config.robot_radius, self.robot.pose,
-                              body.camera_height, obj.position, needed)
-            self.emit("action", action="(step-back)", status="start" if stand else "failed",
-                      distance=round(distance, 2), needed=round(needed, 2))
-            if stand is not None:
-                self.drive_to(stand)
-        return self.verify(obj)
+        """`verify`, stepping back first to where it means something
+        (`sensing.verify_report`)."""
+        return sensing.verify_report(self, obj)
 
     def verify(self, obj: KnownObject) -> bool:
-        """Face `obj` and look at it: True when one of `verify_frames` frames sees its label
-        within `agree` m of where it was found (always True with 0 frames)."""
-        frames = self.config.verify_frames
-        if frames <= 0:
-            return True
-        x, y, _ = self.robot.pose
-        dx, dy = obj.position[0] - x, obj.position[1] - y
-        self.robot.turn_to(math.atan2(dy, dx))
-        self.robot.look(0.0, -math.atan2(self.camera.height - obj.position[2],
-                                         max(math.hypot(dx, dy), 0.1)))
-        seen = self.confirm(obj, needed=1, frames=frames)
-        self.emit("observation", label=obj.label, detected=seen, verifying=True,
-                  position=[round(v, 2) for v in obj.position])
-        return seen
-
-    def _place_seen(self) -> KnownObject | None:
-        """Confirmed detections become known objects once the place map has a room for them
-        (the very first look comes before the first place)."""
-        obj = None
-        for seen in list(self._unplaced):
-            room = self.mind.room_at(seen.position[:2])
-            if room is None and seen.label == self.builder.task.target:
-                # a target seen through a door is reported from here; its room (evidence
-                # about the room's category) is the nearest known one until it is entered
-                room = self.mind.nearest_room(seen.position[:2])
-            if room is None:
-                continue
-            self._unplaced.remove(seen)
-            obj = self.mind.add_object(seen.label, seen.position, room=room)
-            self.found_sids[obj.id] = seen.id
-            self.seen_while_moving[obj.id] = {
-                ("label-of", obj.id, seen.label), ("detected", obj.id),
-                ("related", obj.id, "in", obj.room)}
-        return obj
+        """Face `obj` and see it again before it is reported (`sensing.verify`)."""
+        return sensing.verify(self, obj)
 
     def known_near(self, seen: SeenLike) -> bool:
         """A detection of an object the mind already knows (same label, within
         `same_object` metres)."""
-        reach = self.config.same_object
-        return any(obj.label == seen.label and math.dist(obj.position[:2], seen.position[:2])
-                   <= reach for obj in self.mind.objects.values())
-
-    @property
-    def _ahead_tilt(self) -> float:
-        return -math.atan2(self.camera.height - self.camera.support_height,
-                           self.camera.look_distance)
+        return sensing.known_near(self.mind, self.config.same_object, seen)
 
     def _classify(self) -> None:
-        """Ask the place classifier, unless the robot stands in a doorway (it would see the
-        room beyond and credit it to this place); a reading that cannot be used is a warning
-        in the trace, never dropped silently."""
-        if self.mind.near_door(self.robot.pose[:2], self.config.doorway_clearance):
-            return
-        observed = self.robot.classify_place()
-        if observed is None:
-            self.emit("warning", source="place_classifier", detail="no reading here")
-            return
-        unused = self.mind.observe_appearance(observed)
-        if unused is not None:
-            self.emit("warning", source="place_classifier", observed=observed, detail=unused)
-
-    def _record_pose(self) -> None:
-        x, y, yaw = self.robot.pose
-        room = self.mind.room_at((x, y))
-        category = ""
-        if room is not None and self.mind.cmap.graph.has_room(room):
-            belief = self.mind.cmap.room_category(room)
-            category = max(belief, key=belief.get)
-        self.stats.path.append((x, y, yaw, category))
+        """Ask the place classifier, unless in a doorway (`sensing.classify`)."""
+        sensing.classify(self.robot, self.mind, self.config.doorway_clearance, self.emit)
 
     # ---- steps ------------------------------------------------------------------------------
 
