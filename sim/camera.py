@@ -82,8 +82,10 @@ def detect_objects(client: BulletClient, view: CameraView, things: Sequence[Dete
         if wanted is not None and thing.label not in wanted:
             continue
         fraction = visible_fraction(client, view, thing)
-        own = _stream(frame, f"object {thing.name}")
-        if fraction < max(config.min_visible_fraction, 1e-9) or own.random() < config.fn_rate:
+        if fraction < max(config.min_visible_fraction, 1e-9):
+            continue
+        own = _stream(frame, f"object {thing.name}")  # drawn from only for what is in view
+        if own.random() < config.fn_rate:
             continue
         found.append(_true_detection(view, thing, fraction, config, own, time))
     vocabulary = sorted({t.label for t in things})

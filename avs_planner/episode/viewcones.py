@@ -184,25 +184,14 @@ def candidate_cells(mind: Mind) -> tuple[np.ndarray, np.ndarray]:
     if mind.cell_cache is not None and mind.cell_cache[0] == key:
         return mind.cell_cache[1]
     edge = grid.state_grid() != CellState.FREE
+    padded = np.pad(owner, 1)  # the owner of each cell's neighbour below, above, right, left
     found = []
-    for axis, shift in ((0, 1), (0, -1), (1, 1), (1, -1)):
-        beside = np.zeros_like(owner)  # the owner of the neighbour in this direction
-        if axis == 0 and shift == 1:
-            beside[:-1, :] = owner[1:, :]
-        elif axis == 0:
-            beside[1:, :] = owner[:-1, :]
-        elif shift == 1:
-            beside[:, :-1] = owner[:, 1:]
-        else:
-            beside[:, 1:] = owner[:, :-1]
+    for beside in (padded[2:, 1:-1], padded[:-2, 1:-1], padded[1:-1, 2:], padded[1:-1, :-2]):
         mask = edge & (beside > 0)
         found.append(np.column_stack([np.argwhere(mask), beside[mask]]))
-    rows = np.unique(np.concatenate(found), axis=0) if found else np.zeros((0, 3), int)
-    if len(rows) == 0:
-        result = (np.zeros((0, 2)), np.zeros(0, dtype=object))
-    else:
-        names = np.array(ids, dtype=object)
-        result = (grid.to_world(rows[:, :2]), names[rows[:, 2] - 1])
+    rows = np.unique(np.concatenate(found), axis=0)
+    names = np.array(ids, dtype=object)
+    result = (grid.to_world(rows[:, :2]), names[rows[:, 2] - 1])
     mind.cell_cache = (key, result)
     return result
 

@@ -11,6 +11,7 @@ from avs_planner.cp.search import PlanStatus, SearchOptions
 from avs_planner.errors import PddlError, PlanningError
 from avs_planner.pddl import PddlSource, check, read_text
 from avs_planner.up_engine import to_up_plan
+from tests.avs_planner.cp.pddl_cases import lamps
 
 DOMAIN = """(define (domain lift)
   (:requirements :strips :typing :universal-preconditions :disjunctive-preconditions)
@@ -82,19 +83,6 @@ def test_too_many_state_dependent_effect_conditions_name_the_ground_action() -> 
     from avs_planner.cp.conditional import MAX_CONDITIONS
 
     n = MAX_CONDITIONS + 1
-    objects = " ".join(f"o{i}" for i in range(n))
-    domain = """(define (domain lamps)
-  (:requirements :strips :typing :conditional-effects)
-  (:types lamp)
-  (:predicates (on ?l - lamp) (lit ?l - lamp) (done))
-  (:action switch :parameters (?l - lamp) :effect (on ?l))
-  (:action flip :parameters ()
-    :effect (and (done) (forall (?l - lamp) (when (on ?l) (lit ?l))))))
-"""
-    problem = f"""(define (problem many) (:domain lamps)
-  (:objects {objects} - lamp)
-  (:init (on o0))
-  (:goal (done)))
-"""
+    domain, problem = lamps(n)
     with pytest.raises(PlanningError, match=rf"action flip, as \(flip \): {n} state-dependent"):
         plan(read_text(domain, problem), SearchOptions())

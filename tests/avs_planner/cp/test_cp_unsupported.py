@@ -15,6 +15,7 @@ from avs_planner.cp.planner import plan
 from avs_planner.cp.search import PlanStatus, SearchOptions
 from avs_planner.cp.unsupported import UnsupportedError
 from avs_planner.pddl import read_text
+from tests.avs_planner.cp.pddl_cases import lamps
 
 MOVIE = """(define (domain movie-robby)
   (:requirements :strips :typing)
@@ -62,27 +63,8 @@ def test_what_the_reader_now_takes_is_planned(domain, problem, expected, warning
     assert [step.label for step in result.plan] == expected
 
 
-def _lamps(count: int) -> tuple[str, str]:
-    """A `flip` whose effects hold one state-dependent condition per lamp."""
-    domain = """(define (domain lamps)
-  (:requirements :strips :typing :conditional-effects)
-  (:types lamp)
-  (:predicates (on ?l - lamp) (lit ?l - lamp) (done))
-  (:action switch :parameters (?l - lamp) :effect (on ?l))
-  (:action flip :parameters ()
-    :effect (and (done) (forall (?l - lamp) (when (on ?l) (lit ?l))))))
-"""
-    objects = " ".join(f"o{i}" for i in range(count))
-    problem = f"""(define (problem many) (:domain lamps)
-  (:objects {objects} - lamp)
-  (:init (on o0))
-  (:goal (done)))
-"""
-    return domain, problem
-
-
 def test_the_effect_condition_limit_names_the_action_where_it_is_declared() -> None:
-    task = read_text(*_lamps(MAX_CONDITIONS + 1), "d.pddl", "p.pddl")
+    task = read_text(*lamps(MAX_CONDITIONS + 1), "d.pddl", "p.pddl")
     with pytest.raises(UnsupportedError) as exc:
         ground(task, cache=GroundingCache())
     assert str(exc.value).startswith(
@@ -93,7 +75,7 @@ def test_the_effect_condition_limit_names_the_action_where_it_is_declared() -> N
     assert (found.file, found.line, found.column, found.code) == ("d.pddl", 6, 12,
                                                                   "unsupported")
     assert found.is_error and found.message == exc.value.message
-    assert grounding_diagnostics(read_text(*_lamps(MAX_CONDITIONS), "d.pddl", "p.pddl")) == []
+    assert grounding_diagnostics(read_text(*lamps(MAX_CONDITIONS), "d.pddl", "p.pddl")) == []
 
 
 def test_a_goal_conjunct_the_grounder_refuses_is_placed_at_that_conjunct() -> None:
@@ -120,7 +102,7 @@ def test_a_goal_conjunct_the_grounder_refuses_is_placed_at_that_conjunct() -> No
 
 
 def test_a_task_built_without_the_reader_is_named_without_a_position() -> None:
-    task = read_text(*_lamps(MAX_CONDITIONS + 1))
+    task = read_text(*lamps(MAX_CONDITIONS + 1))
     with pytest.raises(UnsupportedError) as exc:
         ground(type(task)(task.problem), cache=GroundingCache())
     assert exc.value.position is None
@@ -135,7 +117,7 @@ def _write(tmp_path: Path, domain: str, problem: str) -> tuple[str, str]:
 
 def test_plan_and_domain_check_refuse_the_effect_condition_limit_at_one_place(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    domain, problem = _write(tmp_path, *_lamps(MAX_CONDITIONS + 1))
+    domain, problem = _write(tmp_path, *lamps(MAX_CONDITIONS + 1))
     where = f"{domain}:6:12: "
     assert main(["plan", domain, problem]) == 1
     assert f"avs: error: {where}action flip, as (flip ): " in capsys.readouterr().err
@@ -146,10 +128,10 @@ def test_plan_and_domain_check_refuse_the_effect_condition_limit_at_one_place(
 
 def test_plan_and_domain_check_refuse_a_when_condition_at_one_place(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    domain_text = _lamps(2)[0].replace("(when (on ?l) (lit ?l))",
+    domain_text = lamps(2)[0].replace("(when (on ?l) (lit ?l))",
                                        "(when (or (on ?l) (lit ?l)) (lit ?l))")
-    domain, problem = _write(tmp_path, domain_text, _lamps(2)[1])
-    task = read_text(domain_text, _lamps(2)[1])  # the reader reads it (other engines may)
+    domain, problem = _write(tmp_path, domain_text, lamps(2)[1])
+    task = read_text(domain_text, lamps(2)[1])  # the reader reads it (other engines may)
     assert [d.code for d in task.not_grounded] == ["unsupported-effect"]
     where = f"{domain}:7:51: "
     assert main(["plan", domain, problem]) == 1
