@@ -1,5 +1,6 @@
 """The robot's spatial knowledge: metric maps, place map, conceptual layer (chain graph), and
-QSR models (`conceptual_map.qsr`: relation mixtures and supporting planes, seed 002).
+QSR models (`conceptual_map.qsr`: relation mixtures and supporting planes, after the QSR paper
+by Kunze et al.).
 
 Never imports `sim`: everything it knows comes from sensor data handed over by the executor.
 The conceptual layer's facade is `conceptual_map.ConceptualMap` (imported on first use, so

@@ -3,8 +3,8 @@
 Visibility is decided by ray tests to nine sample points of each object (its centre and its
 corners pulled 20% inwards): a point counts when the first surface the ray meets belongs to the
 object. An object is reported when enough of its points are visible, then dropped with
-probability `fn_rate`; each queried label gets a phantom with probability `fp_rate` (seed 003:
-0.2 and 0.05).
+probability `fn_rate`; each queried label gets a phantom with probability `fp_rate` (the active
+visual search paper by Göbelbecker et al.: 0.2 and 0.05).
 """
 
 from __future__ import annotations

@@ -24,7 +24,8 @@ _OTHER_COLOURS = ["#f4e1b6", "#dcb6f4", "#b6f0f0", "#e0e0e0"]
 
 
 def category_colours(spec: WorldSpec) -> dict[str, str]:
-    """A fill colour per room category (seed 003's red kitchen, blue office, green corridor)."""
+    """A fill colour per room category (the red kitchen, blue office and green corridor of the
+    active visual search paper by Göbelbecker et al.)."""
     colours: dict[str, str] = {}
     extra = iter(_OTHER_COLOURS * (1 + len(spec.rooms)))
     for room in spec.rooms:

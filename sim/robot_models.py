@@ -1,7 +1,8 @@
 """The two robot models: geometry, joint limits, sensor parameters and time model of each.
 
-Numbers follow the seeds: a Pioneer III with a laser and a camera 1.4 m high on a pan-tilt unit
-(seed 003 §4), and a PR2 with a 0.31 m telescoping torso, head pan 350° and tilt 115° (seed 000 §4).
+Numbers follow the papers: a Pioneer III with a laser and a camera 1.4 m high on a pan-tilt unit
+(§4 of the active visual search paper by Göbelbecker et al.), and a PR2 with a 0.31 m telescoping
+torso, head pan 350° and tilt 115° (§4 of the FLAP paper by Gedicke et al.).
 Speeds are nominal values of the real platforms, not measurements.
 """
 

@@ -3,7 +3,8 @@
 Driving at `linear_speed`, turning in place at `angular_speed`, the torso at `torso_speed`, the
 head's pan and tilt moving together (the slower axis decides), and a fixed cost per laser scan or
 depth frame (`scan_time`) and per semantic detection or place classification (`sensing_time`).
-Planners predict with the same numbers (seed 000 §3: driving + torso + pan/tilt + sensing).
+Planners predict with the same numbers: driving + torso + pan/tilt + sensing, as in §3 of the
+FLAP paper by Gedicke et al.
 """
 
 from __future__ import annotations

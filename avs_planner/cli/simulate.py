@@ -36,8 +36,8 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--strict-labels", action="store_true", help="refuse a target label "
                         "the knowledge does not list (exit 1) instead of searching for it with "
                         "the uninformed prior")
-    parser.add_argument("--scenario", help="a seed run a-f (or a scenario YAML path); "
-                        "other options override it")
+    parser.add_argument("--scenario", help="one of the active visual search paper's runs "
+                        "a-f (Fig. 3), or a scenario YAML path; other options override it")
     parser.add_argument("--category", help="only an object in a room of this category")
     parser.add_argument("--robot", choices=["pioneer", "pr2"])
     parser.add_argument("--strategy", default=None, help="search strategy: switching (the "

@@ -1,4 +1,5 @@
-"""The continual planner (CP) of seed 003: plans minimising c(pi) + R(1 - p(pi)).
+"""The continual planner (CP) of Göbelbecker et al., "A Planning Approach to Active Visual Search
+in Large Environments": plans minimising c(pi) + R(1 - p(pi)).
 
 Parse -> `ground` (bitsets, cached per domain/objects/static atoms) -> `search` (weighted A*,
 heuristics by name from `HEURISTICS`). `plan` does both; `ContinualPlanner` adds monitoring,

@@ -1,8 +1,9 @@
 """What a search call returns: `PlanStatus`, `PlanStep`, `PlanResult` and the objective.
 
-The objective c(pi) + R(1 - p(pi)) of seed 003 is defined here once: the Python engine's g
-and every result's `objective` use it. `_finish` builds a `PlanResult` from a plan's ground
-actions the same way for both engines, so their results differ only in `extra["engine"]`.
+The objective c(pi) + R(1 - p(pi)) of the active visual search paper (Göbelbecker et al.) is
+defined here once: the Python engine's g and every result's `objective` use it. `_finish` builds
+a `PlanResult` from a plan's ground actions the same way for both engines, so their results
+differ only in `extra["engine"]`.
 The result types are the planner's public shape (`avs plan --json`, the HTTP service, the
 episode loop), kept apart from the search that fills them.
 """
@@ -90,7 +91,7 @@ class PlanResult:
 
 
 def objective(cost: float, probability: float, reward: float) -> float:
-    """The seed's c(pi) + R(1 - p(pi))."""
+    """The objective c(pi) + R(1 - p(pi)) of the active visual search paper."""
     return cost + reward * (1.0 - probability)
 
 

@@ -1,4 +1,5 @@
-"""The engine "python": weighted A* on g = c + R(1 - p) over a `GroundTask` (seed 003).
+"""The engine "python": weighted A* on g = c + R(1 - p) over a `GroundTask`, the objective of
+the active visual search paper (Göbelbecker et al.).
 
 `_Search` is one search call: its nodes (kept by `pareto._Labels`), its open lists (the
 main list ordered by f, LAMA's helpful-actions list and the goal-count lists, popped in

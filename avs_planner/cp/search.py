@@ -1,4 +1,5 @@
-"""Weighted A* on g = c + R(1 - p) over a `GroundTask` (seed 003, "Switching Planner").
+"""Weighted A* on g = c + R(1 - p) over a `GroundTask` (the "Switching Planner" of the active
+visual search paper by Göbelbecker et al.).
 
 A node carries its cost c and success probability p. Two paths to the same state are only
 merged when one dominates the other in both c and p, because the better g now need not be

@@ -1,4 +1,5 @@
-"""Decision-theoretic sub-planner (seed 003, §2): a POMDP over view cones, solved closed-loop.
+"""Decision-theoretic sub-planner (§2 of Göbelbecker et al., "A Planning Approach to Active Visual
+Search in Large Environments"): a POMDP over view cones, solved closed-loop.
 
 Entry point: `DTSession`. Models follow pomdp-py's layout (domain, models, agent, problem).
 """

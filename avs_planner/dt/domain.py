@@ -1,4 +1,5 @@
-"""State, action and observation of the view-cone search POMDP (seed 003, §2 "DT planner").
+"""State, action and observation of the view-cone search POMDP (§2 "DT planner" of the active
+visual search paper by Göbelbecker et al.).
 
 The robot stands at the start pose or at one view cone's pose; the target is in one cone or in
 none of them. Robot position, the last detection flag and `done` are observed; only the target is

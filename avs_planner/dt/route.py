@@ -1,5 +1,6 @@
-"""Route-aware look sequences: expected search cost of looking at cones in an order (FLAP,
-seed 000, eq. 4-6), built by the utility-greedy rule p / t from a few different first looks.
+"""Route-aware look sequences: expected search cost of looking at cones in an order (FLAP by
+Gedicke et al., eq. 4-6), built by the utility-greedy rule p / t from a few different first
+looks.
 
 A sequence is open-loop on misses: look at its cones in order (a cone may repeat: a second
 look after a miss); at the first detection stop as well as possible (confirm, reject, or look

@@ -5,11 +5,12 @@ detection counts when both frames agree; when they split, a third frame decides)
 confirmation becomes a known object, every search (confirmed or rejected) thins the conceptual
 map's unseen count there by the coverage of the cones looked through.
 
-The session is the seed's DT (Göbelbecker et al., §2): its MOVE costs are the robot's own
-driving times along the paths it would drive (`PathLengths`: `plan_path` on its grid, as the
-executor drives, never straight lines through walls), computed once per session; cones no path
-reaches are left out. Its terminal penalties are the CP's goal reward R
-(`ExecutorConfig.miss_penalty`, which the switching strategy sets from `LoopConfig.reward`).
+The session is the DT of the active visual search paper (Göbelbecker et al., §2): its MOVE
+costs are the robot's own driving times along the paths it would drive (`PathLengths`:
+`plan_path` on its grid, as the executor drives, never straight lines through walls), computed
+once per session; cones no path reaches are left out. Its terminal penalties are the CP's goal
+reward R (`ExecutorConfig.miss_penalty`, which the switching strategy sets from
+`LoopConfig.reward`).
 A search of a support looks on it and in it, as the knowledge lists the label there
 (`viewcones.support_relations`).
 """

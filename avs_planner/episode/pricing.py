@@ -4,7 +4,7 @@ Every cost is seconds of robot time, so that the reward R (the seconds a found o
 worth) weighs them rightly: a move costs its path length over the body's speed, and a search
 the mean of a prior from the body (the view cones it is given, each a drive, a quarter turn
 and a look) and the searches of that kind timed in this episode. Without a body, or with
-`BuilderConfig.seconds` off, the seed's own numbers in its own units.
+`BuilderConfig.seconds` off, the active visual search paper's own numbers in its own units.
 
 Kept apart from the state builder (`state_builder.py`), which assembles a problem's objects
 and atoms and only writes these prices into it: pricing has its own inputs (the body, the
@@ -43,7 +43,7 @@ def search_prior(body: RobotBody | None, config: BuilderConfig, target: bool,
                  relation: str) -> float:
     """A search's cost before any was timed: its view cones (`cones_per_search`, each a drive
     of `cone_spacing`, a quarter turn and two frames) when costs are seconds, else the
-    seed's number for a search of the target or of a support."""
+    active visual search paper's number for a search of the target or of a support."""
     k = RELATIONS.index(relation)
     prior = (config.target_search_cost if target else config.support_search_cost)[k]
     if config.seconds and body is not None:

@@ -38,7 +38,8 @@ class SearchTask:
 
 @dataclass(frozen=True)
 class BuilderConfig:
-    """Sizes and static numbers of the problem (search costs/detection rates: seed 003 §4)."""
+    """Sizes and static numbers of the problem (search costs/detection rates: §4 of the active
+    visual search paper by Göbelbecker et al.)."""
 
     virtual_rooms: int = 1
     virtual_objects: int = 2
@@ -62,12 +63,13 @@ class BuilderConfig:
     # of that kind timed in this episode (`observe_search_time`). The prior: the view cones
     # a search is given (up to 6 in a room, 4 around a support: `episode/viewcones.py`),
     # each a drive of `cone_spacing` m, a quarter turn and two frames (a look is two
-    # detections). Without a body, the seed's numbers above, in its own units.
-    # On by default since each building's rate is learnt (conceptual_map/.../existence.py):
-    # with the seed's units a room search (120) for p = 0.5 x P(in room) is worth R = 500
-    # only where P > 0.54, and Fig. 3f (development seeds 0-19) gave up 5 times in 20 once
-    # one office searched in vain lowered P(markers in the other); priced in seconds, 2 in
-    # 20, each after the marker's own room was searched and missed. Before that it was off:
+    # detections). Without a body, the active visual search paper's numbers above, in its
+    # own units.
+    # On by default since each building's rate is learnt (conceptual_map/.../existence.py): with
+    # the active visual search paper's units a room search (120) for p = 0.5 x P(in room) is
+    # worth R = 500 only where P > 0.54, and Fig. 3f (development seeds 0-19) gave up 5 times in
+    # 20 once one office searched in vain lowered P(markers in the other); priced in seconds, 2
+    # in 20, each after the marker's own room was searched and missed. Before that it was off:
     # with exact lambdas it found as many objects but gave up on fewer absent ones.
     seconds: bool = True
     cone_spacing: tuple[float, float] = (2.0, 1.5)  # m between cones: in a room, on a support

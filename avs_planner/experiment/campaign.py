@@ -1,9 +1,9 @@
 """Campaign files: which episodes to run, validated with errors that name the entry.
 
-A campaign is worlds (or the seed's scenarios) × targets × strategies × robots × seeds; the
-format is in docs/experiments.md. `load_campaign` reads and checks a file (or a built-in by
-name, from `campaigns/`), and `Campaign.runs()` expands it into one `RunSpec` per episode,
-each with a stable run id (the name of its directory in the output).
+A campaign is worlds (or the active visual search paper's scenarios) × targets × strategies ×
+robots × seeds; the format is in docs/experiments.md. `load_campaign` reads and checks a file
+(or a built-in by name, from `campaigns/`), and `Campaign.runs()` expands it into one `RunSpec`
+per episode, each with a stable run id (the name of its directory in the output).
 """
 
 from __future__ import annotations

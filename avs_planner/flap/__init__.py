@@ -1,4 +1,4 @@
-"""FLAP view planning (seed 000): frontier-based view sampling in the 3D voxel map, target
+"""FLAP view planning (Gedicke et al.): frontier-based view sampling in the 3D voxel map, target
 probability per cell (eq. 1-3), transition times, and expected-time sequencing (eq. 4-9).
 
 Gedicke, Günther and Hertzberg, "FLAP for CAOS: Forward-Looking Active Perception for

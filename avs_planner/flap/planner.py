@@ -1,13 +1,13 @@
 """Expected-time view sequencing (FLAP eq. 4-9): branch and bound, greedy, brute force.
 
-`plan_views` is the seed's planner: depth-first branch and bound that expands children in order
-of utility p/t (eq. 6, Sarmiento et al.'s utility greedy), optionally drops strictly dominated
-views (eq. 7, flag xi), branches only up to depth psi and only on children whose utility is at
-least the best utility / phi, and stops a plan once it is complete (eq. 9, omega). Its first
-dive is the greedy sequence, so it is anytime. Set differences only: each node keeps, per view,
-the weight of the atoms it would still reveal, and subtracts what the chosen view covers.
-xi, psi and phi give up optimality for speed; an instance small enough to search without them
-within the node budget (`PlannerOptions.exact_nodes`) is searched exactly.
+`plan_views` is the FLAP paper's planner: depth-first branch and bound that expands children in
+order of utility p/t (eq. 6, Sarmiento et al.'s utility greedy), optionally drops strictly
+dominated views (eq. 7, flag xi), branches only up to depth psi and only on children whose
+utility is at least the best utility / phi, and stops a plan once it is complete (eq. 9, omega).
+Its first dive is the greedy sequence, so it is anytime. Set differences only: each node keeps,
+per view, the weight of the atoms it would still reveal, and subtracts what the chosen view
+covers. xi, psi and phi give up optimality for speed; an instance small enough to search without
+them within the node budget (`PlannerOptions.exact_nodes`) is searched exactly.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 A view is a robot pose (base x, y, yaw; torso lift; head pan, tilt) pointing the camera at a
 random frontier cell of the search region, with the set of region cells it would see. Most
-constraints shape the draw (the seed's local consistency, so few samples are rejected): the
+constraints shape the draw (the FLAP paper's local consistency, so few samples are rejected): the
 torso lift fixes the camera height, which with the range band and tilt limits bounds the
 horizontal distance, and the azimuth is drawn on the known side of a sideways frontier. The
 frontier-normal test (< 90 degrees) and the footprint test on the 2D grid are then checked for

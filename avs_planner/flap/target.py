@@ -18,7 +18,8 @@ from conceptual_map.metric import CellState, VoxelMap
 
 @dataclass(frozen=True)
 class TargetVolume:
-    """A box [lo, hi] (world metres) that holds the target with probability P_i (seed: 0.2)."""
+    """A box [lo, hi] (world metres) that holds the target with probability P_i (the FLAP
+    paper: 0.2)."""
 
     lo: tuple[float, float, float]
     hi: tuple[float, float, float]
@@ -42,7 +43,7 @@ def uniform_volumes(
     boxes: Iterable[tuple[tuple[float, float, float], tuple[float, float, float]]],
     probability: float = 0.2,
 ) -> list[TargetVolume]:
-    """Volumes that all carry the same P_i (the seed's experiments: 0.2 each)."""
+    """Volumes that all carry the same P_i (the FLAP paper's experiments: 0.2 each)."""
     return [TargetVolume(lo, hi, probability, f"volume{k}") for k, (lo, hi) in enumerate(boxes)]
 
 

@@ -1,7 +1,7 @@
 """Transition times between views (FLAP §3.2): the robot's time model over grid paths.
 
 `exact_time` plans an A* path and prices it with the RobotBody (turns, driving, torso, head,
-sensing). `build_table` is the seed's lookup table: view positions are clustered, one
+sensing). `build_table` is the FLAP paper's lookup table: view positions are clustered, one
 Dijkstra sweep per cluster gives grid distances, and driving time is a linear regression of
 exact path times over those distances, fitted on a few sampled pairs.
 """

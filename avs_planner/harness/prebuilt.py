@@ -1,5 +1,6 @@
-"""Pre-built maps (seed 003 Fig. 3f): explore to the nearest placeholder until none is left,
-with the executor's own sensing, so the maps and the conceptual map are the robot's."""
+"""Pre-built maps (Fig. 3f of the active visual search paper by Göbelbecker et al.): explore to
+the nearest placeholder until none is left, with the executor's own sensing, so the maps and the
+conceptual map are the robot's."""
 
 from __future__ import annotations
 
@@ -9,7 +10,8 @@ from avs_planner.episode.outcome import StepStatus
 
 def explore(executor: Executor, max_moves: int = 60) -> int:
     """Visit placeholders nearest-first; returns how many drives were made. The robot is not
-    searching yet (seed 003: driven by joystick), so its detector does not watch."""
+    searching yet (in the active visual search paper it was driven by joystick), so its detector
+    does not watch."""
     mind = executor.mind
     executor.watching = False
     executor.look_around()

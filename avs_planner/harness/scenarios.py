@@ -1,5 +1,6 @@
-"""The seed's six office runs (Fig. 3 a-f) as scenario files: an episode spec plus the outcome
-the seed reports. Built-ins live in `scenarios/`; any YAML path works too."""
+"""The six office runs (Fig. 3 a-f) of the active visual search paper as scenario files: an
+episode spec plus the outcome the paper reports. Built-ins live in `scenarios/`; any YAML path
+works too."""
 
 from __future__ import annotations
 

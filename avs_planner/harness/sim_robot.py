@@ -23,8 +23,9 @@ from sim.errors import MotionError, PathBlockedError, SimError
 from sim.robot_models import ROBOT_MODELS
 from sim.world_spec import RoomSpec, WorldSpec
 
-# The Pioneer's mind keeps the 0.30 m disc (0.26 + 0.04) the seed's runs were tuned with (its
-# doors are 0.9 m, the margin costs it nothing); other bodies keep PLANNING_CLEARANCE.
+# The Pioneer's mind keeps the 0.30 m disc (0.26 + 0.04) the runs of the active visual search
+# paper's Fig. 3 a-f were tuned with (its doors are 0.9 m, the margin costs it nothing); other
+# bodies keep PLANNING_CLEARANCE.
 _CLEARANCE = {"pioneer": 0.04}
 
 

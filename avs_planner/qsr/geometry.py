@@ -1,6 +1,6 @@
 """Vectorised visibility tests of the QSR view planner: 2D view cones and 3D frustums.
 
-Like the seed's In(v, Viewcone(psi)), these are pure field-of-view and range tests over voxel
+Like the QSR paper's In(v, Viewcone(psi)), these are pure field-of-view and range tests over voxel
 centres (no occlusion), evaluated for all poses or frustums against all voxels in one pass.
 """
 

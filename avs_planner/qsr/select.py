@@ -2,7 +2,7 @@
 
 Sample n navigable poses, score each 2D view cone by the density of the supporting-plane voxels
 inside it, take the best pose; there, rank nine 3D frustums (3 pans x 3 tilts within the head's
-limits) by the density they contain. The three methods of the seed's experiments differ only
+limits) by the density they contain. The three methods of the QSR paper's experiments differ only
 in the density and the choice: `qsr` (P_QSR), `supporting-planes` (uniform over plane voxels,
 best cone) and `random` (a random one of the n poses; its head is still pointed by the uniform
 density).
@@ -209,8 +209,8 @@ def best_rate(
     body: RobotBody, look_s: float,
 ) -> ScoredPose | None:
     """The pose with the most eq. 2 score per second of getting there and looking for
-    `look_s`: the utility p/t of Sarmiento et al. that FLAP (seed 000, eq. 6) plans with,
-    where p is the belief's mass in the pose's cone. None if no pose is reachable."""
+    `look_s`: the utility p/t of Sarmiento et al. that FLAP (Gedicke et al., eq. 6) plans
+    with, where p is the belief's mass in the pose's cone. None if no pose is reachable."""
     rates = pose_rates(poses, grid, start, body, look_s)
     if not len(poses) or not np.isfinite(rates).any():
         return None
@@ -234,7 +234,8 @@ def pose_rates(
 
 def cone_half_angle(body: RobotBody, pan_sweep: float = 0.0) -> float:
     """Half-angle of the 2D view cone: half the camera's hfov, widened by a pan sweep that the
-    head can make both ways (the seed's 60 degree cone "as the pan-tilt unit can cover more")."""
+    head can make both ways (the QSR paper's 60 degree cone "as the pan-tilt unit can cover
+    more")."""
     sweep = max(0.0, min(pan_sweep, body.pan.high, -body.pan.low))
     return min(math.pi, body.hfov / 2.0 + sweep)
 

@@ -1,5 +1,6 @@
-"""The trajectory picture in the style of seed 003 Fig. 3: the robot's own map, its path
-coloured by the room category it believed at the time, start and end, detections, places."""
+"""The trajectory picture in the style of Fig. 3 of the active visual search paper (Göbelbecker
+et al.): the robot's own map, its path coloured by the room category it believed at the time,
+start and end, detections, places."""
 
 from __future__ import annotations
 

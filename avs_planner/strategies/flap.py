@@ -1,9 +1,11 @@
-"""FLAP (seed 000) as a strategy: continual expected-time view planning in the 3D map.
+"""FLAP as a strategy: continual expected-time view planning in the 3D map, after Gedicke,
+Günther and Hertzberg, "FLAP for CAOS: Forward-Looking Active Perception for Clutter-Aware
+Object Search".
 
 The search region is the space above the supports the robot knows for the target (tables,
 shelves, ... from `mind.objects`; their labels come from the knowledge base through the state
-builder), one box per support (overlapping boxes of one label merge, like the seed's shelf
-arrangements), each with P_i = `p_volume` (the seed: 0.2) or, with `p_volume` <= 0, the
+builder), one box per support (overlapping boxes of one label merge, like the FLAP paper's shelf
+arrangements), each with P_i = `p_volume` (the FLAP paper: 0.2) or, with `p_volume` <= 0, the
 conceptual map's P(target on it). Each cycle `FlapSearch` samples views on the current maps,
 plans (branch and bound, or greedy with `greedy: true`) and returns the first view; the robot
 drives there on the 2D grid, lifts its torso, points its head at the view's target, takes a
@@ -14,9 +16,9 @@ the target), and stops at the budget.
 Supports must be known first: with `pre_explore` the episode's preparation (`prepare`, before
 the clock starts) surveys the building, detecting supports at every stop and, with
 `prior_map: true`, integrating depth frames so the 3D map exists before the search (the
-seed's "previously recorded map"); otherwise the search itself surveys until it knows
+FLAP paper's "previously recorded map"); otherwise the search itself surveys until it knows
 supports (and may find the target on the way). `reset_region: true` forgets the 3D map inside
-the search region at the start (the seed's outdated map).
+the search region at the start (the FLAP paper's outdated map).
 """
 
 from __future__ import annotations
@@ -228,7 +230,7 @@ def support_volumes(ctx: SearchContext, skip: set[str] = frozenset()) -> list[Ta
 
 
 def task_volumes(ctx: SearchContext) -> list[TargetVolume]:
-    """The region the task gives (option `volumes`, as the seed's search tasks do)."""
+    """The region the task gives (option `volumes`, as the FLAP paper's search tasks do)."""
     return parse_volumes(ctx.options["volumes"], ctx.options["p_volume"])
 
 
@@ -268,7 +270,7 @@ def check_options(options: dict) -> None:
 def _p_on(ctx: SearchContext, obj: KnownObject) -> float:
     try:
         return float(ctx.mind.cmap.p_object_at(ctx.target, ("on", obj.id)))
-    except Exception:  # noqa: BLE001 - a label the knowledge lacks: the seed's prior
+    except Exception:  # noqa: BLE001 - a label the knowledge lacks: the FLAP paper's prior
         return 0.2
 
 
@@ -417,7 +419,7 @@ def _detectable(frame, body) -> _Frame:  # noqa: ANN001 - a DepthFrameLike and a
 
 
 def _drive_quietly(ctx: SearchContext, goal: tuple[float, float]) -> StepOutcome:
-    """The seed's transition: follow one A* path on the robot's grid to the view, with one
+    """The FLAP paper's transition: follow one A* path on the robot's grid to the view, with one
     laser scan at the end, and no sensing on the way (the executor's drive scans every metre,
     classifies each new place and watches for the target: about a third of the search time
     in `flap_two_rooms`, which the transition model does not predict). Falls back to the

@@ -1,24 +1,26 @@
-"""QSR indirect search (Kunze et al., seed 002) as three strategies on one loop.
+"""QSR indirect search as three strategies on one loop, after Kunze, Kumar and Hawes, "Indirect
+Object Search based on Qualitative Spatial Relations".
 
 `qsr`, `supporting-planes` and `random` differ only in the density view selection uses (the QSR
 mixture over the supporting planes, uniform over them, a random one of the sampled poses). The
-loop follows the seed's control program: a search monitor (found? more than `abort_s` simulated
+loop follows the QSR paper's control program: a search monitor (found? more than `abort_s` simulated
 seconds of search? then stop), the search method (Algorithm 1: `select_view`), navigation to
 the chosen pose, and perception with the best frustums there (pan/tilt, a depth frame into the
 3D map, detection confirmed by a second frame). Voxels a frustum has covered lose density
 (`seen_weight` per look), so the next selection looks elsewhere.
 
-The seed starts with its 2D and 3D maps and the landmarks' poses given. Here the robot gets
-them itself first, in a *survey* that does not look for the target: it looks all round at its
-start and at a few frontier stops, integrating laser scans, depth frames (the mind's voxel map)
-and detections of the knowledge's landmark labels. A landmark is a label detected at least
-twice (in two frames) at positions within the executor's agreement distance; its position is
-the mean of those detections. Its *facing* (the direction of its intrinsic front) is an
-assumption written down here and in `conceptual_map/qsr/README.md`: a landmark faces the open
-side, the mean direction from it to the cells of the 2D map where the robot can stand within
-`OPEN_SIDE_RADIUS` (desks stand against walls or each other and are used from the free side;
-monitors and keyboards on them face the same way). The search monitor's clock starts when the
-survey ends (the seed's time is search time with known maps); summaries carry both times.
+The QSR paper (Kunze et al.) starts with its 2D and 3D maps and the landmarks' poses given. Here
+the robot gets them itself first, in a *survey* that does not look for the target: it looks all
+round at its start and at a few frontier stops, integrating laser scans, depth frames (the
+mind's voxel map) and detections of the knowledge's landmark labels. A landmark is a label
+detected at least twice (in two frames) at positions within the executor's agreement distance;
+its position is the mean of those detections. Its *facing* (the direction of its intrinsic
+front) is an assumption written down here and in `conceptual_map/qsr/README.md`: a landmark
+faces the open side, the mean direction from it to the cells of the 2D map where the robot can
+stand within `OPEN_SIDE_RADIUS` (desks stand against walls or each other and are used from the
+free side; monitors and keyboards on them face the same way). The search monitor's clock starts
+when the survey ends (the QSR paper's time is search time with known maps); summaries carry both
+times.
 
 After a found object, the knowledge learns from it (`learn_from_observation` with the surveyed
 landmarks): kept in this process for the next search without task descriptions, and written to

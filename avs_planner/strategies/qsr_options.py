@@ -8,11 +8,11 @@ from typing import Any
 from avs_planner.errors import AvsError
 
 OPTIONS: dict[str, Any] = {
-    "abort_s": 120.0,  # the seed's search monitor: simulated seconds of search before abort
+    "abort_s": 120.0,  # the QSR paper's search monitor: simulated seconds of search before abort
     "n_poses": 20,  # poses sampled per selection (Algorithm 1's n)
     "frustums": 2,  # looks a pose is rated for (utility rate's look time), and the looks
     # taken at each pose without relook (the best of the nine ranked frustums)
-    "pan_sweep_deg": 0.0,  # widen the 2D cone by a head pan each way (the seed's Table IV: 60)
+    "pan_sweep_deg": 0.0,  # widen the 2D cone by a head pan each way (the QSR paper's Table IV: 60)
     "seen_weight": 0.25,  # density factor of a voxel per look that covered it: about the
     # chance that a look misses a cup in view (camera miss 0.2, + 0.8 x 0.2^2 unconfirmed)
     "rerank": True,  # rank the frustums at a pose again after each look that found nothing
@@ -25,10 +25,10 @@ OPTIONS: dict[str, Any] = {
     "confirm_frames": 2,  # frames to confirm a first detection (any one agreeing suffices)
     "uniform_floor": 0.02,  # qsr: share of uniform density mixed in (wrong QSRs stay findable)
     "utility": "rate",  # pose choice: rate (eq. 2's score per second of getting there and
-    # looking, Sarmiento et al.'s p/t) or eq2 (the seed's argmax of eq. 2, travel ignored)
+    # looking, Sarmiento et al.'s p/t) or eq2 (the QSR paper's argmax of eq. 2, travel ignored)
     "max_poses": 40,  # view poses before giving up regardless of time
     "survey_stops": 12,  # frontier stops of the survey at most (after looking round at the
-    # start); it ends sooner when no frontier is left: the seed starts with complete maps
+    # start); it ends sooner when no frontier is left: the QSR paper starts with complete maps
     "survey_headings": 8,  # directions looked at per survey stop
     "depth_columns": 64,  # depth frame size (columns x rows)
     "depth_rows": 48,

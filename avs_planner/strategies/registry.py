@@ -104,12 +104,13 @@ _SWITCHING_OPTIONS["views"] = "cones"
 _SWITCHING_OPTIONS["qsr_cones"] = "off"
 
 _FLAP_OPTIONS = {  # avs_planner/strategies/flap.py
-    "greedy": False,  # next best view by p/t (the seed's baseline) instead of branch and bound
+    "greedy": False,  # next best view by p/t (the FLAP paper's baseline), not branch and bound
     "views": 200,  # view samples per cycle (the views still planned count towards them)
     "clusters": 50,  # transition table clusters
     "time_limit_s": 0.5,  # planner wall limit per cycle (0: none); its first plan is greedy
     "omega": 0.05,  # give up once p(V̂(S)) < omega
-    "p_volume": 0.2,  # P_i per support volume (seed: 0.2); <= 0: the conceptual map's belief
+    "p_volume": 0.2,  # P_i per support volume (FLAP paper: 0.2); <= 0: the conceptual map's
+    # belief
     "prior_map": True,  # the preparation (pre_explore) builds the 3D map with depth frames
     "reset_region": True,  # forget the 3D map inside the search region at the start
     "support_reach": 0.7,  # m: half width of a support's box around its detected centre
@@ -118,10 +119,11 @@ _FLAP_OPTIONS = {  # avs_planner/strategies/flap.py
     "survey_headings": 6,  # headings looked at per survey stop
     "survey_on": True,  # after a region is searched, survey on for more supports
     "sense_en_route": True,  # drive to views with the executor (scans every metre, place
-    # classification, the target watch); false: one path, no sensing on the way (the seed's)
+    # classification, the target watch); false: one path, no sensing on the way (as in the
+    # FLAP paper)
     "max_views": 80,
     "volumes": [],  # the task's search region: [{lo: [x, y, z], hi: [x, y, z], p, name}, ...]
-    # (the seed's experiments give the volumes); empty: boxes above the known supports
+    # (the FLAP paper's experiments give the volumes); empty: boxes above the known supports
 }
 
 STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
@@ -150,8 +152,9 @@ STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
     Strategy("random", "QSR baseline: as qsr, but a random one of the 20 sampled view poses",
              "avs_planner.strategies.qsr:run_random", _QSR_OPTIONS,
              check=_QSR_CHECK),
-    Strategy("flap", "FLAP (seed 000): frontier view sampling in the 3D map and expected-time "
-             "view sequencing over the target's known supports (greedy: true is its baseline)",
+    Strategy("flap", "FLAP (Gedicke et al.): frontier view sampling in the 3D map and "
+             "expected-time view sequencing over the target's known supports (greedy: true is "
+             "its baseline)",
              "avs_planner.strategies.flap:run", _FLAP_OPTIONS,
              prepare="avs_planner.strategies.flap:prepare",
              check="avs_planner.strategies.flap:check_options"),

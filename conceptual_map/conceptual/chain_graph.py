@@ -1,4 +1,5 @@
-"""The chain graph of seed 003 §3: room categories, place properties, phi_rc between rooms.
+"""The chain graph of §3 of Göbelbecker et al., "A Planning Approach to Active Visual Search in
+Large Environments": room categories, place properties, phi_rc between rooms.
 
 One category variable per room; each observed place property is a directed factor
 P(value | category of the place's room) (a pgmpy `DiscreteFactor`, reduced by the evidence);

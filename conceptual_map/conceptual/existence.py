@@ -1,4 +1,5 @@
-"""Object existence as Poisson processes (seed 003 eq. 1-2) and the evidence objects give.
+"""Object existence as Poisson processes (eq. 1-2 of the active visual search paper by
+Göbelbecker et al.) and the evidence objects give.
 
 Given a room's category c, the number of `label` objects at a location L is Poisson(lambda_{L,c});
 locations are independent, so lambdas add over a location and its sub-locations. A search that

@@ -34,7 +34,8 @@ from conceptual_map.knowledge import Knowledge, load_knowledge
 
 
 class ConceptualMap:
-    """Room/placeholder category beliefs and object-existence probabilities (seed 003 §3)."""
+    """Room/placeholder category beliefs and object-existence probabilities (§3 of the active
+    visual search paper by Göbelbecker et al.)."""
 
     def __init__(
         self, knowledge: Knowledge | None = None, settings: BPSettings | None = None

@@ -1,4 +1,5 @@
-"""What lies behind a placeholder: the six structural hypotheses of seed 003 §3 "Exploration".
+"""What lies behind a placeholder: the six structural hypotheses of §3 "Exploration" of the
+active visual search paper (Göbelbecker et al.).
 
 Each hypothesis adds 0, 1 or 2 hypothetical rooms hanging off the placeholder's room R, with the
 category prior as their unary and phi_rc on the links. Because those rooms are leaves (or a chain)
@@ -25,7 +26,8 @@ NO_NEW_ROOM = "none"
 
 
 class Hypothesis(enum.Enum):
-    """Structure of the unexplored space behind a placeholder (seed 003, in its order)."""
+    """Structure of the unexplored space behind a placeholder (in the order of the active visual
+    search paper)."""
 
     NO_NEW_PLACES = 1
     PLACES_NO_ROOM = 2
@@ -64,8 +66,9 @@ class PlaceholderPrediction:
     """P_category(placeholder) and how it was composed.
 
     `any_room[c]`: probability that the placeholder leads to at least one new room of category c
-    (the seed's "any of the hypothesised rooms"); `first_room[c]`: probability that the first
-    new room reached is of category c, so `sum(first_room) + no_new_room == 1`.
+    (the active visual search paper's "any of the hypothesised rooms"); `first_room[c]`:
+    probability that the first new room reached is of category c, so
+    `sum(first_room) + no_new_room == 1`.
     """
 
     weights: MappingProxyType[Hypothesis, float]

@@ -8,7 +8,8 @@ from types import MappingProxyType
 import numpy as np
 
 RELATIONS = ("in", "on")
-"""Relations of an object to its support (a related space in seed 003's terms)."""
+"""Relations of an object to its support (a related space in the terms of the active visual
+search paper by Göbelbecker et al.)."""
 
 
 @dataclass(frozen=True)
@@ -156,7 +157,8 @@ class Knowledge:
         """Expected count of `label` anywhere in a room: direct plus on/in expected supports.
 
         The supports' own expected counts multiply their per-instance lambdas (the mean of the
-        compound count), which is how seed 003 adds lambdas over sub-locations.
+        compound count), which is how the active visual search paper (Göbelbecker et al.) adds
+        lambdas over sub-locations.
         """
         total = self.room_lambda(label).copy()
         for (lab, _rel, support), lam in self.relation_lambda.items():

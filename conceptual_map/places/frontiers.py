@@ -1,4 +1,5 @@
-"""Reachable frontier regions of the 2D grid: where placeholders go (seed 003 §2, §3).
+"""Reachable frontier regions of the 2D grid: where placeholders go (§2, §3 of the active visual
+search paper by Göbelbecker et al.).
 
 A region is a connected group of frontier cells (unknown next to free) close to the free space
 the robot can reach; it counts only if enough unknown space lies behind it.

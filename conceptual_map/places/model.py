@@ -23,7 +23,8 @@ class Place:
 
 @dataclass(frozen=True)
 class Placeholder:
-    """A hypothetical place at a reachable free/unknown border (seed 003 §2).
+    """A hypothetical place at a reachable free/unknown border (§2 of the active visual search
+    paper by Göbelbecker et al.).
 
     `position` is where the robot can stand to look; `open_space` is the unknown area (m^2)
     behind the frontier within a few metres, the evidence for how much may lie beyond.

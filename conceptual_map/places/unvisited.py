@@ -1,6 +1,7 @@
 """Reachable free space that no place stands in: rooms seen (through a doorway, or from far
 off) but not entered. Mapping them leaves no frontier, so without these the planner would have
-nothing to go to there (seed 003 plans only over places and placeholders).
+nothing to go to there (the planner of the active visual search paper by Göbelbecker et al.
+plans only over places and placeholders).
 
 A region is unvisited when it lies beyond a mapped door from every place, or farther than
 `visit_radius` from all places (a door not yet recognised, or the far end of a large room).

@@ -43,7 +43,7 @@ def relative_angle(
     """Eq. 1: angle of the object seen from the landmark minus the robot-to-landmark heading.
 
     Arrays broadcast over a leading axis ((N, 2) or (2,)); the result is in [0, 2 pi). The
-    quadrant-aware arctangent replaces the seed's tan^-1 of a quotient.
+    quadrant-aware arctangent replaces the QSR paper's tan^-1 of a quotient.
     """
     robot, landmark, obj = (np.asarray(a, dtype=float) for a in (robot, landmark, obj))
     to_obj = obj - landmark
@@ -53,13 +53,13 @@ def relative_angle(
 
 
 def relative_radius(robot: np.ndarray, landmark: np.ndarray, obj: np.ndarray) -> np.ndarray:
-    """|object - landmark| / |landmark - robot|: the seed's ratio behind close and distant."""
+    """|object - landmark| / |landmark - robot|: the QSR paper's ratio behind close and distant."""
     robot, landmark, obj = (np.asarray(a, dtype=float) for a in (robot, landmark, obj))
     return np.linalg.norm(obj - landmark, axis=-1) / np.linalg.norm(landmark - robot, axis=-1)
 
 
 def virtual_robot(landmark: Landmark, distance: float) -> np.ndarray:
-    """Where the seed imagines the robot: `distance` metres in front of the landmark."""
+    """Where the QSR paper imagines the robot: `distance` metres in front of the landmark."""
     return landmark.xy + distance * np.array([math.cos(landmark.facing), math.sin(landmark.facing)])
 
 

@@ -1,4 +1,4 @@
-"""Learning QSR counts from what was seen (the seed's future work, kept simple).
+"""Learning QSR counts from what was seen (the QSR paper's future work, kept simple).
 
 When the target is found, its relation to each nearby visible landmark is classified with eq. 1
 (nearest directional mean; close below the relative-radius threshold) and the matching one-step

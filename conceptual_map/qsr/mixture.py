@@ -1,4 +1,4 @@
-"""2D Gaussians fitted to sampled positions, and weighted mixtures of them (seed Fig. 5)."""
+"""2D Gaussians fitted to sampled positions, and weighted mixtures of them (QSR paper, Fig. 5)."""
 
 from __future__ import annotations
 

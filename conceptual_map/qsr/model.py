@@ -61,7 +61,7 @@ class QsrDescription:
         return (self.target, self.chain)
 
     def text(self) -> str:
-        """The seed's notation, e.g. `right(cup, keyboard) & front(keyboard, monitor)`."""
+        """The QSR paper's notation, e.g. `right(cup, keyboard) & front(keyboard, monitor)`."""
         parts, referent = [], self.target
         for step in self.chain:
             parts += [f"{rel}({referent}, {step.of})" for rel in step.relations]

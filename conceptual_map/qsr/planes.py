@@ -1,8 +1,10 @@
-"""Supporting planes from the 3D voxel map (seed §II-B, Fig. 4) and densities over their voxels.
+"""Supporting planes from the 3D voxel map (QSR paper §II-B, Fig. 4) and densities over their
+voxels.
 
 A voxel belongs to a supporting plane when it is occupied, the voxel above it is free and
 nothing is occupied for `clearance` above that: an upward-facing surface, which is what the
-seed's averaged upward normals select. Connected surface voxels at table height form segments.
+QSR paper's averaged upward normals select. Connected surface voxels at table height form
+segments.
 """
 
 from __future__ import annotations

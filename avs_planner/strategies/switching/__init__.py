@@ -1,4 +1,5 @@
-"""The switching planner (seed 003) as a strategy: the CP + DT loop of `loop.py`.
+"""The switching planner of Göbelbecker et al., "A Planning Approach to Active Visual Search in
+Large Environments", as a strategy: the CP + DT loop of `loop.py`.
 
 Option `qsr_cones` (`off` by default): `on` makes view cones on a support, or in a room with
 a perceived landmark, follow the QSR mixture at the perceived landmarks instead of being

@@ -1,4 +1,5 @@
-"""The switching loop (seed 003): plan with assumptions, execute, monitor, replan, give up.
+"""The switching loop of the active visual search paper (Göbelbecker et al.): plan with
+assumptions, execute, monitor, replan, give up.
 
 Assumptive steps stay in the plan and are re-checked by the monitor against every new belief
 state; physical and sensing steps are executed and removed. The CP replans when the monitor
@@ -63,7 +64,7 @@ class LoopConfig:
     # SwitchingLoop._doubt_categories); the state builder's own threshold is 0.9
     doubt_category: float = 0.999
     # the detector looks for the target as the robot drives (Executor.watch); False searches
-    # only through the DT's view cones, as the seed's system did
+    # only through the DT's view cones, as the active visual search paper's system did
     watch: bool = True
     # blocked spots are tried again this many times when nothing else is left
     retry_blocked: int = 2

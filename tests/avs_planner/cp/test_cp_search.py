@@ -1,4 +1,5 @@
-"""Search: optimality at w = 1 against brute force, statuses, the seed's first plan."""
+"""Search: optimality at w = 1 against brute force, statuses, the first plan of the active visual
+search paper."""
 
 from __future__ import annotations
 

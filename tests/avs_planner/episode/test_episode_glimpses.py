@@ -178,7 +178,8 @@ def test_searches_priced_in_the_robots_seconds_learn_from_timed_searches(corrido
 
     mind, builder, executor = corridor
     seed_cost = builder.search_cost("cerealbox", "in")
-    assert seed_cost == builder.config.target_search_cost[0]  # off: the seed's numbers
+    # off: the active visual search paper's numbers
+    assert seed_cost == builder.config.target_search_cost[0]
     mind.body = executor.robot.body()
     builder.config = replace(builder.config, seconds=True)
     body = mind.body

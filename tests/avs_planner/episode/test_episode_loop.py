@@ -1,5 +1,6 @@
-"""The switching loop on the office world, seed 003 Fig. 3a: from the corridor to the cereal
-box in the kitchen, with assumptions in plans, replans on surprise and DT searches."""
+"""The switching loop on the office world, Fig. 3a of the active visual search paper (Göbelbecker
+et al.): from the corridor to the cereal box in the kitchen, with assumptions in plans, replans on
+surprise and DT searches."""
 
 from __future__ import annotations
 
@@ -18,8 +19,8 @@ SUMMARY_FIELDS = {"outcome", "target", "object", "sim_time_s", "distance_m", "pl
 def episode_a(tmp_path_factory):
     out = tmp_path_factory.mktemp("episode_a")
     events: list[dict] = []
-    # the seed's system searched only through the DT (no detector watching on the way), so
-    # the plans, replans and DT calls of Fig. 3a show in the trace
+    # the active visual search paper's system searched only through the DT (no detector
+    # watching on the way), so the plans, replans and DT calls of Fig. 3a show in the trace
     spec = load_scenario("a").episode_spec(seed=1, output_dir=str(out),
                                            strategy_options={"watch": False})
     summary = run_episode(spec, events.append, lambda: False)

@@ -1,5 +1,6 @@
 """The state builder: AVS problems from the robot's maps that the linter accepts and the CP
-solves with the seed's kind of first plan (assume a kitchen behind a placeholder, search it)."""
+solves with the active visual search paper's kind of first plan (assume a kitchen behind a
+placeholder, search it)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""The seed's six office runs (Fig. 3 a-f) and a floor plan no other test has seen.
+"""The active visual search paper's six office runs (Fig. 3 a-f) and a floor plan no other test
+has seen.
 
 Each run takes 2-10 s of wall time, and all six run at three sensor-noise seeds, so they are
 marked slow; scenario (a) also runs in the default suite (test_episode_loop.py).

@@ -143,7 +143,8 @@ def test_a_room_seen_but_not_entered_or_owned_is_unmatched_and_no_room_entered_i
 
 
 def test_an_episode_summary_carries_the_map_score(tmp_path: Path) -> None:
-    """Seed 003's Fig. 3a run: the summary scores the rooms the robot mapped."""
+    """The Fig. 3a run of the active visual search paper (Göbelbecker et al.): the summary
+    scores the rooms the robot mapped."""
     summary = run_episode({"target": "cerealbox", "world": "office", "seed": 1,
                            "output_dir": str(tmp_path)})
     score = summary["map_score"]

@@ -1,5 +1,6 @@
 """The assumption ledger (`reporting.explain`): built from hand-made traces, from a real give-up
-(the seed's scenario c), for strategies without plans, and printed by `avs explain`."""
+(scenario c of the active visual search paper), for strategies without plans, and printed by
+`avs explain`."""
 
 from __future__ import annotations
 
@@ -228,10 +229,11 @@ EXISTS5 = "(assume-obj-exists-in cerealbox new-room1 kitchen new-object1)"
 
 def seen_behind_trace(room: str, belief: dict[str, float],
                       places: list[list[Any]]) -> list[dict[str, Any]]:
-    """Seed 003's Fig. 3a run as `avs simulate --scenario a --seed 1` traced it: plan 5
-    assumes a kitchen behind placeholder5; on the way there the robot sees a table, a counter
-    and the cereal box through the doorway (the mind puts them in `room`), placeholder5
-    vanishes, and the monitor calls the room hypothesis impossible."""
+    """The Fig. 3a run of the active visual search paper (Göbelbecker et al.), as
+    `avs simulate --scenario a --seed 1` traced it: plan 5 assumes a kitchen behind placeholder5;
+    on the way there the robot sees a table, a counter and the cereal box through the doorway
+    (the mind puts them in `room`), placeholder5 vanishes, and the monitor calls the room
+    hypothesis impossible."""
     corridor = {"corridor": 0.9, "office": 0.1}
     return [
         {"t": 0.0, "type": "start", "target": "cerealbox", "world": "office",

@@ -1,4 +1,5 @@
-"""The flap strategy searches `flap_two_rooms` with depth frames in the 3D map (seed 000)."""
+"""The flap strategy (FLAP, Gedicke et al.) searches `flap_two_rooms` with depth frames in the 3D
+map."""
 
 import json
 
@@ -70,7 +71,7 @@ def test_flap_gives_up_on_an_absent_label_through_the_omega_test():
 
 
 def test_the_task_can_give_the_region():
-    """Option `volumes` (the seed's tasks give the volumes): checked with the other options,
+    """Option `volumes` (the FLAP paper's tasks give the volumes): checked with the other options,
     errors naming the entry."""
     flap = get_strategy("flap")
     given = [{"lo": [1, 2, 0.7], "hi": [2, 3, 1.0], "p": 0.3, "name": "t"}, {"lo": [0, 0, 0],
@@ -87,7 +88,7 @@ def test_the_task_can_give_the_region():
 
 
 def test_a_given_region_is_searched_to_the_omega_test_with_quiet_drives():
-    """The seed's experiment: the six volumes of `flap_two_rooms`, `sense_en_route: false`
+    """The FLAP paper's experiment: the six volumes of `flap_two_rooms`, `sense_en_route: false`
     (transitions are driving, turning, torso, head and sensing only: no place classification
     or watch on the way), one region, ended by omega."""
     from bench.flap_experiment import seed_volumes

@@ -1,5 +1,5 @@
-"""The QSR strategies (seed 002) search the desk world: survey, view selection, monitor,
-learning, and the task's QSR descriptions."""
+"""The strategies of the QSR paper (Kunze et al.) search the desk world: survey, view selection,
+monitor, learning, and the task's QSR descriptions."""
 
 import json
 import math
@@ -43,7 +43,7 @@ def test_each_method_finds_a_cup_on_the_desks_and_counts_its_views(strategy, tmp
 
 def test_the_search_monitor_gives_up_on_an_absent_object():
     """Staplers have QSR descriptions but none is in the room: the monitor aborts the search
-    after `abort_s` simulated seconds of search (the seed's 120 s, shortened here)."""
+    after `abort_s` simulated seconds of search (the QSR paper's 120 s, shortened here)."""
     assert get_strategy("qsr").options["abort_s"] == 120.0
     summary = run_episode({**_spec("qsr", options={"abort_s": 30.0}), "target": "stapler"})
     assert summary["outcome"] == "gave_up" and summary["object"] is None
