@@ -15,9 +15,9 @@ from fractions import Fraction
 from pathlib import Path
 
 import pyparsing
+from unified_planning.environment import get_environment
 from unified_planning.io import PDDLReader
 from unified_planning.model import Action, FNode, Problem
-from unified_planning.shortcuts import get_environment
 
 from avs_planner.errors import PddlError, SourcePosition
 from avs_planner.pddl.check import NAME_CLASH, PddlSource, check_read
