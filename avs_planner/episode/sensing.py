@@ -53,7 +53,8 @@ def look_around(ex: Executor) -> None:
 def sense(ex: Executor, poses: list[tuple[float, float, float]], watch: bool = False
           ) -> KnownObject | None:
     """Integrate a scan from `poses`; the detector watches when asked or at a new place.
-    Returns the target the watch confirmed, if any."""
+    Returns the target the watch confirmed, or one confirmed earlier that the scan placed
+    in a room, if any."""
     before = ex.mind.place_map.current_place
     events = ex.mind.sense(ex.robot.scan(), poses, ex.robot.clock)
     place = ex.mind.place_map.current_place
@@ -63,7 +64,9 @@ def sense(ex: Executor, poses: list[tuple[float, float, float]], watch: bool = F
     if watch or (place is not None and place != before):
         seen = ex.watch()
     if ex._unplaced:
-        place_seen(ex)
+        # a target confirmed before the map had a room for it (the very first look) is
+        # found now that the scan gave it one: the caller stops as for a watch's find
+        seen = place_seen(ex) or seen
     if events:
         kinds: dict[str, int] = {}
         for e in events:

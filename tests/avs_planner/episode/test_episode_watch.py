@@ -2,6 +2,8 @@
 DT search, and the planner hears of it through the monitor (it matches the plan's virtual
 object or settles the goal)."""
 
+import pytest
+
 from avs_planner.harness import Episode, EpisodeSpec, run_episode
 
 WORLD = """
@@ -47,9 +49,38 @@ def test_seen_targets_reach_the_monitor_with_the_next_step() -> None:
         atoms = episode.executor.seen_while_moving[oid]
         assert ("label-of", oid, "cerealbox") in atoms and ("detected", oid) in atoms
         assert episode.mind.objects[oid].label == "cerealbox"
-        # nothing is watched before the search starts (seed 003 Fig. 3f: pre-built maps)
+        # nothing is watched before the search starts (Fig. 3f of the active visual search
+        # paper: pre-built maps)
         episode.executor.watching = False
         assert episode.executor.watch() is None
     finally:
         episode.trace.close()
         episode.robot.world.close()
+
+
+def test_a_target_seen_in_the_first_frame_ends_the_look_around_once_the_map_places_it() -> None:
+    """The first frame comes before the first place, so a target confirmed in it waits for
+    the scan behind to give it a room; once placed, it is found, and the robot does not
+    turn on through the rest of its headings."""
+    import dataclasses
+    import math
+
+    spec = EpisodeSpec.from_dict({"target": "cerealbox", "world_file": WORLD, "seed": 0})
+    for _ in range(4):  # the first frame confirms a sighting 9 times in 10
+        episode = Episode(spec)
+        try:
+            executor = episode.executor
+            executor.config = dataclasses.replace(executor.config, look_headings=6)
+            start = executor.robot.pose[2]
+            executor.look_around()
+            found = [o for o in episode.mind.objects.values() if o.label == "cerealbox"]
+            if not found:
+                continue
+            turned = (executor.robot.pose[2] - start) % (2 * math.pi)
+            assert turned == pytest.approx(math.pi, abs=0.1), \
+                "the look went on past the half turn that placed the target"
+            return
+        finally:
+            episode.trace.close()
+            episode.robot.world.close()
+    raise AssertionError("the cereal box ahead was never confirmed")
