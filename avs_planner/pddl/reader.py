@@ -25,6 +25,7 @@ from avs_planner.pddl.model import ProbabilisticProblem, SourceMap
 from avs_planner.pddl.probabilistic import translate_domain
 from avs_planner.pddl.sexpr import Atom, Node, SList, is_number, parse_sexprs
 from avs_planner.pddl.structure import Domain, Report, find_define, read_problem
+from avs_planner.pddl.up_builder import build_problem
 
 _UP_POSITION = re.compile(r"line:?\s*(\d+),\s*col:?\s*(\d+)", re.IGNORECASE)
 
@@ -128,11 +129,33 @@ def _read(path: str | Path) -> str:
 
 
 def _up_parse(domain: str, problem: str, domain_name: str, problem_name: str) -> Problem:
+    """The UP `Problem` of the (translated, repaired) text: built directly by `up_builder`
+    when it takes the text (30-90x faster than UP's pyparsing reader, the same
+    Problem), else read by UP's `PDDLReader`, whose errors become `PddlError`s."""
+    built = _fast_build(domain, problem)
+    if built is not None:
+        return built
     try:
         return PDDLReader().parse_problem_string(domain, problem)
     except Exception as exc:  # noqa: BLE001 - UP raises many kinds; all become PddlError
         file = domain_name if _domain_fails(domain) else problem_name
         raise _convert(exc, file) from exc
+
+
+def _fast_build(domain: str, problem: str) -> Problem | None:
+    """`up_builder`'s Problem, or None to read with UP's reader: for a construct the builder
+    leaves to UP, and for any error on the way (UP's reader then reports it, as before).
+    Warnings the model gave are shown only if the build is kept, so a fallback does not
+    show them twice."""
+    with warnings.catch_warnings(record=True) as caught:
+        try:
+            built = build_problem(domain, problem)
+        except Exception:  # noqa: BLE001 - Unsupported, or what the model rejects
+            return None
+    for warning in caught:
+        warnings.warn_explicit(warning.message, warning.category, warning.filename,
+                               warning.lineno)
+    return built
 
 
 def _domain_fails(domain: str) -> bool:
