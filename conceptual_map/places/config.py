@@ -20,6 +20,9 @@ class PlaceMapConfig:
     door_min_width: float = 0.5
     door_max_depth: float = 0.35  # a door is a short narrowing (a wall), not a narrow corridor
     door_merge_distance: float = 0.5
+    # door hypotheses are also looked for in the mapped free space this close to the robot,
+    # where it narrows (`PlaceMap._doors_in_view`): about the laser's range
+    door_view_radius: float = 5.0
     probe_range: float = 1.5  # how far the opening probe looks for jambs
     reach_tolerance: float = 0.6  # frontier cells this close to reachable space count
     min_frontier_length: float = 0.3

@@ -1,10 +1,17 @@
-"""Door hypotheses from the robot's own grid: a short narrowing in a wall (seed 003 §2).
+"""Door hypotheses from the robot's own grid: a short narrowing in a wall (Göbelbecker et al.,
+"A Planning Approach to Active Visual Search in Large Environments", §2).
 
 At each probe point, chords through the point are probed in many directions up to the first
 occupied cell. The shortest chord is the opening's width across; it is a door when it is
 narrower than ~1.5 m (double doors included), widens again a wall's thickness before and after
 (a narrow corridor or a gap beside a long piece of furniture stays narrow for longer), and its
 jambs continue as walls along the chord's line.
+
+The place map probes the path the robot drove, the way from a place to each new frontier,
+and the ridge of the free space around the robot (`PlaceMap._doors_in_view`: a room seen
+through its door from a corridor is parted from the corridor before the robot goes in, and if
+it never does); points off the path must see the space widen beside the opening in floor known
+to be free, so the mouth of a corridor not yet looked into is no door.
 
 A hypothesis may still be the gap between pieces of furniture, or between furniture and a
 wall: the laser sees furniture as an outline round unseen (or occupied) inside, and an edge of
@@ -49,10 +56,12 @@ class Opening:
 
 
 def chord_extents(
-    grid: OccupancyGrid, points: np.ndarray, angles: np.ndarray, reach: float
+    grid: OccupancyGrid, points: np.ndarray, angles: np.ndarray, reach: float,
+    known_only: bool = False,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Distances (P, A) from each point to the first occupied cell along +axis and -axis."""
-    occupied = grid.state_grid() == CellState.OCCUPIED
+    """Distances (P, A) from each point to the first occupied cell along +axis and -axis
+    (`known_only`: to the first cell not known to be free, the grid's outside included)."""
+    state = grid.state_grid()
     steps = np.arange(1, int(np.ceil(reach / (0.5 * grid.resolution))) + 1) * 0.5 * grid.resolution
     axis = np.stack([np.cos(angles), np.sin(angles)], axis=1)
     out = []
@@ -62,8 +71,9 @@ def chord_extents(
         )
         cells = grid.to_cell(probe.reshape(-1, 2))
         inside = grid.inside(cells)
-        blocked = np.zeros(cells.shape[0], dtype=bool)
-        blocked[inside] = occupied[cells[inside, 0], cells[inside, 1]]
+        blocked = np.full(cells.shape[0], known_only)
+        hit = state[cells[inside, 0], cells[inside, 1]]
+        blocked[inside] = hit != CellState.FREE if known_only else hit == CellState.OCCUPIED
         blocked = blocked.reshape(probe.shape[:3])
         first = np.where(blocked.any(axis=2), steps[np.argmax(blocked, axis=2)], np.inf)
         out.append(first)
@@ -71,12 +81,15 @@ def chord_extents(
 
 
 def openings_along(
-    grid: OccupancyGrid, points: np.ndarray, config: PlaceMapConfig
+    grid: OccupancyGrid, points: np.ndarray, config: PlaceMapConfig, seen_beside: bool = False
 ) -> list[Opening]:
     """Door-like openings at the given points (at most one per point).
 
     The jambs must also continue as straight walls along the chord: otherwise the gap between
     a table's corner and a wall, or a diagonal across a half-seen corner, looks like a door.
+    `seen_beside`: the space must widen beside the opening in floor known to be free (for
+    points the robot did not drive through: the mouth of a corridor not yet looked into
+    would otherwise pass for a door).
     """
     if points.shape[0] == 0:
         return []
@@ -103,7 +116,7 @@ def openings_along(
         axis = np.array([np.cos(angle), np.sin(angle)])
         centre = points[k] + axis * 0.5 * (plus[k, best[k]] - minus[k, best[k]])
         opening = Opening(centre, float(narrow[k]), angle)
-        if _is_short(grid, opening, config) and _in_wall(grid, opening):
+        if _is_short(grid, opening, config, seen_beside) and _in_wall(grid, opening):
             found.append(opening)
     return found
 
@@ -128,12 +141,15 @@ def _in_wall(grid: OccupancyGrid, opening: Opening, reach: float = 0.3) -> bool:
     return True
 
 
-def _is_short(grid: OccupancyGrid, opening: Opening, config: PlaceMapConfig) -> bool:
-    """The chord widens within `door_max_depth` on both sides of the opening."""
+def _is_short(grid: OccupancyGrid, opening: Opening, config: PlaceMapConfig,
+              known_only: bool = False) -> bool:
+    """The chord widens within `door_max_depth` on both sides of the opening (`known_only`:
+    in floor known to be free)."""
     beside = np.stack(
         [opening.centre + s * config.door_max_depth * opening.normal for s in (1.0, -1.0)]
     )
-    plus, minus = chord_extents(grid, beside, np.array([opening.angle]), config.probe_range)
+    plus, minus = chord_extents(grid, beside, np.array([opening.angle]), config.probe_range,
+                                known_only)
     return bool(np.all(plus[:, 0] + minus[:, 0] >= opening.width + _WIDENING))
 
 

@@ -1,4 +1,5 @@
-"""The place map (seed 003 §2): places, paths, placeholders, doors and rooms on a networkx graph.
+"""The place map (Göbelbecker et al., "A Planning Approach to Active Visual Search in Large
+Environments", §2): places, paths, placeholders, doors and rooms on a networkx graph.
 
 `PlaceMap.follow` takes the robot's poses since the last call and the current occupancy grid
 and returns what changed as `MapEvent`s. It only reads the robot's own grid and poses.
@@ -11,9 +12,11 @@ from collections.abc import Sequence
 
 import networkx as nx
 import numpy as np
+from scipy import ndimage
 
 from conceptual_map.errors import MapError
 from conceptual_map.metric.grid2d import OccupancyGrid
+from conceptual_map.metric.logodds import CellState
 from conceptual_map.places.config import PlaceMapConfig
 from conceptual_map.places.doors import Opening, between_walls, crossings, openings_along
 from conceptual_map.places.frontiers import FrontierRegion, frontier_regions
@@ -56,6 +59,9 @@ class PlaceMap:
         self._walled: frozenset[str] = frozenset()
         self._walls_key: tuple | None = None
         self._extents: tuple | None = None  # (key, owner, room ids, free regions): room_extents
+        # the grid's cell states when the free space was last probed for doors (`_doors_in_view`
+        # probes again only near cells that changed since)
+        self._door_probed: tuple | None = None
 
     # ---- public API -------------------------------------------------------------------------
 
@@ -76,6 +82,7 @@ class PlaceMap:
         points = self._trajectory(poses)
         events += self._grow_places(grid, points, time)
         events += self._find_doors(grid, points, time)
+        events += self._doors_in_view(grid, poses[-1][:2], time)
         events += self._refresh_placeholders(grid, poses[-1][:2], time)
         events += self._refresh_rooms(grid, time)  # marks the door edges first
         return events
@@ -245,6 +252,65 @@ class PlaceMap:
         found = openings_along(grid, points, self.config)
         return self._add_openings(found, points, time)
 
+    def _doors_in_view(self, grid: OccupancyGrid, here: Sequence[float], time: float
+                       ) -> list[MapEvent]:
+        """Door hypotheses wherever the mapped free space near the robot narrows to a door's
+        width, not only where the robot drove or means to: a room seen through its door from
+        the corridor is parted from the corridor before the robot goes in (else its floor
+        joined the corridor's room until then, and stayed joined if the robot never went
+        in). Probe points: free cells, within `door_view_radius` of the robot, that the
+        robot's disc fits in and where the clearance has a saddle (as clear as both
+        neighbours across, no clearer than both along), one per 0.2 m square; the opening
+        test is the path's. Only points within `probe_range` of a cell whose state changed
+        since the last probe are probed again (what the test reads lies within that
+        range)."""
+        cfg, res = self.config, grid.resolution
+        clear = grid.clearance()
+        state = grid.state_grid()
+        before = self._door_probed
+        self._door_probed = (tuple(grid.origin), state.copy())
+        changed = np.ones(state.shape, dtype=bool)
+        if (before is not None and before[0] == tuple(grid.origin)
+                and before[1].shape == state.shape):
+            changed = before[1] != state
+            if not changed.any():
+                return []
+            near = int(math.ceil(cfg.probe_range / res))
+            changed = ndimage.maximum_filter(changed, size=2 * near + 1)
+        centre = grid.to_cell(np.asarray([here[:2]], dtype=float))[0]
+        reach = int(math.ceil(cfg.door_view_radius / res))
+        lo = np.maximum(centre - reach, 0)
+        hi = np.minimum(centre + reach + 1, np.asarray(clear.shape))
+        if np.any(hi - lo < 3):
+            return []
+        window = (slice(lo[0], hi[0]), slice(lo[1], hi[1]))
+        c = np.pad(clear[window], 1, mode="edge")
+        mid = c[1:-1, 1:-1]
+
+        def peak(di: int, dj: int) -> tuple[np.ndarray, np.ndarray]:
+            """(as clear as both neighbours along (di, dj), no clearer than both)"""
+            a = c[1 + di:c.shape[0] - 1 + di, 1 + dj:c.shape[1] - 1 + dj]
+            b = c[1 - di:c.shape[0] - 1 - di, 1 - dj:c.shape[1] - 1 - dj]
+            return (mid >= a) & (mid >= b), (mid <= a) & (mid <= b)
+
+        # a saddle of the clearance: widest across the opening, narrowest along the way through
+        (x_max, x_min), (y_max, y_min) = peak(1, 0), peak(0, 1)
+        (d_max, d_min), (e_max, e_min) = peak(1, 1), peak(1, -1)
+        ridge = (x_max & y_min) | (y_max & x_min) | (d_max & e_min) | (e_max & d_min)
+        band = ((mid >= 0.5 * cfg.door_min_width - res) & (mid <= 0.5 * cfg.door_max_width)
+                & (state[window] == CellState.FREE))
+        standable = grid.traversable(cfg.reach_radius)[window]
+        cells = np.argwhere(ridge & band & standable & changed[window]) + lo
+        if cells.size == 0:
+            return []
+        near = np.hypot(*(cells - centre).T) <= reach
+        cells = cells[near]
+        block = max(1, int(round(0.2 / res)))
+        _, first = np.unique(cells // block, axis=0, return_index=True)
+        points = grid.to_world(cells[np.sort(first)])
+        found = openings_along(grid, points, cfg, seen_beside=True)
+        return self._add_openings(found, points[:0], time)
+
     def _add_openings(
         self, openings: list[Opening], path_points: np.ndarray, time: float
     ) -> list[MapEvent]:
@@ -379,7 +445,8 @@ class PlaceMap:
         self, grid: OccupancyGrid, regions: list[FrontierRegion], ids: list[str], time: float
     ) -> list[MapEvent]:
         """Door hypotheses (not yet passed) on the way from a place to a new or moved frontier,
-        like the seed's per-scan door detector; passing through later confirms them."""
+        like the active visual search paper's per-scan door detector; passing through later
+        confirms them."""
         probes = []
         for pid, region in zip(ids, regions, strict=True):
             prev = self.placeholders.get(pid)

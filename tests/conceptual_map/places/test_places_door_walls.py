@@ -45,9 +45,9 @@ def test_a_chord_along_a_table_edge_is_not_between_walls(run: Run) -> None:
 
 
 def test_a_door_passed_by_is_judged_from_the_side_the_robot_was_on() -> None:
-    """Along the corridor only: a wall's face on the room side, next to the jambs, is hidden
-    from the corridor. Seen from the corridor the jambs are walls; asked for both faces,
-    not yet (the door does part the corridor from the room seen through it)."""
+    """Along the corridor only: a wall's face on the room side, next to the jambs, is mostly
+    hidden from the corridor, so only the corridor's side is asked. Seen from there the
+    jambs are walls, and the door parts the corridor from the room seen through it."""
     peek = explore(rooms_world([CORRIDOR, ROOM_K, ROOM_O], DOORS), [(1, 3.25), (7, 3.25)])
     pm = peek.place_map
     assert len(pm.doors) == 2
@@ -56,7 +56,6 @@ def test_a_door_passed_by_is_judged_from_the_side_the_robot_was_on() -> None:
         d = np.subtract(b, a)
         corridor_side = 1 if float(np.dot([-d[1], d[0]], [0.0, -1.0])) > 0 else -1
         assert between_walls(peek.grid, door.ends, depth, sides=(corridor_side,))
-        assert not between_walls(peek.grid, door.ends, depth, sides=(1, -1))
     assert len(pm.rooms) == 1
     (corridor,) = pm.rooms
     assert pm.room_at(peek.grid, (2.0, 5.0)) is None  # the kitchen seen through its door
@@ -80,3 +79,24 @@ def test_a_door_hypothesis_along_furniture_splits_no_room(run: Run) -> None:
     for point in ((5.0, 6.4), (7.3, 6.0), (7.3, 5.0), (4.5, 4.5)):  # both sides of its line
         cell = grid.to_cell(np.asarray([point]))[0]
         assert owner[cell[0], cell[1]] == k
+
+
+@pytest.mark.parametrize("side_room, doors", [
+    ((3.0, 4.0, 5.0, 6.0), [(4.0, 4.0, 0.9)]),  # small: all of it seen through the door
+    ((2.0, 4.0, 6.0, 7.0), [(3.0, 4.0, 0.9), (5.0, 4.0, 0.9)]),  # two doors off the corridor
+])
+def test_a_room_seen_through_its_doors_from_the_corridor_is_not_the_corridors(
+        side_room, doors) -> None:
+    """Driving along the corridor past the doors only: every door is a hypothesis parting
+    the rooms (found where the mapped floor narrows, not only on the path or on the way to
+    a frontier), so the floor seen through a door is not the corridor's."""
+    corridor = (0.0, 2.5, 8.0, 4.0)
+    peek = explore(rooms_world([corridor, side_room], doors), [(1, 3.25), (7, 3.25)])
+    pm = peek.place_map
+    centres = sorted(tuple(round(v) for v in d.centre) for d in pm.doors.values())
+    assert centres == [(round(x), round(y)) for x, y, _ in doors]
+    assert set(pm._walled) == set(pm.doors)
+    (corridor_room,) = pm.rooms
+    x0, y0, x1, y1 = side_room
+    assert pm.room_at(peek.grid, (0.5 * (x0 + x1), 0.5 * (y0 + y1) + 0.5)) is None
+    assert pm.room_at(peek.grid, (4.0, 3.25)) == corridor_room
