@@ -83,11 +83,12 @@ TARGET_RATIO = 5.0  # issue 21: office scale at least this many times faster tha
 
 
 def office_scale(rows: list[dict]) -> str | None:
-    """Issue 21's office-scale target on the seed's situations (domains/avs/problems) and the
-    generated ~20-place problems: the median of FD's own time (its translator parses and
-    grounds, its search searches) over our planning time (grounding + search), against the
-    target, with the ratios over ours with reading (UP's PDDL reader) and FD's end-to-end
-    time beside it; None without such rows."""
+    """The office-scale target on the situations of the active visual search paper ("A Planning
+    Approach to Active Visual Search in Large Environments", Göbelbecker et al.;
+    domains/avs/problems) and the generated ~20-place problems: the median of FD's own time
+    (its translator parses and grounds, its search searches) over our planning time (grounding
+    + search), against the target, with the ratios over ours with reading (UP's PDDL reader)
+    and FD's end-to-end time beside it; None without such rows."""
     group = [r for r in rows if r["label"].startswith("avs/") or "-p20-" in r["label"]]
     if not group:
         return None
@@ -98,7 +99,7 @@ def office_scale(rows: list[dict]) -> str | None:
     solved = sum(r["status"] == "solved" for r in group)
     slowest = max(group, key=lambda r: r["ours_read_s"])
     met = solved == len(group) and own >= TARGET_RATIO
-    return (f"-- office scale ({len(group)}: seed problems + 20-place): median ours+read "
+    return (f"-- office scale ({len(group)}: paper problems + 20-place): median ours+read "
             f"{median_ms:.1f} ms, FD own/ours (planning) {own:.1f}x (target >= "
             f"{TARGET_RATIO:g}x), FD own/ours+read {own_read:.1f}x, FD e2e/ours+read "
             f"{e2e:.1f}x, solved {solved}/{len(group)}: "

@@ -1,7 +1,9 @@
-"""Episode benchmark: the seed's office runs (Fig. 3 a-f) over several sensor-noise seeds.
+"""Episode benchmark: the active visual search paper's office runs (Fig. 3 a-f) over several
+sensor-noise seeds. The paper: "A Planning Approach to Active Visual Search in Large
+Environments" (Göbelbecker et al.).
 
 Run: `.venv/bin/python -m bench.episode_bench [--quick] [--seeds N] [--scenarios a,b,...]`.
-Per scenario: success rate (the seed's outcome: found where the object exists, gave up where it
+Per scenario: success rate (the paper's outcome: found where the object exists, gave up where it
 does not), median simulated time, distance, number of plans, CP time per plan, DT time per
 decision and wall time per episode; a last line sums up every CP call (median, p90, max, the
 share within the CP's 20 ms target). The reference, measured in the same run on the same seeds,

@@ -4,11 +4,12 @@
 
 The maps are synthetic (bench/flap_scene.py): a 6 m x 5 m room with two cluttered tables and a
 two-level shelf, mapped by ray casting laser scans and depth frames from three poses into an
-OccupancyGrid and a VoxelMap; the four target volumes (P_i = 0.2 each, as in the seed) are reset
-to unknown. Robot: PR2 numbers (the seed's robot) unless a line says Pioneer. Times are median
-wall seconds with the process CPU seconds beside them (the machine may be shared). The seed's
-figures (Table 1) were measured on an Intel Core i7 870; the text gives no planner decision
-times (Fig. 6 plots them as bars).
+OccupancyGrid and a VoxelMap; the four target volumes (P_i = 0.2 each, as in the FLAP paper,
+"FLAP for CAOS: Forward-Looking Active Perception for Clutter-Aware Object Search", Gedicke et
+al.) are reset to unknown. Robot: PR2 numbers (the FLAP paper's robot) unless a line says
+Pioneer. Times are median wall seconds with the process CPU seconds beside them (the machine
+may be shared). The FLAP paper's figures (Table 1) were measured on an Intel Core i7 870; its
+text gives no planner decision times (Fig. 6 plots them as bars).
 """
 
 from __future__ import annotations
@@ -56,7 +57,7 @@ def bench_sampling(scene: Scene, belief: TargetBelief, body: RobotBody, repeats:
     wall, cpu, views = timed(run, repeats)
     cover = belief.p_views(v.cells for v in views)
     print(f"view sampling, 200 views ({body.name}): {wall:.3f} s wall, {cpu:.3f} s CPU"
-          f"  (seed {SEED_SAMPLING_S} s: {SEED_SAMPLING_S / wall:.0f}x)  "
+          f"  (FLAP paper {SEED_SAMPLING_S} s: {SEED_SAMPLING_S / wall:.0f}x)  "
           f"p(V̂(S)) = {cover:.3f} of {1 - 0.8 ** len(scene.volumes):.3f} possible")
     return views
 
@@ -70,7 +71,7 @@ def bench_table(scene: Scene, body: RobotBody, views: list, repeats: int) -> tup
                                                  poses[table.kept[j]]) - 1.0)
               for i, j in rng.integers(table.kept.size, size=(60, 2)) if i != j]  # fmt: skip
     print(f"transition table, 50 clusters ({body.name}): {wall:.3f} s wall, {cpu:.3f} s CPU"
-          f"  (seed {SEED_TABLE_S} s: {SEED_TABLE_S / wall:.0f}x)  vs exact A* times: mean "
+          f"  (FLAP paper {SEED_TABLE_S} s: {SEED_TABLE_S / wall:.0f}x)  vs exact A* times: mean "
           f"|error| {np.mean(errors):.1%}, worst {np.max(errors):.1%} ({len(errors)} pairs)")
     return table
 
@@ -107,7 +108,7 @@ def bench_gap(problem: SequencingProblem, instances: int, size: int) -> None:
 def bench_decisions(problem: SequencingProblem, sizes: tuple[int, ...], repeats: int) -> None:
     o = PlannerOptions()
     print(f"B&B decision time (xi={int(o.xi)}, psi={o.psi}, phi={o.phi}, omega={o.omega}); "
-          "seed: no number in the text")
+          "the FLAP paper: no number in the text")
     for n in sizes:
         walls, cpus, ratios, nodes = [], [], [], []
         for k in range(repeats):

@@ -1,22 +1,25 @@
-"""The FLAP seed's experiment (§4, Fig. 6): planner vs greedy, with and without a prior map.
+"""The FLAP paper's experiment (§4, Fig. 6): planner vs greedy, with and without a prior map.
+
+The paper: "FLAP for CAOS: Forward-Looking Active Perception for Clutter-Aware Object Search"
+(Gedicke et al.).
 
     .venv/bin/python -m bench.flap_experiment [--trials N] [--out rows.jsonl]
     .venv/bin/python -m bench.flap_experiment --summarize rows.jsonl
 
-World `flap_two_rooms` (after the seed's Fig. 4), a PR2, trials with seeds 0..N-1, each from a
+World `flap_two_rooms` (after the FLAP paper's Fig. 4), a PR2, trials with seeds 0..N-1, each from a
 random start pose (drawn by the experimenter from the world file, the same for all four cells
 of a seed). Every episode runs `avs simulate --strategy flap` with `pre_explore`: the robot
 surveys the building before the clock starts; with a prior map the survey also integrates depth
 frames, so the 3D map exists before the search; without one only the 2D map is known (the
-seed: "only walls are known"). The search region is the seed's, given by the task (option
-`volumes`, as the seed's tasks give it): a box over each of the six supports of its Fig. 4 (two
-shelf arrangements, one single shelf, three tables), P_i = 0.2 each; it is reset to unknown at
-the start in both. Drives between views follow one path with no sensing on the way
-(`sense_en_route: false`), so executed transitions are what the planner's time model predicts,
-as in the seed's simulation. The target label (`stapler`) is absent, so every trial runs until
-the omega test (p(V̂(S)) < 0.05) ends it, as the seed's trials do.
+FLAP paper: "only walls are known"). The search region is the FLAP paper's, given by the task
+(option `volumes`, as the paper's tasks give it): a box over each of the six supports of its
+Fig. 4 (two shelf arrangements, one single shelf, three tables), P_i = 0.2 each; it is reset
+to unknown at the start in both. Drives between views follow one path with no sensing on the
+way (`sense_en_route: false`), so executed transitions are what the planner's time model
+predicts, as in the FLAP paper's simulation. The target label (`stapler`) is absent, so every
+trial runs until the omega test (p(V̂(S)) < 0.05) ends it, as the FLAP paper's trials do.
 
-Measures per trial, as the seed's (its footnote 4: eq. 4 on the executed sequence): the
+Measures per trial, as the FLAP paper's (its footnote 4: eq. 4 on the executed sequence): the
 expected search time E[T] = sum_k S_{k-1} (t_k - t_{k-1}), S_k the probability that the target
 was not among the cells revealed by the first k views, t_k the simulated clock at view k
 (execution: driving, turning, torso, head, sensing), and the same sum over each cycle's wall
@@ -45,9 +48,9 @@ WORLD = "flap_two_rooms"
 TARGET = "stapler"  # the knowledge puts it on shelves and tables; the world has none
 CELLS = [("map", True, False), ("map", True, True), ("no map", False, False),
          ("no map", False, True)]  # (label, prior_map, greedy)
-SEED_DIFF = {"map": -10.0, "no map": -7.0}  # %: the seed's planner vs greedy (§5)
+SEED_DIFF = {"map": -10.0, "no map": -7.0}  # %: the FLAP paper's planner vs greedy (§5)
 OPTIONS = {"time_limit_s": 0.5, "max_views": 60, "survey_on": False,
-           "sense_en_route": False,  # one region per trial; transitions as the seed models them
+           "sense_en_route": False,  # one region per trial; transitions as the paper models
            "depth_columns": 64}
 
 
@@ -69,8 +72,8 @@ def start_pose(seed: int) -> list[float]:
 
 
 def seed_volumes(margin: float = 0.05, height: float = 0.3, gap: float = 0.3) -> list[dict]:
-    """The seed's search region (its Fig. 4: two shelf arrangements, one single shelf, three
-    tables), given by the experimenter as the seed's tasks give it: a box over each shelf's
+    """The FLAP paper's search region (its Fig. 4: two shelf arrangements, one single shelf,
+    three tables), given by the experimenter as the paper's tasks give it: a box over each shelf's
     and table's top (footprint + `margin`, `height` high), boxes of one label closer than
     `gap` merged into one arrangement; P_i = 0.2 each."""
     spec = load_spec(WORLD)
@@ -158,7 +161,7 @@ def summarize(rows: list[dict]) -> str:
         name = "greedy" if greedy else "B&B (ξ=1, ψ=6, φ=3)"
         lines.append(f"| {label} | {name} | {len(cell)} | " + " | ".join(cols) + " |")
     lines += ["", "| prior map | paired trials | planner vs greedy, E[T] exec + plan | "
-              "E[T] exec | sensing steps | seed (Fig. 6, §5) |", "|---|---|---|---|---|---|"]
+              "E[T] exec | sensing steps | FLAP paper (Fig. 6, §5) |", "|---|---|---|---|---|---|"]
     for label, prior in (("map", True), ("no map", False)):
         plan = {r["seed"]: r for r in rows if r["prior_map"] == prior and not r["greedy"]}
         greedy = {r["seed"]: r for r in rows if r["prior_map"] == prior and r["greedy"]}

@@ -2,7 +2,7 @@
 
 The maps are built the way the robot would build them: laser scans and depth frames ray-cast
 from a few poses into an OccupancyGrid and a VoxelMap; the target volumes are then reset to
-unknown (the seed's "maps that get out of date"). No simulator is involved.
+unknown (the FLAP paper's "maps that get out of date"). No simulator is involved.
 """
 
 from __future__ import annotations

@@ -1,10 +1,12 @@
-"""QSR indirect search (seed 002) timings: view selection, mixture fit, supporting planes.
+"""QSR indirect search timings: view selection, mixture fit, supporting planes.
 
-The scene is the seed-style desk room (`sim/worlds/qsr_desks.yaml`, 8 x 6 m, 5 cm voxels) as fully
-observed synthetic maps. View selection (Algorithm 1, 20 poses, 2D cones + nine 3D frustums),
-without and with line of sight through the voxel map (what the strategies use), is
-printed beside the issue's 20 ms target and beside Algorithm 1's double loop written literally
-in Python (same poses, same voxels, same density), measured in the same run.
+The method is the QSR paper's, "Indirect Object Search based on Qualitative Spatial Relations"
+(Kunze et al.). The scene is a desk room after the QSR paper's (`sim/worlds/qsr_desks.yaml`,
+8 x 6 m, 5 cm voxels) as fully observed synthetic maps. View selection (Algorithm 1, 20 poses,
+2D cones + nine 3D frustums), without and with line of sight through the voxel map (what the
+strategies use), is printed beside the issue's 20 ms target and beside Algorithm 1's double
+loop written literally in Python (same poses, same voxels, same density), measured in the same
+run.
 Run: `.venv/bin/python -m bench.qsr_bench [--quick]`.
 """
 
@@ -46,7 +48,7 @@ def timed(fn: Callable[[int], object], repeats: int) -> list[float]:
 
 def literal_algorithm_1(poses: np.ndarray, points: np.ndarray, density: np.ndarray,
                         half: float, reach: float) -> np.ndarray:  # fmt: skip
-    """sum(psi) += P(v_i) In(v_i, Viewcone(psi)), one voxel at a time, as the seed writes it."""
+    """sum(psi) += P(v_i) In(v_i, Viewcone(psi)), one voxel at a time, as the QSR paper has it."""
     sums = np.zeros(len(poses))
     for k, (x, y, yaw) in enumerate(poses.tolist()):
         for (vx, vy, _), p in zip(points.tolist(), density.tolist(), strict=True):

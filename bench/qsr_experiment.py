@@ -1,7 +1,9 @@
-"""Seed 002's simulated experiments (Kunze et al., Tables II and III) on our desk scenes.
+"""The QSR paper's simulated experiments (Tables II and III) on our desk scenes.
+
+The paper: "Indirect Object Search based on Qualitative Spatial Relations" (Kunze et al.).
 
 Two scenes (`--scene`): `kitchen` (default, `sim/worlds/qsr_kitchen_{a,b,c}.yaml`), like the
-seed's (the TUM kitchen of MORSE): four desks with monitors and keyboards, and as much other
+QSR paper's (the TUM kitchen of MORSE): four desks with monitors and keyboards, and as much other
 supporting surface no QSR points at (counters, a dining table, a meeting table, a sideboard);
 and `desks` (`sim/worlds/qsr_desks_{a,b,c}.yaml`), four desks and nothing else, three of them
 with a cup (there uniform over the supporting planes is nearly the QSR density, and the two
@@ -11,9 +13,9 @@ three methods (`random`, `supporting-planes`, `qsr`) on A; Table III runs `qsr` 
 Every cell is `--trials` searches for a cup (seeds 0..N-1) through
 `avs_planner.harness.run_episode`, learning switched off so that trials are independent.
 
-As in the seed, time and poses are means over the successful trials only; "found" counts
+As in the QSR paper, time and poses are means over the successful trials only; "found" counts
 searches that ended with a confirmed cup that is a cup in the world. Time is the search
-monitor's time (simulated seconds after the survey, which stands in for the seed's given maps
+monitor's time (simulated seconds after the survey, which stands in for the QSR paper's given maps
 and landmark poses); the survey's own time is printed beside it.
 "±" is the half-width of a normal 95% confidence interval of the mean (over successful trials).
 Table II ends with the ordering check of the issue: qsr < supporting-planes < random in mean
@@ -86,13 +88,13 @@ def _fmt(value: float | None, digits: int = 1) -> str:
 def print_table(title: str, rows: list[tuple[str, dict[str, Any], tuple[int, float, float]]]
                 ) -> None:  # fmt: skip
     print(title)
-    print(f"{'':<22} {'found':>7} {'time s':>13} {'poses':>12} | {'seed found':>10} "
+    print(f"{'':<22} {'found':>7} {'time s':>13} {'poses':>12} | {'paper found':>11} "
           f"{'time s':>7} {'poses':>6} | {'survey s':>8} {'wrong':>5}")
     for name, s, (f, t, p) in rows:
         time_s = f"{_fmt(s['time'])} ±{_fmt(s['time_ci'])}"
         poses = f"{_fmt(s['poses'], 2)} ±{_fmt(s['poses_ci'], 2)}"
         print(f"{name:<22} {s['found']:>3}/{s['trials']:<3} {time_s:>13} {poses:>12} | "
-              f"{f:>6}/{SEED_TRIALS:<3} {t:>7.1f} {p:>6.1f} | {_fmt(s['survey']):>8} "
+              f"{f:>7}/{SEED_TRIALS:<3} {t:>7.1f} {p:>6.1f} | {_fmt(s['survey']):>8} "
               f"{s['wrong']:>5}")
     print()
 
@@ -167,7 +169,7 @@ def ordering(table: dict[str, dict[str, Any]], variant: str = "A") -> list[str]:
 
 def with_failures(runs: list[dict[str, Any]], abort_s: float = 120.0) -> tuple[float, float]:
     """Mean search time and poses over all trials, a failed one counted at the monitor's
-    abort time with the poses it had searched (the seed's means leave failures out)."""
+    abort time with the poses it had searched (the QSR paper's means leave failures out)."""
     ok = [r["outcome"] == "found" and r["correct"] for r in runs]
     time_s = statistics.fmean(r["search_time_s"] if good else max(abort_s, r["search_time_s"])
                               for r, good in zip(runs, ok, strict=True))  # fmt: skip
@@ -206,9 +208,9 @@ def main(argv: list[str] | None = None) -> int:
     for variant in ("B", "C") if "III" in tables and not args.from_json else ():
         cells[f"qsr/{variant}"] = run_cell("qsr", variant, args.trials, options, args.scene)
     table = {key: stats(runs) for key, runs in cells.items()}
-    print(f"seed 002 experiments, scene {args.scene}, {args.trials} trials per cell "
+    print(f"QSR paper experiments, scene {args.scene}, {args.trials} trials per cell "
           f"(seeds 0..{args.trials - 1}), "
-          f"options {options or 'default'}; ours beside the seed's (10 trials); time and poses "
+          f"options {options or 'default'}; ours beside the paper's (10 trials); time and poses "
           f"over successful trials; "
           + (f"from {args.from_json}\n" if args.from_json else
              f"wall {time.perf_counter() - start:.0f} s\n"))

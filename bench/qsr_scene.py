@@ -1,4 +1,4 @@
-"""The desk scene of the seed's experiments (`sim/worlds/qsr_desks.yaml`) as synthetic maps.
+"""The desk scene of the QSR paper's experiments (`sim/worlds/qsr_desks.yaml`) as synthetic maps.
 
 For QSR tests and benchmarks only: the geometry is written out here (nothing imports `sim`), and
 the maps are filled as if fully observed (boxes occupied, air free), so supporting planes and

@@ -15,7 +15,7 @@ def test_office_scale_takes_the_seed_and_20_place_problems_only():
             _row("gen/avs-p20-h5-r4-l8-s1", 30, 3000, read_ms=300),
             _row("gen/avs-p8-h2-r2-l4-s0", 1, 500)]  # 8 places: not office scale
     line = office_scale(rows)  # own/ours: 90, 200, 136.4, 100 -> 118.2
-    assert line.startswith("-- office scale (4: seed problems + 20-place): median ours+read "
+    assert line.startswith("-- office scale (4: paper problems + 20-place): median ours+read "
                            "200.0 ms, FD own/ours (planning) 118.2x (target >= 5x)")
     assert "FD own/ours+read 10.0x" in line and "solved 4/4: met" in line
     assert line.endswith("slowest gen/avs-p20-h5-r4-l8-s0 300.0 ms")
