@@ -33,7 +33,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -48,6 +48,7 @@ from avs_planner.pddl.reader import _names_shared, apply_repairs
 from avs_planner.pddl.sexpr import parse_sexprs
 from avs_planner.pddl.up_builder import build_problem
 from bench.avs_generator import AvsSize, generate
+from bench.pddl_bench import best_of
 
 ROOT = Path(__file__).resolve().parents[1]
 IPC = ROOT.parent / "shared" / "ipc"  # beside the checkout
@@ -78,16 +79,6 @@ def cases(quick: bool) -> list[tuple[str, str, str]]:
     return found[:3] + found[-1:] if quick else found
 
 
-def median_time(repeats: int, run: Callable[[], object]) -> float:
-    """Median wall time of `repeats` runs, in seconds."""
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        run()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
-
-
 @contextmanager
 def ups_reader_only() -> Iterator[None]:
     """`read_text` as before the fast path: UP's reader builds every Problem."""
@@ -112,11 +103,11 @@ def measure(domain: str, problem: str, repeats: int) -> tuple[float, float, floa
     """Seconds for UP's reader, the builder, read_text with UP's reader, read_text."""
     text, shared = up_text(domain, problem)
     with _names_shared(shared):
-        up = median_time(repeats, lambda: PDDLReader().parse_problem_string(text, problem))
-        built = median_time(repeats, lambda: build_problem(text, problem))
+        up = best_of(repeats, lambda: PDDLReader().parse_problem_string(text, problem))
+        built = best_of(repeats, lambda: build_problem(text, problem))
     with ups_reader_only():
-        read_up = median_time(repeats, lambda: read_text(domain, problem))
-    read_fast = median_time(repeats, lambda: read_text(domain, problem))
+        read_up = best_of(repeats, lambda: read_text(domain, problem))
+    read_fast = best_of(repeats, lambda: read_text(domain, problem))
     return up, built, read_up, read_fast
 
 
