@@ -51,6 +51,7 @@ from avs_planner.up_engine import to_up_plan
 from bench.avs_generator import AvsSize, generate
 from bench.cp_report import office_scale, report  # noqa: F401 - office_scale: tests
 from bench.fd_runner import FdRun, run_fd
+from tests.ipc import domain_for, instances, ipc_folders
 
 ROOT = Path(__file__).resolve().parents[1]
 IPC = Path(os.environ.get("AVS_IPC_DIR", ROOT.parent / "shared" / "ipc"))  # beside the checkout
@@ -103,22 +104,21 @@ def ipc_cases(quick: bool, full: bool = False, domains: tuple[str, ...] = (),
     """The IPC instances: every other one (`quick`: the first two, `full`: all), or those
     numbered `numbers`; of every domain, or of `domains`."""
     cases = []
-    found = {d.parent.name: d for d in sorted(require_ipc().glob("*/domain.pddl"))}
+    found = {folder.name: folder for folder in ipc_folders(require_ipc())}
     unknown = sorted(set(domains) - set(found))
     if unknown:
         raise SystemExit(f"no IPC domain {', '.join(unknown)} in {IPC} (there are: "
                          f"{', '.join(found)})")
-    for name, domain in found.items():
+    for name, folder in found.items():
         if domains and name not in domains:
             continue
-        instances = sorted(domain.parent.glob("instance-*.pddl"),
-                           key=lambda p: int(p.stem.split("-")[1]))
+        numbered = instances(folder)
         if numbers:
-            picked = [p for p in instances if int(p.stem.split("-")[1]) in numbers]
+            picked = [p for p in numbered if int(p.stem.split("-")[1]) in numbers]
         else:
-            picked = instances if full else instances[:2] if quick else instances[::2]
-        for problem in picked:
-            cases.append(Case(f"{name}/{problem.stem}", domain, problem, False))
+            picked = numbered if full else numbered[:2] if quick else numbered[::2]
+        for problem in picked:  # domain.pddl, or domain-N.pddl where one per instance
+            cases.append(Case(f"{name}/{problem.stem}", domain_for(problem), problem, False))
     if full:  # instance 1 of every domain first, then 2, ...: a run stopped early is a sample
         cases.sort(key=lambda c: int(c.problem.stem.split("-")[1]))  # stable: by domain within
     return cases

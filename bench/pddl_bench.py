@@ -19,6 +19,7 @@ from unified_planning.io import PDDLReader
 from avs_planner.pddl import PddlSource, check, read_text
 from avs_planner.pddl.probabilistic import translate_domain
 from avs_planner.pddl.sexpr import parse_sexprs
+from tests.ipc import domain_for, instances, ipc_folders
 
 ROOT = Path(__file__).resolve().parents[1]
 IPC = Path(__file__).resolve().parents[2] / "shared" / "ipc"  # beside the checkout
@@ -28,10 +29,10 @@ def cases(quick: bool) -> list[tuple[str, Path, Path]]:
     """(label, domain, problem): the AVS problems and the IPC domains' first/last instances."""
     avs = ROOT / "domains" / "avs"
     found = [(f"avs/{p.stem}", avs / "domain.pddl", p) for p in sorted(avs.glob("problems/*"))]
-    for domain in sorted(IPC.glob("*/domain.pddl")):
-        instances = sorted(domain.parent.glob("instance-*.pddl"), key=lambda p: len(p.read_text()))
-        for problem in instances[:1] if quick else [instances[0], instances[-1]]:
-            found.append((f"{domain.parent.name}/{problem.stem}", domain, problem))
+    for folder in ipc_folders(IPC):  # domain.pddl, or domain-N.pddl per instance
+        numbered = sorted(instances(folder), key=lambda p: len(p.read_text()))
+        for problem in numbered[:1] if quick else [numbered[0], numbered[-1]]:
+            found.append((f"{folder.name}/{problem.stem}", domain_for(problem), problem))
     return found[:4] if quick else found
 
 

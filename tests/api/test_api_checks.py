@@ -1,5 +1,5 @@
-"""Task input is checked at submission (issue 22, item 5): each wrong field is a 422 naming it,
-against the real knowledge base, built-in worlds and strategy registry."""
+"""Task input is checked at submission: each wrong field is a 422 naming it, against the
+real knowledge base, built-in worlds and strategy registry."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""`avs plan --json | head`: a reader that goes away is not an internal error (issue 22)."""
+"""`avs plan --json | head`: a reader that goes away early is not an internal error; the
+command exits with its broken-pipe status and prints no traceback."""
 
 from __future__ import annotations
 

@@ -19,7 +19,7 @@ from unified_planning.shortcuts import (
 )
 
 from avs_planner.pddl.model import ProbabilisticProblem
-from tests.ipc import IPC, ipc_domains
+from tests.ipc import IPC, domain_for, ipc_domains
 
 ROOT = Path(__file__).resolve().parents[3]
 AVS_DOMAIN = ROOT / "domains" / "avs" / "domain.pddl"
@@ -37,10 +37,10 @@ def avs_and_ipc_makers() -> list[tuple[str, object]]:
         for problem in sorted((AVS_DOMAIN.parent / "problems").glob("*.pddl"))
     ]
     for name in ipc_domains(solvable=True):
-        domain = IPC / name / "domain.pddl"
-        instance = domain.parent / "instance-1.pddl"
+        instance = IPC / name / "instance-1.pddl"
         if instance.exists():
-            cases.append((domain.parent.name, lambda d=domain, i=instance: read_files(d, i)))
+            domain = domain_for(instance)  # domain.pddl, or domain-1.pddl where one per instance
+            cases.append((name, lambda d=domain, i=instance: read_files(d, i)))
     return cases
 
 

@@ -11,12 +11,12 @@ from avs_planner.cp.planner import plan
 from avs_planner.cp.search import PlanStatus, SearchOptions
 from avs_planner.pddl import read_files
 from avs_planner.up_engine import to_up_plan
-from tests.ipc import require_ipc
+from tests.ipc import domain_for, require_ipc
 
 
 def _read(domain: str, n: int):
-    folder = require_ipc() / domain
-    return read_files(folder / "domain.pddl", folder / f"instance-{n}.pddl")
+    instance = require_ipc() / domain / f"instance-{n}.pddl"
+    return read_files(domain_for(instance), instance)
 
 
 def test_anytime_returns_improving_plans() -> None:
@@ -124,9 +124,9 @@ def test_avs_plan_runs_the_anytime_mode_by_default_when_a_timeout_bounds_it(monk
 
 
 def _solve_params() -> list:
-    from tests.ipc import IPC, NOT_SOLVED_YET
+    from tests.ipc import NOT_SOLVED_YET, ipc_domains
 
-    names = sorted(d.parent.name for d in IPC.glob("*/domain.pddl"))
+    names = ipc_domains(readable=False)
     return [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=NOT_SOLVED_YET[n]))
             if n in NOT_SOLVED_YET else n for n in names]
 

@@ -138,14 +138,14 @@ def test_static_fluent_names_match_up(shapes, corridor):
     from unified_planning.io import PDDLReader
 
     from avs_planner.cp.grounding import static_fluent_names
-
-    from .conftest import IPC
+    from tests.ipc import IPC, domain_for
 
     problems = [shapes.problem, corridor.problem]
-    for domain in ("blocks", "elevators", "logistics", "gripper"):
+    for domain in ("blocks", "elevators", "logistics", "gripper", "airport", "openstacks",
+                   "trucks"):
         if (IPC / domain).is_dir():
-            problems.append(PDDLReader().parse_problem(
-                str(IPC / domain / "domain.pddl"), str(IPC / domain / "instance-1.pddl")))
+            instance = IPC / domain / "instance-1.pddl"
+            problems.append(PDDLReader().parse_problem(str(domain_for(instance)), str(instance)))
     for problem in problems:
         expected = frozenset(f.name for f in problem.get_static_fluents())
         assert static_fluent_names(problem) == expected

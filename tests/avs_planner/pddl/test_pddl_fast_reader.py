@@ -12,7 +12,6 @@ in one environment, so the very same nodes).
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import pytest
@@ -31,7 +30,7 @@ from avs_planner.pddl.sexpr import parse_sexprs
 from avs_planner.pddl.up_builder import Unsupported, build_problem
 from bench.avs_generator import AvsSize, generate
 from tests.avs_planner.cp.pddl_cases import lamps
-from tests.ipc import require_ipc
+from tests.ipc import domain_for, instances, ipc_folders, require_ipc
 
 ROOT = Path(__file__).resolve().parents[3]
 AVS = ROOT / "domains" / "avs"
@@ -88,17 +87,11 @@ def assert_same(domain: str, problem: str) -> tuple[Problem, Problem]:
 def ipc_pairs(first_only: bool) -> list[tuple[str, Path, Path]]:
     """(label, domain, problem) per IPC instance; `domain-N.pddl` where a domain has one
     per instance."""
-    ipc = require_ipc()
     found = []
-    for folder in sorted(p for p in ipc.iterdir() if p.is_dir()):
-        instances = sorted(folder.glob("instance-*.pddl"),
-                           key=lambda p: int(re.sub(r"\D", "", p.stem)))
-        for instance in instances[:1] if first_only else instances:
-            number = instance.stem.split("-")[1]
-            domain = folder / "domain.pddl"
-            if not domain.exists():
-                domain = folder / f"domain-{number}.pddl"
-            found.append((f"{folder.name}/{instance.stem}", domain, instance))
+    for folder in ipc_folders(require_ipc()):
+        numbered = instances(folder)
+        for instance in numbered[:1] if first_only else numbered:
+            found.append((f"{folder.name}/{instance.stem}", domain_for(instance), instance))
     return found
 
 

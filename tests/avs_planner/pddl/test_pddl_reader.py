@@ -12,13 +12,12 @@ from avs_planner.pddl import read_files, read_text
 from avs_planner.pddl.probabilistic import translate_domain
 from avs_planner.pddl.reader import _up_parse
 from avs_planner.pddl.sexpr import parse_sexprs
-from tests.ipc import IPC, NOT_READ_YET
+from tests.ipc import IPC, NOT_READ_YET, domain_for, instances, ipc_folders
 
 ROOT = Path(__file__).resolve().parents[3]
 AVS = ROOT / "domains" / "avs"
-IPC_PAIRS = [
-    (d, p) for d in sorted(IPC.glob("*/domain.pddl")) for p in sorted(d.parent.glob("instance-*"))
-]
+# (domain, instance) of every IPC instance: domain.pddl, or domain-N.pddl for instance-N.pddl
+IPC_PAIRS = [(domain_for(p), p) for folder in ipc_folders() for p in instances(folder)]
 READ_PAIRS = [(d, p) for d, p in IPC_PAIRS if d.parent.name not in NOT_READ_YET]
 
 TINY_DOMAIN = """(define (domain tiny)
@@ -83,7 +82,8 @@ def test_translation_keeps_every_offset() -> None:
 
 
 FIRST_IPC = [
-    pytest.param(d, p, marks=pytest.mark.xfail(strict=True, reason=f"issue 21: {NOT_READ_YET[n]}"))
+    pytest.param(d, p, marks=pytest.mark.xfail(strict=True,
+                                               reason=f"not read yet: {NOT_READ_YET[n]}"))
     if (n := d.parent.name) in NOT_READ_YET else pytest.param(d, p)
     for d, p in IPC_PAIRS if p.name == "instance-1.pddl"
 ]
