@@ -26,6 +26,7 @@ from avs_planner.dt import DTRewards, DTSession, DTStatus, SearchBudget, TravelC
 from avs_planner.dt.domain import REJECT, ActionKind
 from avs_planner.episode.driving import TARGET_SEEN
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
+from avs_planner.episode.sensing import glimpse
 from avs_planner.episode.viewcones import ConeSet, support_relations, support_spaces
 from conceptual_map.errors import MapError
 from conceptual_map.metric import plan_path
@@ -118,7 +119,7 @@ class ViewConeSearch:
         self.ex.stats.views += 1
         if self.ex.on_look is not None:
             self.ex.on_look()
-        match = self._detect_once(label, relation, location)
+        match = self._detect_once(label, relation, location, self._also_for(label))
         if match is None:
             self.ex.emit("observation", label=label, detected=False)
             self._glimpse_tops(label, relation, location)
@@ -147,8 +148,26 @@ class ViewConeSearch:
         glimpses.frame(self.ex.robot.pose, self.head[0], self.head[1], [], supports,
                        tops_label=label)
 
-    def _detect_once(self, label: str, relation: str, location: str) -> SeenLike | None:
-        seen = [s for s in self.ex.robot.detect([label]) if s.label == label]
+    def _also_for(self, label: str) -> list[str]:
+        """The labels the first frame of a look for the target also looks for: the supports
+        the problem knows of, as the watch's frames do (`sensing.glimpse`). A support it
+        shows becomes a known object; one it does not show is less likely in the cells the
+        frame had in view with a free line of sight. Without this, a room the DT had looked
+        through kept most of its prior count of desks not found yet, each with its share
+        of the target, and the stopping rule went on searching rooms already searched.
+        (The cones' coverage of the target's location is no measure of that: it does not
+        know what the furniture hides, and a kitchen whose table stands behind a fridge
+        row lost its tables and counters to it, and with them its category.)"""
+        if self.ex.glimpses is None or label != self.ex.builder.task.target:
+            return []
+        return [s for s in self.ex.builder.supports if s != label]
+
+    def _detect_once(self, label: str, relation: str, location: str,
+                     also: Sequence[str] = ()) -> SeenLike | None:
+        frame = self.ex.robot.detect([label, *also])
+        if also:
+            glimpse(self.ex, frame, list(also), self.head)
+        seen = [s for s in frame if s.label == label]
         matches = [s for s in seen if self._inside(s, relation, location)]
         for s in seen:
             self.ex.stats.detections.append((s.position[0], s.position[1], label, s in matches))

@@ -43,6 +43,11 @@ def look_around(ex: Executor) -> None:
     for k in range(1, headings):
         if found is not None and k > half:  # the target is here: the map is done
             break
+        if ex._unplaced and k < half:
+            # the target is confirmed and waits only for the scan behind to give it a
+            # room: turn straight there (a frame at each heading on the way cost a second
+            # on every target seen in the first frame)
+            continue
         ex.robot.turn_to(yaw + 2.0 * math.pi * k / headings)
         if k == half:
             found = ex._sense([ex.robot.pose], watch=True) or found
@@ -88,10 +93,14 @@ def watch(ex: Executor) -> KnownObject | None:
         return None
     label = ex.builder.task.target
     ex.robot.look(0.0, ahead_tilt(ex.camera))
-    labels = [label, *ex.builder.supports] if ex.glimpses is not None else [label]
+    # once a target is confirmed and only waits for the scan to give it a room, what the
+    # frame shows of supports no longer matters: confirming a desk seen in passing took
+    # a frame (a second) before the target could be reported
+    glimpsing = ex.glimpses is not None and not ex._unplaced
+    labels = [label, *ex.builder.supports] if glimpsing else [label]
     frame = ex.robot.detect(labels)
     first = [s for s in frame if s.label == label]
-    if ex.glimpses is not None:
+    if glimpsing:
         glimpse(ex, frame, labels)
     if not first or ex.known_near(first[0]):
         return None
@@ -105,14 +114,18 @@ def watch(ex: Executor) -> KnownObject | None:
     return place_seen(ex)
 
 
-def glimpse(ex: Executor, frame: list[SeenLike], labels: list[str]) -> None:
-    """What one frame taken in passing says: the labels it did not show are less likely
-    where it looked; supports it shows (seen again in a second frame) become known."""
+def glimpse(ex: Executor, frame: list[SeenLike], labels: list[str],
+            head: tuple[float, float] | None = None) -> None:
+    """What one frame (the head at `head`, pan and tilt; by default ahead, as the watch
+    looks) says of `labels`: those it did not show are less likely where it looked;
+    supports it shows (seen again in a second frame) become known. The tops of known
+    supports count for the target only when the target is one of `labels`."""
     assert ex.glimpses is not None
     target = ex.builder.task.target
     shown = {s.label for s in frame}
     unseen = [lab for lab in labels if lab not in shown]
-    changed = ex.glimpses.frame(ex.robot.pose, 0.0, ahead_tilt(ex.camera), unseen,
+    pan, tilt = head if head is not None else (0.0, ahead_tilt(ex.camera))
+    changed = ex.glimpses.frame(ex.robot.pose, pan, tilt, unseen,
                                 ex._supports_of(target) if target in unseen else (),
                                 tops_label=target)
     if changed:

@@ -233,3 +233,41 @@ def test_a_top_partly_in_the_frame_is_searched_in_part() -> None:
     assert mind.cmap.objects.remaining(where, "cerealbox") == pytest.approx(part)
     glimpses.frame((1.0, 2.5, 0.0), 0.0, -0.2, [], [table.id], tops_label="cerealbox")
     assert mind.cmap.objects.remaining(where, "cerealbox") == pytest.approx(0.36)
+
+
+
+def test_a_dt_look_for_the_target_is_a_look_for_its_supports(corridor) -> None:
+    """A DT frame looks for the target's supports as the watch's frames do: one that shows
+    no desk lowers the room's count of desks not found yet where it had a free view, and
+    with it the target's share on them. It used to look for the target alone, so a room
+    the DT had searched through kept its prior count of desks, and the stopping rule kept
+    it worth searching."""
+    mind, builder, executor = corridor
+    if executor.glimpses is None:
+        executor.enable_glimpses()
+    room, _ = _here(mind)
+    target = builder.task.target
+    supports = [s for s in builder.supports if s != target]
+    assert supports
+    before = {s: mind.cmap.objects.remaining(room, s) for s in supports}
+    p_before = mind.cmap.p_unsearched(target, room)
+    asked: list[list[str]] = []
+    detect = executor.robot.detect
+
+    class Robot:  # the executor's robot, recording what each frame looks for
+        def __getattr__(self, name):  # noqa: ANN001, ANN204
+            return getattr(executor.robot_, name)
+
+        def detect(self, labels):  # noqa: ANN001, ANN202
+            asked.append(list(labels))
+            return [s for s in detect(labels) if s.label not in supports]  # no desk shows
+
+    executor.robot_, executor.robot = executor.robot, Robot()
+    search = ViewConeSearch(executor, target, "in", room)
+    for yaw in (0.0, 1.57, 3.14, -1.57):
+        executor.robot_.turn_to(yaw)
+        search._look(target, "in", room)
+    assert asked and set(supports) <= set(asked[0])
+    after = {s: mind.cmap.objects.remaining(room, s) for s in supports}
+    assert all(after[s] < before[s] for s in supports), (before, after)
+    assert mind.cmap.p_unsearched(target, room) < p_before

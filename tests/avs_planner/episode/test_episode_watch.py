@@ -60,8 +60,10 @@ def test_seen_targets_reach_the_monitor_with_the_next_step() -> None:
 
 def test_a_target_seen_in_the_first_frame_ends_the_look_around_once_the_map_places_it() -> None:
     """The first frame comes before the first place, so a target confirmed in it waits for
-    the scan behind to give it a room; once placed, it is found, and the robot does not
-    turn on through the rest of its headings."""
+    the scan behind to give it a room; the robot turns straight to that scan (no frame at
+    the headings between: they cost a second and can show nothing that matters now), and
+    once placed, the target is found, and the robot does not turn on through the rest of
+    its headings."""
     import dataclasses
     import math
 
@@ -72,6 +74,7 @@ def test_a_target_seen_in_the_first_frame_ends_the_look_around_once_the_map_plac
             executor = episode.executor
             executor.config = dataclasses.replace(executor.config, look_headings=6)
             start = executor.robot.pose[2]
+            clock = executor.robot.clock
             executor.look_around()
             found = [o for o in episode.mind.objects.values() if o.label == "cerealbox"]
             if not found:
@@ -79,8 +82,27 @@ def test_a_target_seen_in_the_first_frame_ends_the_look_around_once_the_map_plac
             turned = (executor.robot.pose[2] - start) % (2 * math.pi)
             assert turned == pytest.approx(math.pi, abs=0.1), \
                 "the look went on past the half turn that placed the target"
+            assert executor.robot.clock - clock == pytest.approx(
+                _half_turn_look(spec), abs=0.01), \
+                "the robot stopped at headings before the half turn"
             return
         finally:
             episode.trace.close()
             episode.robot.world.close()
     raise AssertionError("the cereal box ahead was never confirmed")
+
+
+def _half_turn_look(spec: EpisodeSpec) -> float:
+    """Seconds of the same first look with two headings: a frame, the half turn, a scan."""
+    import dataclasses
+
+    episode = Episode(spec)
+    try:
+        executor = episode.executor
+        executor.config = dataclasses.replace(executor.config, look_headings=2)
+        clock = executor.robot.clock
+        executor.look_around()
+        return executor.robot.clock - clock
+    finally:
+        episode.trace.close()
+        episode.robot.world.close()
