@@ -1,4 +1,4 @@
-"""The service under an operator (issue 22): shutdown time with open event streams, and a
+"""The service under an operator: shutdown time with open event streams, and a
 short plan's latency behind a long one.
 
 1. `avs serve` with 2 running episodes (a stand-in runner that runs until stopped) and N open

@@ -1,4 +1,4 @@
-"""PR2 vs Pioneer on the same worlds and seeds (issue 26's targets).
+"""PR2 vs Pioneer on the same worlds and seeds.
 
 Run: `.venv/bin/python -m bench.body_bench [--worlds 20] [--scenario-seeds 3] [--jsonl FILE]`.
 Runs the switching planner with each robot on the present targets of generated office worlds

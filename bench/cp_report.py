@@ -79,7 +79,7 @@ def stages(rows: list[dict]) -> str | None:
            f"{_median(r['warm_s'] for r in group) * 1e3:.1f} ms"
 
 
-TARGET_RATIO = 5.0  # issue 21: office scale at least this many times faster than FD's own
+TARGET_RATIO = 5.0  # the office-scale target: at least this many times faster than FD's own
 
 
 def office_scale(rows: list[dict]) -> str | None:
@@ -107,7 +107,8 @@ def office_scale(rows: list[dict]) -> str | None:
             f"{slowest['ours_read_s'] * 1e3:.1f} ms")
 
 
-BUILDING_TARGETS_MS = {80: 50.0, 160: 200.0}  # issue 21: cold median planning time
+# the building-scale target: cold median planning time (ms) per number of places
+BUILDING_TARGETS_MS = {80: 50.0, 160: 200.0}
 
 
 def building_scale(rows: list[dict]) -> str | None:

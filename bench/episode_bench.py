@@ -92,7 +92,7 @@ def run(scenarios: list[str], seeds: list[int], with_reference: bool, jsonl: Pat
 
 def _print_cp_calls(rows: list[dict], target_s: float = 0.020) -> None:
     """Every CP call of every episode (first plans and replans): the planning times the
-    switching loop actually waits for, against the CP's 20 ms target (issue 3)."""
+    switching loop actually waits for, against the CP's 20 ms target."""
     calls = sorted(t for r in rows for t in r["cp_time_s"])
     if not calls:
         return

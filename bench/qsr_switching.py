@@ -1,4 +1,4 @@
-"""The switching planner with and without QSR-weighted view cones (issue 25, item 4).
+"""The switching planner with and without QSR-weighted view cones.
 
 Runs `switching` searches for a cup (seeds 0..N-1) per world with option `qsr_cones` set to
 `on` (cones follow the QSR mixture at the perceived landmarks), `observe` (the same landmark

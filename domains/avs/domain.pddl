@@ -1,5 +1,5 @@
 ;; Active visual search (AVS), after Goebelbecker et al., "A planning approach to active
-;; visual search in large environments" (seed 003), section "Domain Modeling".
+;; visual search in large environments", section "Domain Modeling".
 ;;
 ;; Conventions (see domains/README.md):
 ;;  * (probabilistic P E): with probability P the effect E happens, otherwise the action fails.

@@ -1,4 +1,4 @@
-"""Access control for a shared service (issue 35, item 4): keys with roles from a file or the
+"""Access control for a shared service: keys with roles from a file or the
 environment, reads that need a key, each key seeing its own tasks, per-key quotas."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The service under attack (issue 35, items 1 and 2): no file path from a request reaches the
+"""The service under attack: no file path from a request reaches the
 file system, and a small request cannot buy unbounded work or an unbounded answer."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The smaller items of issue 35 (item 5): Last-Event-ID `null`, JSON errors on the event
+"""The service's smaller edge cases: Last-Event-ID `null`, JSON errors on the event
 stream's path (and so documented), the one-world rule in the schema, the SSE keep-alive, and
 DELETE of an ended plan job."""
 

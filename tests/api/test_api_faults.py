@@ -1,4 +1,4 @@
-"""Faults recover without a restart (issue 35, item 3): a store that fails writes (disk full)
+"""Faults recover without a restart: a store that fails writes (disk full)
 fails the affected task with the reason, keeps the workers, turns health to degraded and back,
 and runs the waiting tasks then; no error is plain text; a damaged store at start-up is a
 documented exit code with a one-line message."""

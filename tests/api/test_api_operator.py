@@ -1,6 +1,7 @@
-"""Issue 22 in-process: streams end on shutdown, fair and cancellable plan jobs, asynchronous
-plans, local /docs, and the small protocol fixes (empty Idempotency-Key, 405 Allow, bodies
-that are not UTF-8, attempts after a requeue, no server paths in events)."""
+"""The service under an operator, in-process: streams end on shutdown, fair and cancellable
+plan jobs, asynchronous plans, local /docs, and the small protocol fixes (empty
+Idempotency-Key, 405 Allow, bodies that are not UTF-8, attempts after a requeue, no server
+paths in events)."""
 
 from __future__ import annotations
 

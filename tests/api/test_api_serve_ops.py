@@ -1,6 +1,6 @@
-"""Issue 22 against a real `avs serve` process: one instance per data dir, a forged
-X-Forwarded-For does not escape the rate limit, SIGTERM with an open stream is quick and the
-task resumes, and a plan client that hangs up frees its worker."""
+"""The service under an operator, against a real `avs serve` process: one instance per data
+dir, a forged X-Forwarded-For does not escape the rate limit, SIGTERM with an open stream is
+quick and the task resumes, and a plan client that hangs up frees its worker."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-;; Seed 003, section 4, first plan: the robot is in the middle of the corridor (room1) and
+;; Goebelbecker et al., "A Planning Approach to Active Visual Search in Large Environments",
+;; section 4, first plan: the robot is in the middle of the corridor (room1) and
 ;; nothing is explored yet. Placeholder place1 lies behind a door hypothesis (likely a new
 ;; room, probably a kitchen); placeholder place3 is the open end of the corridor.
 ;; Target: a cerealbox. Expected best plan for c + R(1 - p), R = 500 (see domains/README.md):

@@ -1,4 +1,5 @@
-;; Seed 003, section 4, second plan: the robot explored the corridor (room1), found office1
+;; Goebelbecker et al., "A Planning Approach to Active Visual Search in Large Environments",
+;; section 4, second plan: the robot explored the corridor (room1), found office1
 ;; (room2, an office) and then room3, which is probably a kitchen (0.8). room3 is not fully
 ;; explored: its placeholder place16 is still to be visited. The corridor's far end
 ;; (placeholder place20) is unexplored. Target: a cerealbox. Expected best plan (R = 500):

@@ -1,4 +1,5 @@
-;; Seed 003, section 4, third plan: the DT planner found a table (object1) in room3, and
+;; Goebelbecker et al., "A Planning Approach to Active Visual Search in Large Environments",
+;; section 4, third plan: the DT planner found a table (object1) in room3, and
 ;; room3 is now so likely a kitchen that it counts as certain. The robot stands at place16
 ;; in room3. Target: a cerealbox. Expected best plan (R = 500):
 ;;   assume-obj-exists-on cerealbox object1 table kitchen room3 new-object2

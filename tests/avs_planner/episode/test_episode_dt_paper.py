@@ -1,4 +1,4 @@
-"""The DT as the active visual search paper uses it (issue 34): MOVE costs along the robot's own
+"""The DT as the active visual search paper uses it: MOVE costs along the robot's own
 paths (through the door, not through the wall), unreachable cones left out, one goal reward R
 from the loop's config, and a support searched on it and in it where the knowledge puts the
 label."""
