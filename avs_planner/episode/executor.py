@@ -301,6 +301,8 @@ class Executor(Driving):
                                target not in self.mind.place_map.placeholders)
         if status.status is StepStatus.DONE and is_placeholder and status.detail != TARGET_SEEN:
             self.look_around()
+            if not status.detail and target in self.mind.place_map.placeholders:
+                self._frontier_stays(target)
         places = self.mind.place_map.places
         if status.status is StepStatus.DONE and target in places and \
                 math.dist(self.robot.pose[:2], places[target].position) <= self.config.arrive:
@@ -308,6 +310,17 @@ class Executor(Driving):
         if status.status is StepStatus.FAILED:
             self.mind.move_failed(target)
         return status
+
+    def _frontier_stays(self, target: str) -> None:
+        """The robot stood at placeholder `target` and looked all round, and its frontier is
+        still there (unknown cells the laser cannot reach from here: inside furniture,
+        beyond its range): a second try from the same spot sees the same. It counts as
+        tried out; before, the nearest placeholder was this one again, and an episode spent
+        a look around on it again ten times (about 8 s each)."""
+        self.mind.tried_placeholders[target] = max(
+            self.mind.tried_placeholders.get(target, 0), self.builder.config.max_placeholder_tries)
+        self.emit("belief", placeholder_stays=target,
+                  reason="looked all round from it; its frontier is still there")
 
     def _target_probability(self, label: str, relation: str, location: str, state: AvsState,
                             assumed: dict[str, str]) -> float | None:

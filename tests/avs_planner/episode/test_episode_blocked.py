@@ -355,3 +355,23 @@ def test_a_robot_inside_a_new_keep_out_disc_first_steps_out_of_it(robot: str) ->
         assert sim.pose == before
     finally:
         sim.world.close()
+
+
+@pytest.mark.parametrize(("detail", "tried_out"), [("", True), ("explored on the way", False)])
+def test_a_placeholder_still_there_after_a_look_from_it_is_tried_out(
+        corridor, detail, tried_out) -> None:  # noqa: ANN001
+    """The robot reached a placeholder and looked all round, and its frontier is still there:
+    a second try from the same spot would see the same, so it is not the nearest placeholder
+    (nor a goal) again. A move cut short (the frontier cleared on the way, a blockage) is no
+    such evidence and keeps its second try."""
+    mind, builder, executor = corridor
+    target = next(iter(mind.place_map.placeholders))
+    looks: list[int] = []
+    executor.drive_to = lambda goal, stop=None: StepOutcome(StepStatus.DONE, detail)
+    executor.look_around = lambda: looks.append(1)
+    executor.move(target, builder.build())
+    assert looks == [1] and target in mind.place_map.placeholders
+    limit = builder.config.max_placeholder_tries
+    assert (mind.tried_placeholders[target] >= limit) is tried_out
+    if tried_out:
+        assert executor.nearest_placeholder() != target
