@@ -26,7 +26,6 @@ import argparse
 import gc
 import json
 import math
-import os
 import statistics
 import sys
 import tempfile
@@ -51,10 +50,9 @@ from avs_planner.up_engine import to_up_plan
 from bench.avs_generator import AvsSize, generate
 from bench.cp_report import office_scale, report  # noqa: F401 - office_scale: tests
 from bench.fd_runner import FdRun, run_fd
-from tests.ipc import domain_for, instances, ipc_folders
+from tests.ipc import IPC, domain_for, instances, ipc_folders  # IPC: ../shared/ipc or $AVS_IPC_DIR
 
 ROOT = Path(__file__).resolve().parents[1]
-IPC = Path(os.environ.get("AVS_IPC_DIR", ROOT.parent / "shared" / "ipc"))  # beside the checkout
 REWARD = 500.0
 LIMIT_S = 60.0
 PROHIBITIVE = 10**7

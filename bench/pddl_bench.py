@@ -19,10 +19,9 @@ from unified_planning.io import PDDLReader
 from avs_planner.pddl import PddlSource, check, read_text
 from avs_planner.pddl.probabilistic import translate_domain
 from avs_planner.pddl.sexpr import parse_sexprs
-from tests.ipc import domain_for, instances, ipc_folders
+from tests.ipc import IPC, domain_for, instances, ipc_folders
 
 ROOT = Path(__file__).resolve().parents[1]
-IPC = Path(__file__).resolve().parents[2] / "shared" / "ipc"  # beside the checkout
 
 
 def cases(quick: bool) -> list[tuple[str, Path, Path]]:

@@ -6,7 +6,9 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Sequence
 from dataclasses import replace
+from types import SimpleNamespace
 
 import pytest
 
@@ -251,23 +253,47 @@ def test_a_dt_look_for_the_target_is_a_look_for_its_supports(corridor) -> None:
     assert supports
     before = {s: mind.cmap.objects.remaining(room, s) for s in supports}
     p_before = mind.cmap.p_unsearched(target, room)
-    asked: list[list[str]] = []
-    detect = executor.robot.detect
-
-    class Robot:  # the executor's robot, recording what each frame looks for
-        def __getattr__(self, name):  # noqa: ANN001, ANN204
-            return getattr(executor.robot_, name)
-
-        def detect(self, labels):  # noqa: ANN001, ANN202
-            asked.append(list(labels))
-            return [s for s in detect(labels) if s.label not in supports]  # no desk shows
-
-    executor.robot_, executor.robot = executor.robot, Robot()
+    asked = _record_frames(executor, hide=supports)  # no desk shows
     search = ViewConeSearch(executor, target, "in", room)
     for yaw in (0.0, 1.57, 3.14, -1.57):
-        executor.robot_.turn_to(yaw)
+        executor.robot.turn_to(yaw)
         search._look(target, "in", room)
     assert asked and set(supports) <= set(asked[0])
     after = {s: mind.cmap.objects.remaining(room, s) for s in supports}
     assert all(after[s] < before[s] for s in supports), (before, after)
     assert mind.cmap.p_unsearched(target, room) < p_before
+
+
+def test_a_frame_while_a_confirmed_target_waits_for_its_room_looks_for_the_target_only(
+        corridor) -> None:  # noqa: ANN001
+    """A target confirmed before the map had a room for it waits for the scan behind; what
+    a frame shows of supports meanwhile no longer matters, and confirming a desk seen in
+    passing would take another frame before the target could be reported."""
+    _, builder, executor = corridor
+    if executor.glimpses is None:
+        executor.enable_glimpses()
+    asked = _record_frames(executor)
+    executor.watch()
+    assert set(builder.supports) <= set(asked[-1])  # as a rule the watch asks for supports too
+    executor._unplaced.append(SimpleNamespace(label=builder.task.target,
+                                              position=(50.0, 50.0, 0.8)))
+    executor.watch()
+    assert asked[-1] == [builder.task.target]
+
+
+def _record_frames(executor, hide: Sequence[str] = ()) -> list[list[str]]:  # noqa: ANN001
+    """Put a proxy of the executor's robot in its place that records the labels each frame
+    asks the detector for, and drops detections of the labels in `hide`."""
+    asked: list[list[str]] = []
+    robot = executor.robot
+
+    class Recording:
+        def __getattr__(self, name):  # noqa: ANN001, ANN204
+            return getattr(robot, name)
+
+        def detect(self, labels):  # noqa: ANN001, ANN202
+            asked.append(list(labels))
+            return [s for s in robot.detect(labels) if s.label not in hide]
+
+    executor.robot = Recording()
+    return asked
