@@ -10,15 +10,23 @@ supports, all thinned by every look, glimpses included) and over what placeholde
 to (the exploration hypotheses of Göbelbecker et al., "A Planning Approach to Active Visual
 Search in Large Environments").
 
-The stopping rule uses the paper's own objective c + R(1 - p): any continuation finds the
-target with at most the probability left, P, and costs at least the cheapest first step (the
-way to the nearest room or placeholder left plus the cheapest way to find the target there:
-a search, or one look around, since the detector watches wherever the robot arrives).
-When R * P is not more than that, going on is worse than giving up by the planner's
-measure, whatever plan it would make; the give-up names the probability left.
-The test is on the whole of P, not option by option: exploring reveals several rooms at once,
-and ten placeholders of p = 0.09 each are worth going on for although none alone is (a
-first version judged each alone and gave up 9 s into an apartment with P = 0.59 left).
+The stopping rule uses the paper's own objective c + R(1 - p). Each option has a lower bound
+on what reaching and searching it costs (the way to the nearest of its spots plus the
+cheapest way to find the target there: a search, or one look around, since the detector
+watches wherever the robot arrives). A continuation that searches a set of options costs at
+least the largest of their bounds, and finds the target with at most the probability of
+their spaces together. So no continuation is worth more than the best "everything within
+cost c": R * P(options with bound <= c) - c over the options' bounds c. When that is not
+positive, going on is worse than giving up by the planner's measure, whatever plan it would
+make; the give-up names the probability left.
+The test is on sets of options, not option by option: exploring reveals several rooms at
+once, and ten placeholders of p = 0.09 each are worth going on for although none alone is (a
+first version judged each alone and gave up 9 s into an apartment with P = 0.59 left). A
+second version set all of P against the cheapest step: a little left in far rooms kept a
+robot going beside a nearby room of almost nothing (a development apartment gave up 36 s
+later than now).
+Every placeholder not given up on counts, short frontiers too: a door first seen edge-on
+shows one, and leaving them out gave up on a cereal box behind such a door.
 Costs are in the planner's units (`StateBuilder`: metres over the body's speed, search
 costs; a look in the body's seconds).
 """
@@ -26,6 +34,7 @@ costs; a look in the body's seconds).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 from avs_planner.episode.mind import Mind
@@ -48,10 +57,27 @@ class Option:
 
 @dataclass(frozen=True)
 class Remaining:
-    """The building-level belief: P(target in space not yet searched) and the options."""
+    """The building-level belief: P(target in space not yet searched) and the options;
+    `within`: for each option's cost bound c (ascending), P(target in the spaces of the
+    options costing at most c)."""
 
     p: float
     options: tuple[Option, ...]
+    within: tuple[tuple[float, float], ...] = ()
+
+    @classmethod
+    def of(cls, options: Iterable[Option], mass: Callable[[float], float],
+           p_any: Callable[[float], float]) -> Remaining:
+        """The belief over `options`, whose spaces are disjoint: their expected counts
+        (`mass` of each one's p) add, and `p_any` of a sum is the probability of the spaces
+        together (under an uncertain building rate their probabilities are not independent,
+        so 1 - prod(1 - p) would overstate it)."""
+        options = tuple(options)
+        within, total = [], 0.0
+        for option in sorted(options, key=lambda o: o.cost):
+            total += mass(option.p)
+            within.append((option.cost, p_any(total)))
+        return cls(within[-1][1] if within else 0.0, options, tuple(within))
 
     def best(self, reward: float) -> Option | None:
         """The option worth most on its own (for traces)."""
@@ -61,19 +87,19 @@ class Remaining:
         return min(self.options, key=lambda o: o.cost, default=None)
 
     def worth_going_on(self, reward: float) -> bool:
-        """Some continuation may be worth more than giving up: R * P exceeds the cost of
-        the cheapest first step (an upper bound on any continuation's value)."""
-        cheapest = self.cheapest()
-        return cheapest is not None and reward * self.p > cheapest.cost
+        """Some continuation may be worth more than giving up: for some cost bound c, R
+        times the probability within c exceeds c (an upper bound on any continuation's
+        value: see the module's doc)."""
+        return any(reward * p > cost for cost, p in self.within)
 
     def describe(self, reward: float) -> str:
         cheapest = self.cheapest()
         head = f"P(target in space not yet searched) = {self.p:.3g}"
         if cheapest is None:
             return f"{head}; nothing is left to search or explore"
-        return (f"{head}; no continuation is worth its cost: reward {reward:g} x P is less "
-                f"than the cheapest next step ({cheapest.kind} {cheapest.name}, cost >= "
-                f"{cheapest.cost:.0f})")
+        return (f"{head}; no continuation is worth its cost: reward {reward:g} x P(within "
+                f"cost c) is at most c for every c (the cheapest next step: {cheapest.kind} "
+                f"{cheapest.name}, cost >= {cheapest.cost:.0f})")
 
 
 def remaining(mind: Mind, builder: StateBuilder, here: tuple[float, float],
@@ -105,10 +131,8 @@ def remaining(mind: Mind, builder: StateBuilder, here: tuple[float, float],
         p = cmap.p_beyond_placeholder(label, pid)
         cost = _travel(mind, field_, here, [ph.position]) / speed + search.fresh
         options.append(Option("placeholder", pid, p, cost))
-    # the spaces are disjoint: their expected counts add (under an uncertain building rate
-    # their probabilities are not independent, so 1 - prod(1 - p) would overstate P)
-    mass = sum(float(cmap.mass(label, o.p)) for o in options)
-    return Remaining(float(cmap.p_any(label, mass)) if options else 0.0, tuple(options))
+    return Remaining.of(options, lambda p: float(cmap.mass(label, p)),
+                        lambda m: float(cmap.p_any(label, m)))
 
 
 @dataclass(frozen=True)

@@ -51,21 +51,32 @@ def test_a_building_searched_through_gives_up_naming_what_is_left(corridor) -> N
     assert belief.worth_going_on(1e6)
 
 
-def test_the_rule_weighs_all_that_is_left_against_the_cheapest_step() -> None:
-    """Ten placeholders of p = 0.09 are worth exploring although none alone is: the rule
-    weighs R x P (all that is left) against the cheapest next step."""
+def _known_rate(options: tuple[Option, ...]) -> Remaining:
+    """The belief over `options` under a known building rate (Poisson: mass -ln(1 - p))."""
+    return Remaining.of(options, lambda p: -math.log1p(-p), lambda m: -math.expm1(-m))
+
+
+def test_the_rule_weighs_what_lies_within_each_cost() -> None:
+    """Ten placeholders of p = 0.09 are worth exploring although none alone is: any set of
+    options costs at least its dearest one's bound, and R x P of all ten (0.61) is more
+    than 53. A near room of p = 0.004 does not make the far rooms' 0.05 worth 60."""
     spread = tuple(Option("placeholder", f"placeholder{k}", 0.09, 53.0) for k in range(10))
-    p = 1.0 - (1.0 - 0.09) ** 10
     assert all(o.value(500.0) < 0 for o in spread)
-    assert Remaining(p, spread).worth_going_on(500.0)
-    options = (Option("room", "room1", 0.05, 30.0), Option("placeholder", "placeholder1", 0.01,
-                                                            120.0))
-    belief = Remaining(0.06, options)
-    assert not belief.worth_going_on(500.0)  # 30 = 500 x 0.06 is not more than 30
+    belief = _known_rate(spread)
+    assert belief.p == pytest.approx(1.0 - (1.0 - 0.09) ** 10)
+    assert belief.worth_going_on(500.0)
+    near_and_far = (Option("room", "room1", 0.004, 10.0), Option("room", "room2", 0.02, 60.0),
+                    Option("placeholder", "placeholder1", 0.03, 60.0))
+    belief = _known_rate(near_and_far)
+    assert 500.0 * belief.p > belief.cheapest().cost  # the cheapest step alone would go on
+    assert not belief.worth_going_on(500.0)  # 500 x 0.054 = 27 < 60, 500 x 0.004 = 2 < 10
     assert belief.cheapest().name == "room1" and "room room1" in belief.describe(500.0)
-    assert belief.worth_going_on(600.0)
-    assert not Remaining(0.0, ()).worth_going_on(500.0)
-    assert "nothing is left" in Remaining(0.0, ()).describe(500.0)
+    assert belief.worth_going_on(1200.0)  # 1200 x 0.054 = 64 > 60
+    # much left far away is worth the way there
+    assert _known_rate((*near_and_far, Option("placeholder", "p9", 0.2, 80.0))) \
+        .worth_going_on(500.0)
+    assert not Remaining.of((), float, float).worth_going_on(500.0)
+    assert "nothing is left" in Remaining.of((), float, float).describe(500.0)
 
 
 def test_p_beyond_a_placeholder_follows_its_hypotheses() -> None:
