@@ -38,7 +38,7 @@ support whose P(target on it) falls below the planner's threshold is settled
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping, Sequence
 
 import numpy as np
 
@@ -72,31 +72,43 @@ class Glimpses:
 
     def frame(self, pose: tuple[float, float, float], pan: float, tilt: float,
               labels: Iterable[str], supports: Iterable[str] = (),
-              tops_label: str | None = None) -> dict[str, dict[str, float]]:
+              tops_label: str | None = None,
+              shown: Mapping[str, Sequence[Sequence[float]]] | None = None
+              ) -> dict[str, dict[str, float]]:
         """A frame from `pose` with the head at (`pan`, `tilt`) did not show `labels`; the
         tops of the known objects `supports` are checked for `tops_label` (the target).
-        Returns, per label, the rooms whose share changed and the new share."""
+        `shown`: labels the frame did show, with where (x, y): it did not show another one
+        anywhere else it had in view, so the cells farther than `support_body` from those
+        detections count as looked at for them too (else a room whose known desk was in
+        every frame kept its prior count of desks not found yet, wherever the frames
+        looked). Returns, per label, the rooms whose share changed and the new share."""
         labels = list(labels)
+        shown = {lab: where for lab, where in (shown or {}).items() if lab not in labels}
         self.frames += 1
         stand = (round(pose[0] / STANDPOINT), round(pose[1] / STANDPOINT))
         changed: dict[str, dict[str, float]] = {}
-        points, rooms = (candidate_cells(self.mind) if labels
+        points, rooms = (candidate_cells(self.mind) if labels or shown
                          else (np.zeros((0, 2)), np.zeros(0, dtype=object)))
         if len(points):
             seen = self._in_view(points, pose, pan, tilt, self.camera.support_height)
             keys = [tuple(k) for k in self._keys(points).tolist()]
-            touched = {r for r in rooms[seen] if r is not None}
-            for label in labels:
+            masks = [(label, seen) for label in labels]
+            for label, where in shown.items():
+                near = np.zeros(len(points), dtype=bool)
+                for xy in where:
+                    near |= np.hypot(*(points - np.asarray(xy[:2])).T) <= self.support_body
+                masks.append((label, seen & ~near))
+            for label, mask in masks:
                 looks = self.cells.setdefault(label, {})
                 new = False
-                for i in np.flatnonzero(seen):
+                for i in np.flatnonzero(mask):
                     where = looks.setdefault(keys[i], set())
                     if stand not in where and len(where) < MAX_LOOKS:
                         where.add(stand)
                         new = True
                 if not new:
                     continue
-                for room in touched:
+                for room in {r for r in rooms[mask] if r is not None}:
                     mine = [keys[i] for i in np.flatnonzero(rooms == room)]
                     share = self._share([len(looks.get(k, ())) for k in mine])
                     self._observe(label, room, share)

@@ -127,7 +127,9 @@ def glimpse(ex: Executor, frame: list[SeenLike], labels: list[str],
     pan, tilt = head if head is not None else (0.0, ahead_tilt(ex.camera))
     changed = ex.glimpses.frame(ex.robot.pose, pan, tilt, unseen,
                                 ex._supports_of(target) if target in unseen else (),
-                                tops_label=target)
+                                tops_label=target,
+                                shown={lab: [s.position for s in frame if s.label == lab]
+                                       for lab in labels if lab in shown})
     if changed:
         ex.emit("belief", glimpsed=changed)
     for seen in frame:

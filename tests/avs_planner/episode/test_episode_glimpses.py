@@ -86,6 +86,48 @@ def test_a_frame_lowers_the_target_where_it_looked_once_per_standpoint(corridor)
     assert mind.cmap.objects.remaining(room, "table") == 1.0
 
 
+def test_a_frame_that_shows_one_desk_shows_no_other_where_it_looked(corridor) -> None:
+    """A frame that shows a desk did not show a second one anywhere else in view: the cells
+    it had in view count as looked at for desks, except near the desk it showed (there, a
+    second detection would be the same desk)."""
+    mind, _, executor = corridor
+    room, (x, y) = _room_and_pose(mind)
+    heading, most = 0.0, 0
+    for k in range(8):  # the heading that sees most of this room's candidate cells
+        g = _glimpses(mind, executor)
+        g.frame((x, y, k * math.pi / 4), 0.0, -0.2, ["cerealbox"])
+        if len(g.cells.get("cerealbox", {})) > most:
+            heading, most = k * math.pi / 4, len(g.cells["cerealbox"])
+    seen = {key for key in _glimpses_cells(mind, executor, (x, y, heading))}
+    assert seen, "no heading saw any of the room"
+    res = mind.grid.resolution
+    desk = np.array(sorted(seen)[len(seen) // 2]) * res  # a cell the frame had in view
+    mind.cmap.objects._glimpsed.clear()
+    g = _glimpses(mind, executor)
+    changed = g.frame((x, y, heading), 0.0, -0.2, [], shown={"desk": [tuple(desk)]})
+    looked = set(g.cells["desk"])
+    assert changed["desk"][room] > 0.0
+    assert mind.cmap.objects.remaining(room, "desk") < 1.0
+    def near(key: tuple[int, int], slack: float) -> bool:  # keys are cells rounded
+        return math.dist(np.array(key) * res, desk) <= g.support_body + slack
+
+    assert looked < seen
+    assert not any(near(key, -res) for key in looked)
+    assert all(near(key, res) for key in seen - looked)
+    # a label the frame did not show is looked for everywhere in view; one listed as not
+    # shown is not also taken as shown
+    g = _glimpses(mind, executor)
+    g.frame((x, y, heading), 0.0, -0.2, ["desk"], shown={"desk": [tuple(desk)]})
+    assert set(g.cells["desk"]) == seen
+
+
+def _glimpses_cells(mind, executor, pose) -> set:  # noqa: ANN001
+    g = _glimpses(mind, executor)
+    g.frame(pose, 0.0, -0.2, ["cerealbox"])
+    mind.cmap.objects._glimpsed.clear()
+    return set(g.cells["cerealbox"])
+
+
 def test_a_frame_does_not_see_through_walls(corridor) -> None:
     mind, _, executor = corridor
     g = _glimpses(mind, executor)
