@@ -13,52 +13,68 @@ reward R (`ExecutorConfig.miss_penalty`, which the switching strategy sets from
 `LoopConfig.reward`).
 A search of a support looks on it and in it, as the knowledge lists the label there
 (`viewcones.support_relations`).
+
+`ViewConeSearch` is one SEARCHFOROBJECT, a skill of the executor (`Executor.view_cone_search`
+makes it): it receives the executor's `SkillContext` (`episode/context.py`: robot, mind, state
+builder, settings, tallies, trace, seed), the driving skill (`Driver`: drives to cones, prices
+travel with its paths), the sensing skill (`Sensing`: glimpses, known objects, supports), the
+cone sets (`ConeSets`: the cones to search), the record of found objects (`found_sids`) and two
+hooks: `on_look` before each look (e.g. depth) and `on_session` with the running DT session
+(for observers).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import replace
-from typing import TYPE_CHECKING
 
 from avs_planner.dt import DTRewards, DTSession, DTStatus, SearchBudget, TravelCosts, ViewCone
 from avs_planner.dt.domain import REJECT, ActionKind
-from avs_planner.episode.driving import TARGET_SEEN
+from avs_planner.dt.session import DTResult
+from avs_planner.episode.cone_sets import ConeSets
+from avs_planner.episode.context import SkillContext
+from avs_planner.episode.driving import TARGET_SEEN, Driver, Point
+from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
-from avs_planner.episode.sensing import glimpse
+from avs_planner.episode.sensing import Sensing
 from avs_planner.episode.viewcones import ConeSet, support_relations, support_spaces
 from conceptual_map.errors import MapError
 from conceptual_map.metric import plan_path
-
-if TYPE_CHECKING:
-    from avs_planner.episode.executor import Executor
+from conceptual_map.metric.path_planning import PathResult
 
 
 class ViewConeSearch:
-    """One SEARCHFOROBJECT for `label` `relation` `location` run by an executor."""
+    """One SEARCHFOROBJECT for `label` `relation` `location` (see the module's doc)."""
 
-    def __init__(self, executor: Executor, label: str, relation: str, location: str):
-        self.ex = executor
+    def __init__(self, context: SkillContext, driver: Driver, sensing: Sensing,
+                 cone_sets: ConeSets, found_sids: dict[str, int], label: str, relation: str,
+                 location: str, on_look: Callable[[], None] | None = None,
+                 on_session: Callable[[DTSession], None] | None = None) -> None:
+        self.context, self.driver, self.sensing = context, driver, sensing
+        self.cone_sets, self.found_sids = cone_sets, found_sids
         self.label, self.relation, self.location = label, relation, location
+        self.on_look, self.on_session = on_look, on_session
         self.head: tuple[float, float] = (0.0, 0.0)  # where the camera points (pan, tilt)
 
     def run(self) -> StepOutcome:
+        ctx, robot, cfg = self.context, self.context.robot, self.context.config
         label, relation, location = self.label, self.relation, self.location
-        made = self.ex.cones_now(label, relation, location)
+        made = self.cone_sets.now(label, relation, location)
         if made is None or not made.cones:
             return StepOutcome(StepStatus.FAILED, "no view cones for this search")
         made, travel = self._reachable(made)
         if not made.cones:
             return StepOutcome(StepStatus.FAILED, "no view cone of this search is reachable")
-        self.ex.stats.dt_calls += 1
-        reward = self.ex.config.miss_penalty  # R, the CP's goal reward (`LoopConfig.reward`)
-        session = DTSession(made.cones, self.ex.config.detector, self.ex.robot.pose,
-                            travel_costs=travel, policy=self.ex.config.dt_policy,
-                            budget=SearchBudget(num_sims=self.ex.config.dt_sims),
+        ctx.stats.dt_calls += 1
+        reward = cfg.miss_penalty  # R, the CP's goal reward (`LoopConfig.reward`)
+        session = DTSession(made.cones, cfg.detector, robot.pose,
+                            travel_costs=travel, policy=cfg.dt_policy,
+                            budget=SearchBudget(num_sims=cfg.dt_sims),
                             rewards=DTRewards(reward, reward),
-                            seed=self.ex.seed + self.ex.stats.dt_calls)
-        self.ex.dt_session = session  # the running session, for observers (the recorder)
+                            seed=ctx.seed + ctx.stats.dt_calls)
+        if self.on_session is not None:  # the running session, for observers (the recorder)
+            self.on_session(session)
         interrupted = False
         while True:
             action = session.next_action()
@@ -66,26 +82,26 @@ class ViewConeSearch:
                 break
             cone = session.cone(action)
             if action.kind is ActionKind.MOVE:
-                if self.ex.drive_to(cone.pose[:2]).detail == TARGET_SEEN:
+                if self.driver.drive_to(cone.pose[:2]).detail == TARGET_SEEN:
                     # the watch confirmed the target on the way to this cone: stop here
                     # (the looks so far still count) and let the planner report it
                     session.update(REJECT)
                     interrupted = True
                     break
-                self.ex.robot.turn_to(cone.pose[2])
-                self.ex.robot.look(*(cone.head or (0.0, 0.0)))
+                robot.turn_to(cone.pose[2])
+                robot.look(*(cone.head or (0.0, 0.0)))
                 self.head = cone.head or (0.0, 0.0)
                 if cone.torso is not None:
-                    self.ex.robot.set_torso(cone.torso)
+                    robot.set_torso(cone.torso)
                 session.update(action)
                 continue
             match = self._look(label, relation, location)
             session.update(action, match is not None, detection=match)
         result = session.result
-        self.ex.stats.dt_decisions.extend(result.decision_times_s)
-        self.ex.emit("dt", label=label, relation=relation, location=location,
-                     result=result.status.value, probability=round(result.probability, 4),
-                     steps=len(result.trace), cones=len(made.cones))
+        ctx.stats.dt_decisions.extend(result.decision_times_s)
+        ctx.emit("dt", label=label, relation=relation, location=location,
+                 result=result.status.value, probability=round(result.probability, 4),
+                 steps=len(result.trace), cones=len(made.cones))
         return self._conclude(result, label, relation, location, made, interrupted)
 
     def _reachable(self, made: ConeSet) -> tuple[ConeSet, TravelCosts]:
@@ -93,19 +109,19 @@ class ViewConeSearch:
         time along the robot's paths (`PathLengths`) plus the turn. A cone no path reaches
         from the robot is left out (its share of the location stays unsearched); two cones
         with no path between them are priced through the robot's pose."""
-        lengths = PathLengths(self.ex)
-        here = self.ex.robot.pose
+        lengths = PathLengths(self.context.mind, self.driver.squeeze)
+        here = self.context.robot.pose
         keep = [c for c in made.cones if math.isfinite(lengths(here[:2], c.pose[:2]))]
         if len(keep) < len(made.cones):
-            self.ex.emit("belief", unreachable_cones=[c.id for c in made.cones
-                                                      if c not in keep])
+            self.context.emit("belief", unreachable_cones=[c.id for c in made.cones
+                                                           if c not in keep])
             made = replace(made, cones=tuple(keep))
         return made, travel_costs(here, made.cones, lengths, *self._speeds())
 
     def _speeds(self) -> tuple[float, float]:
         """(m/s, rad/s) the robot's body drives and turns at (the time model's defaults
         without a body)."""
-        body = self.ex.mind.body
+        body = self.context.mind.body
         return (body.linear_speed, body.angular_speed) if body is not None else (0.5, 1.0)
 
     def _look(self, label: str, relation: str, location: str) -> SeenLike | None:
@@ -116,41 +132,42 @@ class ViewConeSearch:
         30% of the time and the DT went on to other cones with the belief there thinned; a
         phantom (5% of frames, anywhere in view) is rarely repeated at the same spot by
         either frame."""
-        self.ex.stats.views += 1
-        if self.ex.on_look is not None:
-            self.ex.on_look()
+        ctx = self.context
+        ctx.stats.views += 1
+        if self.on_look is not None:
+            self.on_look()
         match = self._detect_once(label, relation, location, self._also_for(label))
         if match is None:
-            self.ex.emit("observation", label=label, detected=False)
+            ctx.emit("observation", label=label, detected=False)
             self._glimpse_tops(label, relation, location)
             return None
-        agree = self.ex.config.agree[0 if label == self.ex.builder.task.target else 1]
-        frames = 1 + (1 if self.ex.config.dt_tiebreak else 0)
+        agree = ctx.config.agree[0 if label == ctx.builder.task.target else 1]
+        frames = 1 + (1 if ctx.config.dt_tiebreak else 0)
         agreed = False
         for _ in range(frames):
             again = self._detect_once(label, relation, location)
             agreed = again is not None and math.dist(again.position, match.position) <= agree
             if agreed:
                 break
-        self.ex.emit("observation", label=label, detected=agreed,
-                     position=[round(v, 2) for v in match.position])
+        ctx.emit("observation", label=label, detected=agreed,
+                 position=[round(v, 2) for v in match.position])
         return match if agreed else None
 
     def _glimpse_tops(self, label: str, relation: str, location: str) -> None:
         """A look for the target that saw none also looked at the tops of other known
         supports in view (`episode/glimpses.py`); the searched location itself is this
         search's own evidence (`Mind.searched`)."""
-        glimpses = self.ex.glimpses
-        if glimpses is None or label != self.ex.builder.task.target:
+        glimpses = self.sensing.glimpses
+        if glimpses is None or label != self.context.builder.task.target:
             return
-        supports = [o for o in self.ex._supports_of(label)
+        supports = [o for o in self.sensing.supports_of(label)
                     if not (relation == "on" and o == location)]
-        glimpses.frame(self.ex.robot.pose, self.head[0], self.head[1], [], supports,
+        glimpses.frame(self.context.robot.pose, self.head[0], self.head[1], [], supports,
                        tops_label=label)
 
     def _also_for(self, label: str) -> list[str]:
         """The labels the first frame of a look for the target also looks for: the supports
-        the problem knows of, as the watch's frames do (`sensing.glimpse`). A support it
+        the problem knows of, as the watch's frames do (`Sensing.glimpse`). A support it
         shows becomes a known object; one it does not show is less likely in the cells the
         frame had in view with a free line of sight. Without this, a room the DT had looked
         through kept most of its prior count of desks not found yet, each with its share
@@ -158,47 +175,50 @@ class ViewConeSearch:
         (The cones' coverage of the target's location is no measure of that: it does not
         know what the furniture hides, and a kitchen whose table stands behind a fridge
         row lost its tables and counters to it, and with them its category.)"""
-        if self.ex.glimpses is None or label != self.ex.builder.task.target:
+        builder = self.context.builder
+        if self.sensing.glimpses is None or label != builder.task.target:
             return []
-        return [s for s in self.ex.builder.supports if s != label]
+        return [s for s in builder.supports if s != label]
 
     def _detect_once(self, label: str, relation: str, location: str,
                      also: Sequence[str] = ()) -> SeenLike | None:
-        frame = self.ex.robot.detect([label, *also])
+        frame = self.context.robot.detect([label, *also])
         if also:
-            glimpse(self.ex, frame, list(also), self.head)
+            self.sensing.glimpse(frame, list(also), self.head)
         seen = [s for s in frame if s.label == label]
         matches = [s for s in seen if self._inside(s, relation, location)]
         for s in seen:
-            self.ex.stats.detections.append((s.position[0], s.position[1], label, s in matches))
+            self.context.stats.detections.append((s.position[0], s.position[1], label,
+                                                  s in matches))
         return matches[0] if matches else None
 
     def _inside(self, seen: SeenLike, relation: str, location: str) -> bool:
+        mind, cfg = self.context.mind, self.context.config
         if relation == "on":  # a support: on its top, or inside it where the knowledge
-            support = self.ex.mind.objects[location]  # puts the label
+            support = mind.objects[location]  # puts the label
             top = 2.0 * support.position[2]
-            low, high = self.ex.config.above_support
-            relations = support_relations(self.ex.mind, seen.label, support.label)
+            low, high = cfg.above_support
+            relations = support_relations(mind, seen.label, support.label)
             if "in" in relations:
                 low = -top  # down to the floor: a cup in a shelf
             if "on" not in relations:
                 high = 0.0
-            reach = self.ex.config.support_radius
+            reach = cfg.support_radius
             near = math.dist(seen.position[:2], support.position[:2]) <= reach
             return near and top + low <= seen.position[2] <= top + high
-        if self.ex.mind.room_at(seen.position[:2]) != location:
+        if mind.room_at(seen.position[:2]) != location:
             return False
-        return not self.ex.known_near(seen)  # not a desk it found before
-
+        return not self.sensing.known_near(seen)  # not a desk it found before
 
     def _searched(self, label: str, relation: str, location: str, coverage: float) -> None:
         """The looks thin `label`'s unseen count at the location: a room, or every space of a
         support the search looked at (on it, in it)."""
+        mind = self.context.mind
         if relation != "on":
-            self.ex.mind.searched(label, relation, location, coverage, 1.0)
+            mind.searched(label, relation, location, coverage, 1.0)
             return
-        for space in support_spaces(self.ex.mind, label, location):
-            self.ex.mind.cmap.observe_search(label, space, min(1.0, coverage), 1.0)
+        for space in support_spaces(mind, label, location):
+            mind.cmap.observe_search(label, space, min(1.0, coverage), 1.0)
 
     def _coverage(self, made: ConeSet, looks: dict[int, int], label: str, relation: str,
                   location: str) -> float:
@@ -207,19 +227,21 @@ class ViewConeSearch:
         top in view (`Glimpses.top_share`), as frames in passing count, when the cones are
         the 2D ones round it; else, or when no look had the top in view by that model, from
         the cones' shares of the location (`looked_share`)."""
-        glimpses, obj = self.ex.glimpses, self.ex.mind.objects.get(location)
+        mind = self.context.mind
+        glimpses, obj = self.sensing.glimpses, mind.objects.get(location)
         if relation == "on" and looks and glimpses is not None and obj is not None \
-                and self.ex.support_views is None \
-                and support_relations(self.ex.mind, label, obj.label) == ("on",):
+                and self.cone_sets.support_views is None \
+                and support_relations(mind, label, obj.label) == ("on",):
             share = glimpses.top_share(location, [
                 (made.cones[i].pose, *(made.cones[i].head or (0.0, 0.0)), k)
                 for i, k in looks.items()])
             if share:
                 return share
-        return looked_share(made, looks, 1.0 - self.ex.config.detector.false_negative)
+        return looked_share(made, looks, 1.0 - self.context.config.detector.false_negative)
 
-    def _conclude(self, result, label: str, relation: str, location: str,  # noqa: ANN001
+    def _conclude(self, result: DTResult, label: str, relation: str, location: str,
                   made: ConeSet, interrupted: bool = False) -> StepOutcome:
+        builder = self.context.builder
         looks: dict[int, int] = {}
         for step in result.trace:
             if step.action.kind is not ActionKind.MOVE:
@@ -228,8 +250,8 @@ class ViewConeSearch:
         if result.status is DTStatus.CONFIRMED and result.detection is not None:
             seen = result.detection
             support = location if relation == "on" else None
-            obj = self.ex.mind.add_object(label, seen.position, support)
-            self.ex.found_sids[obj.id] = seen.id
+            obj = self.context.mind.add_object(label, seen.position, support)
+            self.found_sids[obj.id] = seen.id
             if coverage > 0.0:
                 # Poisson thinning: whatever was found, the cones looked through leave
                 # Poisson(lambda (1 - share seen)) of `label` unseen there, so a second
@@ -247,14 +269,14 @@ class ViewConeSearch:
             # the same state it would decide the same, in no time, and the loop took the
             # repeat for a livelock and gave up with everything else still to search
             # (generated office 300, book: at 667 s, P left = 1). Settled for the planner.
-            self.ex.builder.cannot_search(label, relation, location)
+            builder.cannot_search(label, relation, location)
             return StepOutcome(StepStatus.DONE, "rejected without looking")
         if relation == "on":
             key = (label, location)
-            self.ex.builder.failed_on[key] = self.ex.builder.failed_on.get(key, 0) + 1
+            builder.failed_on[key] = builder.failed_on.get(key, 0) + 1
         else:
             key = (label, location)
-            self.ex.builder.failed_in[key] = self.ex.builder.failed_in.get(key, 0) + 1
+            builder.failed_in[key] = builder.failed_in.get(key, 0) + 1
         return StepOutcome(StepStatus.DONE, "rejected")
 
 
@@ -276,13 +298,14 @@ def looked_share(made: ConeSet, looks: dict[int, int], p_detect: float) -> float
 
 
 class PathLengths:
-    """Lengths (m) of the paths the robot would drive between two points, as the executor
-    plans them (`plan_path` on its grid keeping its planning radius, else the executor's
-    squeeze: a slimmer margin, then unknown cells); inf where there is none. Memoised: one
-    instance serves one DT session (the grid does not change while its costs are made)."""
+    """Lengths (m) of the paths the robot would drive between two points, as the driving
+    skill plans them (`plan_path` on the mind's grid keeping its planning radius, else
+    `squeeze`, the driver's: a slimmer margin, then unknown cells); inf where there is none.
+    Memoised: one instance serves one DT session (the grid does not change while its costs
+    are made)."""
 
-    def __init__(self, executor: Executor):
-        self.ex = executor
+    def __init__(self, mind: Mind, squeeze: Callable[[Point, Point], PathResult]) -> None:
+        self.mind, self.squeeze = mind, squeeze
         self._memo: dict[tuple[tuple[float, float], tuple[float, float]], float] = {}
 
     def __call__(self, a: Sequence[float], b: Sequence[float]) -> float:
@@ -295,13 +318,13 @@ class PathLengths:
     def _length(self, a: tuple[float, float], b: tuple[float, float]) -> float:
         if math.dist(a, b) < 1e-9:
             return 0.0
-        mind = self.ex.mind
+        mind = self.mind
         try:
             path = plan_path(mind.grid, a, b, mind.config.robot_radius)
         except MapError:
             path = None
         if path is None or not path.found:
-            path = self.ex._squeeze(a, b)
+            path = self.squeeze(a, b)
         return path.length if path.found else math.inf
 
 

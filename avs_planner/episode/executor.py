@@ -1,200 +1,224 @@
-"""The executor: runs the physical and sensing steps of a plan through the robot adapter.
+"""The executor: runs the physical and sensing steps of a plan through the robot, composed of
+skills that each receive what they work with.
 
-MOVE drives A* legs on the robot's own grid, scanning and growing the maps after each leg
-(`episode/driving.py`);
-CREATEVIEWCONES samples cones; SEARCHFOROBJECT runs a DT session against the detector;
-REPORTPOSITION ends the task. Assumptive steps never reach the executor.
-Sensing along the way (the first look around a place, the scan after each leg, the watch for
-the target, confirming and verifying a detection) is `episode/sensing.py`'s; the methods
-here that other parts call hand off to it.
+MOVE drives (`Driver`, `episode/driving.py`: A* legs on the robot's own grid, sensing after
+each leg); CREATEVIEWCONES makes cones (`ConeSets`, `episode/cone_sets.py`); SEARCHFOROBJECT
+runs a DT session against the detector (`ViewConeSearch`, `episode/dt_search.py`);
+REPORTPOSITION looks at the target again first (`Verifier`, `episode/verifying.py`) and ends
+the task. Assumptive steps never reach the executor. Sensing along the way (the first look
+around a place, the scan after each leg, the watch for the target, confirming a detection,
+glimpses) is the `Sensing` skill's (`episode/sensing.py`).
+
+`Executor(robot, mind, builder, camera, emit, config, seed)` makes the skills' shared
+`SkillContext` (`episode/context.py`) and the record of found objects (`found_sids`), and
+wires the skills together: the driver senses through `Sensing.sense`, the verifier drives and
+confirms through the driver and the sensing skill, a view-cone search gets all of them. The
+methods and attributes the strategies, the harness and the viewers use are kept here as thin
+delegates to the skills.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
-from functools import partial
-from typing import Any
 
-from avs_planner.cp.search import DEFAULT_REWARD, PlanStep
+from avs_planner.cp.search import PlanStep
 from avs_planner.cp.task import Atom
-from avs_planner.dt import DetectorModel
-from avs_planner.episode import sensing
-from avs_planner.episode.driving import TARGET_SEEN, Driving
+from avs_planner.dt import DTSession
+from avs_planner.episode.cone_sets import ConeSets, Location, SupportViews, WeightedCones
+from avs_planner.episode.context import Event, ExecutorConfig, SkillContext, Stats
+from avs_planner.episode.driving import TARGET_SEEN, Driver, Point, Pose
 from avs_planner.episode.dt_search import ViewConeSearch
 from avs_planner.episode.glimpses import Glimpses
 from avs_planner.episode.mind import KnownObject, Mind
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
 from avs_planner.episode.robot_api import Robot
+from avs_planner.episode.sensing import Sensing
 from avs_planner.episode.state_builder import AvsState, StateBuilder
-from avs_planner.episode.viewcones import (
-    CameraModel,
-    ConeSet,
-    p_at_support,
-    room_cones,
-    support_cones,
-    support_relations,
-)
-from conceptual_map.conceptual.errors import ConceptualError
+from avs_planner.episode.verifying import Verifier
+from avs_planner.episode.viewcones import CameraModel, ConeSet
 from conceptual_map.metric import distance_field
+from conceptual_map.metric.path_planning import PathResult
 
-Event = Callable[..., None]
-
-
-@dataclass
-class ExecutorConfig:
-    """How the executor drives, looks and confirms. Defaults whose comments cite episodes were
-    chosen on development worlds and seeds (generated buildings below seed 10000, Fig. 3
-    noise seeds 0-99), never on the held-out range (docs/experiments.md)."""
-
-    leg: float = 1.0  # m driven between scans
-    arrive: float = 0.35  # m from a MOVE's goal counts as there
-    max_legs: int = 40
-    replan_legs: int = 4  # legs driven on one A* path before searching again (the map grows)
-    dt_policy: str = "pouct"
-    # POUCT simulations per decision. The DT's own benchmark found 50 as good as 150 on its
-    # synthetic instances, but in episodes 50 rejected searches that 150 confirmed (scenario
-    # f, development seeds 0-19: 16/20 found with 50, 18/20 with 150; bench/episode_bench.py)
-    dt_sims: int = 150
-    # a look counts as a detection only when a second frame sees the label again within
-    # `agree` m (a phantom rarely repeats), so misses are likelier and phantoms rarer than
-    # the camera's own 0.2 / 0.05
-    detector: DetectorModel = field(
-        default_factory=lambda: DetectorModel(false_negative=0.36, false_positive=0.01))
-    agree: tuple[float, float] = (0.25, 0.6)  # m, for the target / for supports (whose
-    # detected centre moves with the part in view)
-    squeeze: float = 0.08  # m less clearance when no path keeps the full margin
-    # a leg the base refuses becomes a keep-out disc and the path is planned again around
-    # it, up to this many times per move; then the move fails and the CP plans around it
-    detours: int = 2
-    # s of robot time: the CP's goal reward R, the DT's terminal penalties; the switching
-    # strategy's executor is built with its `LoopConfig.reward` (one R per episode)
-    miss_penalty: float = DEFAULT_REWARD
-    # the detector looks for the target as the robot moves (`watch`; the loop's `watch`)
-    watch: bool = True
-    support_radius: float = 0.9  # m: a detection this near a support is "on" it
-    same_object: float = 1.0  # m: a detection this near a known object of its label is it
-    above_support: tuple[float, float] = (-0.15, 0.45)  # m around the support's top
-    doorway_clearance: float = 0.6  # m from a mapped door: no place classification there
-    # a target seen outside a DT search (while moving; the baselines) is reported only when
-    # this many of the next frames see it again at the same spot
-    confirm_needed: int = 2
-    confirm_frames: int = 3
-    # a confirmation that ends one short of `confirm_needed` with at least one frame agreeing
-    # is ambiguous, not a rejection: it takes up to this many more frames. A real object (hit
-    # in about 70% of frames at 3.6 m with the position noise against `agree`) then passes
-    # 96% of the time instead of 78%; a phantom gets there only if another frame put a phantom
-    # within `agree` of it, so phantoms cost no more frames than before
-    confirm_extra: int = 2
-    # a DT look whose second frame does not repeat the first detection takes a third frame
-    # (`episode/dt_search.py`, `ViewConeSearch._look`); the DT's detector model above stays
-    # the two-frame rule's, so it now slightly over-states misses
-    dt_tiebreak: bool = True
-    # before the target is reported the robot faces it and looks again: at least one of
-    # this many frames must see it within `agree` m (0: report without looking). Two frames
-    # that agree on a phantom are rare, but over the hundreds of looks of a search for an
-    # absent object they happen (1 false report in 50 absent targets on generated worlds);
-    # a phantom that also repeats at that spot is practically never seen, while a real
-    # object in view is missed by all three frames with the camera's 0.2 only 0.8% of times
-    verify_frames: int = 3
-    # frames taken in passing (looking ahead while driving, both ways at a new place) that
-    # do not show the target lower P(ObjectAt) where they looked, and supports they show
-    # become known (`episode/glimpses.py`); the switching strategy turns this on
-    # (`Executor.enable_glimpses`), the other strategies keep their own evidence rules
-    glimpses: bool = False
-    # directions the detector looks in at a new place (`look_around`): 2 is ahead and behind;
-    # 6 covers the whole turn with the camera's 60 degree field of view
-    look_headings: int = 2
+__all__ = ["Event", "Executor", "ExecutorConfig", "Stats"]
 
 
-@dataclass
-class Stats:
-    distance: float = 0.0
-    dt_calls: int = 0
-    dt_decisions: list[float] = field(default_factory=list)
-    views: int = 0
-    path: list[tuple[float, float, float, str]] = field(default_factory=list)
-    detections: list[tuple[float, float, str, bool]] = field(default_factory=list)
-    found_sid: int | None = None
-
-
-class Executor(Driving):
+class Executor:
     """Runs plan steps; `emit(type, **fields)` records trace events."""
 
     def __init__(self, robot: Robot, mind: Mind, builder: StateBuilder, camera: CameraModel,
-                 emit: Event, config: ExecutorConfig | None = None, seed: int = 0):
-        self.robot, self.mind, self.builder = robot, mind, builder
-        self.camera, self.emit = camera, emit
-        self.config = config or ExecutorConfig()
-        self.seed = seed
-        self.cones: dict[tuple[str, str, str], ConeSet] = {}
+                 emit: Event, config: ExecutorConfig | None = None, seed: int = 0) -> None:
+        config = config or ExecutorConfig()
+        self.context = SkillContext(robot, mind, builder, camera, config, Stats(), emit, seed)
+        # known object id -> the detection's id (the summary checks it against the world)
         self.found_sids: dict[str, int] = {}
-        self.stats = Stats()
-        self.watching = self.config.watch  # the detector looks for the target as it moves
-        self.support_views: Callable[..., ConeSet] | None = None  # replaces support_cones
+        self.sensing = Sensing(self.context, self.found_sids, watching=config.watch)
+        self.driver = Driver(self.context, sense=self.sensing.sense)
+        self.verifier = Verifier(self.context, self.driver, self.sensing)
+        self.cone_sets = ConeSets(self.context)
         self.on_look: Callable[[], None] | None = None  # before each DT look (e.g. depth)
-        self.seen_while_moving: dict[str, set[Atom]] = {}
-        self.dt_session: Any = None  # the last SEARCHFOROBJECT's DTSession (read by observers)
-        self._unplaced: list[SeenLike] = []
-        # QSR-weighted support cones (strategies/switching/qsr_cones.install)
-        self.qsr_cones: Any = None
-        # the map's P(ObjectAt) of each cone set's location when it was made: a later
-        # search of it starts from what looks since then have left (`cones_now`)
-        self.cone_basis: dict[tuple[str, str, str], float] = {}
-        self.glimpses: Glimpses | None = None
-        if self.config.glimpses:
+        self.dt_session: DTSession | None = None  # the last SEARCHFOROBJECT's (for observers)
+        if config.glimpses:
             self.enable_glimpses()
 
-    def enable_glimpses(self) -> None:
-        """Frames taken in passing become evidence (`episode/glimpses.py`)."""
-        self.glimpses = Glimpses(self.mind, self.camera,
-                                 1.0 - self.config.detector.false_negative,
-                                 support_body=self.config.support_radius)
+    # ---- the context and the skills' state, as the strategies and the harness read it -------
 
-    # ---- sensing along the way (`episode/sensing.py`) ---------------------------------------
+    @property
+    def robot(self) -> Robot:
+        return self.context.robot
+
+    @robot.setter
+    def robot(self, robot: Robot) -> None:
+        self.context.robot = robot
+
+    @property
+    def config(self) -> ExecutorConfig:
+        return self.context.config
+
+    @config.setter
+    def config(self, config: ExecutorConfig) -> None:
+        self.context.config = config
+
+    @property
+    def mind(self) -> Mind:
+        return self.context.mind
+
+    @property
+    def builder(self) -> StateBuilder:
+        return self.context.builder
+
+    @property
+    def camera(self) -> CameraModel:
+        return self.context.camera
+
+    @property
+    def emit(self) -> Event:
+        return self.context.emit
+
+    @property
+    def stats(self) -> Stats:
+        return self.context.stats
+
+    @property
+    def seed(self) -> int:
+        return self.context.seed
+
+    @property
+    def watching(self) -> bool:
+        """The detector looks for the target as the robot moves (`Sensing.watch`)."""
+        return self.sensing.watching
+
+    @watching.setter
+    def watching(self, on: bool) -> None:
+        self.sensing.watching = on
+
+    @property
+    def glimpses(self) -> Glimpses | None:
+        return self.sensing.glimpses
+
+    @property
+    def seen_while_moving(self) -> dict[str, set[Atom]]:
+        return self.sensing.seen_while_moving
+
+    @property
+    def cones(self) -> dict[Location, ConeSet]:
+        return self.cone_sets.cones
+
+    @property
+    def cone_basis(self) -> dict[Location, float]:
+        return self.cone_sets.basis
+
+    @property
+    def support_views(self) -> SupportViews | None:
+        """A replacement of the 2D support cones (`ConeSets.support_views`)."""
+        return self.cone_sets.support_views
+
+    @support_views.setter
+    def support_views(self, views: SupportViews | None) -> None:
+        self.cone_sets.support_views = views
+
+    @property
+    def qsr_cones(self) -> WeightedCones | None:
+        """QSR-weighted cones (`strategies/switching/qsr_cones.install`)."""
+        return self.cone_sets.qsr_cones
+
+    @qsr_cones.setter
+    def qsr_cones(self, cones: WeightedCones | None) -> None:
+        self.cone_sets.qsr_cones = cones
+
+    # ---- the skills' methods other parts call -----------------------------------------------
+
+    def enable_glimpses(self) -> None:
+        """Frames taken in passing become evidence (`Sensing.enable_glimpses`)."""
+        self.sensing.enable_glimpses()
 
     def look_around(self) -> None:
         """The first view of a place: scans both ways, the detector watching
-        (`sensing.look_around`)."""
-        sensing.look_around(self)
+        (`Sensing.look_around`)."""
+        self.sensing.look_around()
 
-    def _sense(self, poses: list[tuple[float, float, float]], watch: bool = False
-               ) -> KnownObject | None:
+    def sense(self, poses: list[Pose], watch: bool = False) -> KnownObject | None:
         """A scan from `poses`, the detector watching when asked or at a new place
-        (`sensing.sense`); the target the watch confirmed, if any."""
-        return sensing.sense(self, poses, watch)
+        (`Sensing.sense`); the target the watch confirmed, if any."""
+        return self.sensing.sense(poses, watch)
 
     def watch(self) -> KnownObject | None:
-        """One look ahead for the target and the known supports (`sensing.watch`)."""
-        return sensing.watch(self)
-
-    def _supports_of(self, label: str) -> list[str]:
-        """Known objects `label` may lie on (`sensing.supports_of`)."""
-        return sensing.supports_of(self.mind, label)
+        """One look ahead for the target and the known supports (`Sensing.watch`)."""
+        return self.sensing.watch()
 
     def confirm(self, seen: SeenLike, needed: int | None = None,
                 frames: int | None = None, agree: float | None = None) -> bool:
-        """More frames see `seen`'s label again where it was (`sensing.confirm`)."""
-        return sensing.confirm(self.robot, self.config, seen, needed, frames, agree)
-
-    def verify_report(self, obj) -> bool:  # noqa: ANN001 - a known object or a Seen
-        """`verify`, stepping back first to where it means something
-        (`sensing.verify_report`)."""
-        return sensing.verify_report(self, obj)
-
-    def verify(self, obj: KnownObject) -> bool:
-        """Face `obj` and see it again before it is reported (`sensing.verify`)."""
-        return sensing.verify(self, obj)
+        """More frames see `seen`'s label again where it was (`Sensing.confirm`)."""
+        return self.sensing.confirm(seen, needed, frames, agree)
 
     def known_near(self, seen: SeenLike) -> bool:
         """A detection of an object the mind already knows (same label, within
-        `same_object` metres)."""
-        return sensing.known_near(self.mind, self.config.same_object, seen)
+        `same_object` metres; `Sensing.known_near`)."""
+        return self.sensing.known_near(seen)
 
-    def _classify(self) -> None:
-        """Ask the place classifier, unless in a doorway (`sensing.classify`)."""
-        sensing.classify(self.robot, self.mind, self.config.doorway_clearance, self.emit)
+    def verify_report(self, obj: KnownObject | SeenLike) -> bool:
+        """`verify`, stepping back first to where it means something
+        (`Verifier.verify_report`)."""
+        return self.verifier.verify_report(obj)
+
+    def verify(self, obj: KnownObject | SeenLike) -> bool:
+        """Face `obj` and see it again before it is reported (`Verifier.verify`)."""
+        return self.verifier.verify(obj)
+
+    def drive_to(self, goal: Point, stop: Callable[[], bool] = lambda: False) -> StepOutcome:
+        """Drive leg by leg to `goal` (`Driver.drive_to`)."""
+        return self.driver.drive_to(goal, stop)
+
+    def squeeze_path(self, start: Point, goal: Point) -> tuple[PathResult, float]:
+        """A path with a slimmer margin, and the margin (`Driver.squeeze_path`)."""
+        return self.driver.squeeze_path(start, goal)
+
+    def squeeze_margin(self) -> float:
+        """The slimmest margin a path may keep (`Driver.squeeze_margin`)."""
+        return self.driver.squeeze_margin()
+
+    def create_cones(self, label: str, relation: str, location: str,
+                     p: float | None = None) -> StepOutcome:
+        """CREATEVIEWCONES (`ConeSets.create`)."""
+        return self.cone_sets.create(label, relation, location, p)
+
+    def location_belief(self, label: str, relation: str, location: str) -> float:
+        """The map's P(ObjectAt) of the location itself (`ConeSets.location_belief`)."""
+        return self.cone_sets.location_belief(label, relation, location)
+
+    def cones_now(self, label: str, relation: str, location: str) -> ConeSet | None:
+        """The cone set of a location as the looks since it was made left it
+        (`ConeSets.now`)."""
+        return self.cone_sets.now(label, relation, location)
+
+    def view_cone_search(self, label: str, relation: str, location: str) -> ViewConeSearch:
+        """One SEARCHFOROBJECT's DT session over the cones, with this executor's skills."""
+        return ViewConeSearch(self.context, self.driver, self.sensing, self.cone_sets,
+                              self.found_sids, label, relation, location,
+                              on_look=self.on_look, on_session=self._session_started)
+
+    def _session_started(self, session: DTSession) -> None:
+        self.dt_session = session
 
     # ---- steps ------------------------------------------------------------------------------
 
@@ -203,9 +227,9 @@ class Executor(Driving):
         """Execute one step; `assumed` maps rooms to the category the plan assumes for them.
         Targets the detector confirmed on the way come back in the outcome's `observed`."""
         outcome = self._run(step, state, assumed)
-        if self.seen_while_moving:
-            outcome.observed = {**self.seen_while_moving, **outcome.observed}
-            self.seen_while_moving = {}
+        seen = self.sensing.take_seen()
+        if seen:
+            outcome.observed = {**seen, **outcome.observed}
         return outcome
 
     def _run(self, step: PlanStep, state: AvsState,
@@ -215,8 +239,8 @@ class Executor(Driving):
             return self.move(step.args[1], state)
         if name.startswith("createviewcones"):
             relation = name.rsplit("-", 1)[1]
-            p = self._target_probability(step.args[0], relation, step.args[1], state,
-                                         assumed or {})
+            p = self.cone_sets.target_probability(step.args[0], relation, step.args[1], state,
+                                                  assumed or {})
             return self.create_cones(step.args[0], relation, step.args[1], p)
         if name.startswith("searchforobject"):
             relation = name.rsplit("-", 1)[1]
@@ -322,81 +346,11 @@ class Executor(Driving):
         self.emit("belief", placeholder_stays=target,
                   reason="looked all round from it; its frontier is still there")
 
-    def _target_probability(self, label: str, relation: str, location: str, state: AvsState,
-                            assumed: dict[str, str]) -> float | None:
-        """P(ObjectAt) of the searched location under the plan's category assumption (the
-        CP's own number); None to ask the conceptual map (no assumption about the room)."""
-        assumed = {**{a[1]: a[2] for a in state.atoms if a[0] == "has-category"}, **assumed}
-        if relation == "on":
-            support = self.mind.objects.get(location)
-            if support is None or support.room not in assumed:
-                return None
-            key = ("p-obj-on", label, support.label, assumed[support.room])
-        else:
-            if location not in assumed:
-                return None
-            key = ("p-obj-in", label, location, assumed[location])
-        return state.values.get(key)
-
-    def create_cones(self, label: str, relation: str, location: str,
-                     p: float | None = None) -> StepOutcome:
-        key = f"{label}-{relation}-{location}"
-        if relation == "on":
-            support = self.mind.objects.get(location)
-            if support is None:
-                return StepOutcome(StepStatus.FAILED, f"{location} is not a known object")
-            if p is None:  # on it and in it, where the knowledge puts the label
-                p = p_at_support(self.mind, label, location)
-            made = (self.support_views is None and self.qsr_cones
-                    and self.qsr_cones.support_cones(label, support, p, key)) or \
-                (self.support_views or partial(support_cones, relations=support_relations(
-                    self.mind, label, support.label)))(self.mind, support, p, self.camera, key)
-        else:
-            if location not in self.mind.place_map.rooms:
-                return StepOutcome(StepStatus.FAILED, f"{location} is not a known room")
-            if p is None:
-                p = self.mind.cmap.p_object_at(label, location)
-            made = (self.qsr_cones and self.qsr_cones.room_cones(label, location, p, key)) or \
-                room_cones(self.mind, location, label, p, self.camera, key)
-        self.cones[(label, relation, location)] = made
-        self.cone_basis[(label, relation, location)] = self.location_belief(
-            label, relation, location)
-        self.mind.cones_made.add((label, relation, location))
-        self.emit("action", action="createviewcones", cones=len(made.cones),
-                  coverage=round(made.coverage, 3), probability=round(p, 4))
-        if not made.cones:
-            return StepOutcome(StepStatus.FAILED, "no view cone reachable")
-        return StepOutcome(StepStatus.DONE, f"{len(made.cones)} cones")
-
-    def location_belief(self, label: str, relation: str, location: str) -> float:
-        """The map's P(ObjectAt) of the location itself (not its supports; a support's
-        spaces the knowledge puts the label in: on it, in it)."""
-        try:
-            if relation == "on":
-                return p_at_support(self.mind, label, location)
-            return self.mind.cmap.p_object_at(label, location, include_sublocations=False)
-        except ConceptualError:  # a location the map no longer has: no rescaling
-            return 0.0
-
-    def cones_now(self, label: str, relation: str, location: str) -> ConeSet | None:
-        """The cone set of a location, its probabilities scaled by what looks since it was
-        made (searches, glimpses) left of the map's P(ObjectAt) there: a desk searched once
-        is not searched again from its prior."""
-        made = self.cones.get((label, relation, location))
-        then = self.cone_basis.get((label, relation, location), 0.0)
-        if made is None or then <= 0.0:
-            return made
-        scale = min(1.0, self.location_belief(label, relation, location) / then)
-        if scale >= 1.0:
-            return made
-        cones = tuple(replace(c, probability=c.probability * scale) for c in made.cones)
-        return replace(made, cones=cones, probability=made.probability * scale)
-
     def search(self, label: str, relation: str, location: str) -> StepOutcome:
         """SEARCHFOROBJECT: a DT session over the cones CREATEVIEWCONES made; its duration
         prices later searches of its kind (`StateBuilder.observe_search_time`)."""
         start = self.robot.clock
-        outcome = ViewConeSearch(self, label, relation, location).run()
+        outcome = self.view_cone_search(label, relation, location).run()
         if self.stats.dt_calls and self.robot.clock > start:
             self.builder.observe_search_time(label, relation, self.robot.clock - start)
         if outcome.status is StepStatus.FAILED:

@@ -9,7 +9,11 @@ of every point on it, so every phantom agrees and "two of three frames" only ask
 phantoms in two more frames (generated office 23, `most-likely-room`: a phantom stapler at
 0.39 m; development apartment 325, the switching planner: a phantom book at 0.49 m). So
 before a report the robot steps back to where agreement means something (at most
-`MAX_ACCIDENTAL`) when it can reach such a spot (`Executor.verify_report`).
+`MAX_ACCIDENTAL`) when it can reach such a spot.
+
+`Verifier` is that skill of the executor (`Executor.verify_report`, which the strategies call
+too): it receives the executor's `SkillContext` (`episode/context.py`), the driving skill
+(`Driver`, for the step back) and the sensing skill (`Sensing.confirm`, for the frames).
 """
 
 from __future__ import annotations
@@ -18,6 +22,11 @@ import math
 
 import numpy as np
 
+from avs_planner.episode.context import SkillContext
+from avs_planner.episode.driving import Driver
+from avs_planner.episode.mind import KnownObject
+from avs_planner.episode.outcome import SeenLike
+from avs_planner.episode.sensing import Sensing
 from conceptual_map.metric import PathQueryError, distance_field
 
 MAX_ACCIDENTAL = 0.1  # a report's verification must come from where a phantom agrees by
@@ -62,3 +71,51 @@ def step_back(grid, robot_radius: float, pose: tuple[float, float, float],  # no
         if grid.contains(cell) and np.isfinite(reach[tuple(cell)]):
             return goal
     return None
+
+
+class Verifier:
+    """The look before a report: face the object from where agreement means something and
+    see it again (see the module's doc)."""
+
+    def __init__(self, context: SkillContext, driver: Driver, sensing: Sensing) -> None:
+        self.context = context
+        self.driver = driver
+        self.sensing = sensing
+
+    def verify_report(self, obj: KnownObject | SeenLike) -> bool:
+        """`verify` from a camera distance where frames agree by accident at most
+        `MAX_ACCIDENTAL` of the time: stepping back there first when the robot stands
+        closer and can reach such a spot. Without a body: `verify`."""
+        ctx = self.context
+        body = ctx.mind.body
+        if body is None:
+            return self.verify(obj)
+        x, y, _ = ctx.robot.pose
+        distance = math.dist((x, y, body.camera_height), obj.position)
+        needed = min(verify_distance(ctx.config.agree[0], body.hfov, body.vfov),
+                     0.9 * body.detect_range)
+        if distance < needed:
+            stand = step_back(ctx.mind.grid, ctx.mind.config.robot_radius, ctx.robot.pose,
+                              body.camera_height, obj.position, needed)
+            ctx.emit("action", action="(step-back)", status="start" if stand else "failed",
+                     distance=round(distance, 2), needed=round(needed, 2))
+            if stand is not None:
+                self.driver.drive_to(stand)
+        return self.verify(obj)
+
+    def verify(self, obj: KnownObject | SeenLike) -> bool:
+        """Face `obj` and look at it: True when one of `verify_frames` frames sees its label
+        within `agree` m of where it was found (always True with 0 frames)."""
+        ctx = self.context
+        frames = ctx.config.verify_frames
+        if frames <= 0:
+            return True
+        x, y, _ = ctx.robot.pose
+        dx, dy = obj.position[0] - x, obj.position[1] - y
+        ctx.robot.turn_to(math.atan2(dy, dx))
+        ctx.robot.look(0.0, -math.atan2(ctx.camera.height - obj.position[2],
+                                        max(math.hypot(dx, dy), 0.1)))
+        seen = self.sensing.confirm(obj, needed=1, frames=frames)
+        ctx.emit("observation", label=obj.label, detected=seen, verifying=True,
+                 position=[round(v, 2) for v in obj.position])
+        return seen

@@ -321,7 +321,7 @@ class QsrSearch:
                 for seen in robot.detect(list(tracker.labels)):
                     if seen.label in tracker.labels:
                         tracker.add(seen.label, seen.position, robot.pose[:2])
-        ctx.executor._sense([robot.pose])
+        ctx.executor.sense([robot.pose])
 
     def _depth(self) -> None:
         size = (self.opt["depth_columns"], self.opt["depth_rows"])

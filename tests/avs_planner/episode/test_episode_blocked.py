@@ -348,13 +348,13 @@ def test_a_robot_inside_a_new_keep_out_disc_first_steps_out_of_it(robot: str) ->
         touch = (6.0 + mind.config.robot_radius - 0.02, 3.2)  # just ahead of the rim
         blockage = mind.block(touch, sim.clock)
         assert math.dist(sim.pose[:2], touch) < blockage.radius
-        executor._back_off(blockage)
+        executor.driver.back_off(blockage)
         assert math.dist(sim.pose[:2], touch) >= blockage.radius
         assert sim.pose[0] < 6.0 and sim.pose[1] == pytest.approx(3.2, abs=1e-6)
         assert any(k.get("backed_off") == blockage.id for _, k in events)
         far = mind.block((9.0, 3.2), sim.clock)  # a touch well away: nothing to step out of
         before = sim.pose
-        executor._back_off(far)
+        executor.driver.back_off(far)
         assert sim.pose == before
     finally:
         sim.world.close()

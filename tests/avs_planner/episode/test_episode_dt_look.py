@@ -7,8 +7,6 @@ from types import SimpleNamespace
 
 import pytest
 
-from avs_planner.episode.dt_search import ViewConeSearch
-
 
 def _seen(x: float, y: float) -> SimpleNamespace:
     return SimpleNamespace(label="cerealbox", position=(x, y, 0.8))
@@ -16,7 +14,7 @@ def _seen(x: float, y: float) -> SimpleNamespace:
 
 def _look(executor, frames: list, tiebreak: bool = True):  # noqa: ANN001, ANN202
     executor.config = replace(executor.config, dt_tiebreak=tiebreak)
-    search = ViewConeSearch(executor, "cerealbox", "in", "room1")
+    search = executor.view_cone_search("cerealbox", "in", "room1")
     script = iter(frames)
     taken = []
 
@@ -60,7 +58,7 @@ def test_a_search_the_dt_would_not_look_in_is_settled_for_the_planner(corridor) 
 
     _, _, executor = corridor
     builder = executor.builder
-    search = ViewConeSearch(executor, "cerealbox", "in", "room1")
+    search = executor.view_cone_search("cerealbox", "in", "room1")
     no_look = SimpleNamespace(trace=[], status=DTStatus.REJECTED, detection=None)
     outcome = search._conclude(no_look, "cerealbox", "in", "room1", ConeSet((), 0.0, 0.0))
     assert outcome.detail == "rejected without looking"

@@ -31,8 +31,9 @@ WEST, EAST, SHUT = (2.0, 1.0), (4.0, 1.0), (7.0, 2.0)
 
 @pytest.fixture(scope="module")
 def executor() -> SimpleNamespace:
-    """What the DT's costs read of an executor: its robot's pose, the mind's grid and
-    planning radius, the body's speeds, and the executor's squeeze (none here)."""
+    """What the DT's costs read of the executor's skills: the context's robot pose, the
+    mind's grid and planning radius, the body's speeds, and the driver's squeeze (none
+    here)."""
     world = rooms_world(ROOMS, [DOOR])
     grid = OccupancyGrid(origin=(-1.0, -1.0), size=(10.0, 6.0))
     for pose in [(1.0, 1.0, 0.0), (2.0, 3.0, 3.1), (4.5, 2.0, 0.0), (5.0, 3.3, 2.0),
@@ -41,14 +42,14 @@ def executor() -> SimpleNamespace:
     mind = SimpleNamespace(grid=grid, config=SimpleNamespace(robot_radius=0.3),
                            body=SimpleNamespace(linear_speed=0.5, angular_speed=1.0))
     events: list[tuple[str, dict]] = []
-    return SimpleNamespace(
-        mind=mind, robot=SimpleNamespace(pose=(*WEST, 0.0)), events=events,
-        emit=lambda type_, **fields: events.append((type_, fields)),
-        _squeeze=lambda a, b: PathResult(PathStatus.NO_PATH, (), math.inf, 0))
+    context = SimpleNamespace(mind=mind, robot=SimpleNamespace(pose=(*WEST, 0.0)),
+                              emit=lambda type_, **fields: events.append((type_, fields)))
+    driver = SimpleNamespace(squeeze=lambda a, b: PathResult(PathStatus.NO_PATH, (), math.inf, 0))
+    return SimpleNamespace(context=context, driver=driver, events=events)
 
 
 def test_travel_between_cones_either_side_of_a_wall_follows_the_door(executor) -> None:
-    lengths = PathLengths(executor)
+    lengths = PathLengths(executor.context.mind, executor.driver.squeeze)
     metres = lengths(WEST, EAST)
     straight = math.dist(WEST, EAST)
     via_door = math.dist(WEST, DOOR[:2]) + math.dist(DOOR[:2], EAST)
@@ -67,7 +68,8 @@ def test_travel_between_cones_either_side_of_a_wall_follows_the_door(executor) -
 
 def test_cones_no_path_reaches_are_left_out_of_the_session(executor) -> None:
     cones = (ViewCone("c-0", (*EAST, 0.0), 0.3), ViewCone("c-1", (*SHUT, 0.0), 0.3))
-    search = ViewConeSearch(executor, "cup", "in", "room2")
+    search = ViewConeSearch(executor.context, executor.driver, None, None, {}, "cup", "in",
+                            "room2")
     kept, travel = search._reachable(ConeSet(cones, 0.8, 0.75))
     assert [c.id for c in kept.cones] == ["c-0"] and kept.coverage == 0.8
     assert len(travel.from_start) == 1 and travel.from_start[0] > math.dist(WEST, EAST) / 0.5
@@ -111,10 +113,10 @@ def test_a_support_search_looks_in_it_as_well_as_on_it(corridor) -> None:
     inside = support_cones(mind, shelf, 0.4, camera, "in", relations=("in",))
     assert inside.cones and all(a.head[1] > b.head[1] for a, b in zip(
         on.cones, inside.cones, strict=True))  # tilted further down: into the shelf
-    search = ViewConeSearch(executor, "cup", "on", shelf.id)
+    search = executor.view_cone_search("cup", "on", shelf.id)
     assert search._inside(Seen(1, "cup", (x + 0.8, y, 0.9), 0.9), "on", shelf.id)
     assert not search._inside(Seen(2, "cup", (x + 0.8, y, 2.3), 0.9), "on", shelf.id)
-    book = ViewConeSearch(executor, "book", "on", shelf.id)  # a book is on a shelf
+    book = executor.view_cone_search("book", "on", shelf.id)  # a book is on a shelf
     assert not book._inside(Seen(3, "book", (x + 0.8, y, 0.9), 0.9), "on", shelf.id)
     assert book._inside(Seen(4, "book", (x + 0.8, y, 1.7), 0.9), "on", shelf.id)
     before = mind.cmap.p_object_at("cup", RelatedSpace("in", shelf.id))

@@ -211,7 +211,7 @@ def test_a_path_query_refused_where_the_robot_stands_is_no_path_not_a_crash(
         raise PathQueryError("goal is blocked: closer than the robot radius")
 
     monkeypatch.setattr("avs_planner.episode.driving.plan_path", refuse)
-    path = executor._squeeze((6.0, 3.2), (8.0, 3.2))
+    path = executor.driver.squeeze((6.0, 3.2), (8.0, 3.2))
     assert not path.found
 
 

@@ -15,7 +15,7 @@ import pytest
 from avs_planner.dt import ViewCone
 from avs_planner.dt.domain import ActionKind, DTAction
 from avs_planner.dt.session import DTResult, DTStatus, DTStep
-from avs_planner.episode.dt_search import ViewConeSearch, looked_share
+from avs_planner.episode.dt_search import looked_share
 from avs_planner.episode.glimpses import Glimpses
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.viewcones import CameraModel, ConeSet, room_cones, support_cones
@@ -43,7 +43,7 @@ def test_every_look_of_a_dt_search_into_a_cone_counts(corridor) -> None:
     cones = (ViewCone("c-0", (x, y, 0.0), 0.3), ViewCone("c-1", (x, y, math.pi), 0.3))
     made = ConeSet(cones, coverage=0.8, probability=0.6)
     result = DTResult(DTStatus.REJECTED, 0.05, 2.0, _looks(0, 0, 1))
-    ViewConeSearch(executor, "table", "in", room)._conclude(result, "table", "in", room, made)
+    executor.view_cone_search("table", "in", room)._conclude(result, "table", "in", room, made)
     d = 1.0 - executor.config.detector.false_negative
     seen = 0.8 * (0.5 * (1.0 - (1.0 - d) ** 2) + 0.5 * d)
     assert mind.cmap.objects.remaining(room, "table") == pytest.approx(left * (1.0 - seen))
@@ -60,7 +60,7 @@ def test_a_room_search_thins_by_its_coverage_once(corridor) -> None:
     assert sum(c.probability for c in made.cones) == pytest.approx(0.5 * made.coverage)
     left = mind.cmap.objects.remaining(room, "table")
     result = DTResult(DTStatus.REJECTED, 0.05, 2.0, _looks(*range(len(made.cones))))
-    ViewConeSearch(executor, "table", "in", room)._conclude(result, "table", "in", room, made)
+    executor.view_cone_search("table", "in", room)._conclude(result, "table", "in", room, made)
     d = 1.0 - executor.config.detector.false_negative
     assert mind.cmap.objects.remaining(room, "table") == pytest.approx(
         left * (1.0 - d * made.coverage))
@@ -80,7 +80,7 @@ def test_a_support_search_counts_each_standpoint_as_a_look_at_the_whole_top(corr
     looks = {i: 1 for i in range(len(made.cones))}
     d = 1.0 - executor.config.detector.false_negative
     result = DTResult(DTStatus.REJECTED, 0.05, 2.0, _looks(*looks))
-    ViewConeSearch(executor, "cerealbox", "on", table.id)._conclude(
+    executor.view_cone_search("cerealbox", "on", table.id)._conclude(
         result, "cerealbox", "on", table.id, made)
     share = executor.glimpses.top_share(
         table.id, [(c.pose, *c.head, 1) for c in made.cones])
@@ -157,7 +157,7 @@ def test_a_new_place_is_looked_at_in_every_direction(corridor, headings) -> None
     _, _, executor = corridor
     executor.config = replace(executor.config, look_headings=headings)
     yaws: list[float] = []
-    executor.watch = lambda: yaws.append(executor.robot.pose[2])  # type: ignore[method-assign]
+    executor.sensing.watch = lambda: yaws.append(executor.robot.pose[2])  # type: ignore[method-assign]
     start = executor.robot.pose[2]
     executor.look_around()
     assert len(yaws) == headings
@@ -254,7 +254,7 @@ def test_a_dt_look_for_the_target_is_a_look_for_its_supports(corridor) -> None:
     before = {s: mind.cmap.objects.remaining(room, s) for s in supports}
     p_before = mind.cmap.p_unsearched(target, room)
     asked = _record_frames(executor, hide=supports)  # no desk shows
-    search = ViewConeSearch(executor, target, "in", room)
+    search = executor.view_cone_search(target, "in", room)
     for yaw in (0.0, 1.57, 3.14, -1.57):
         executor.robot.turn_to(yaw)
         search._look(target, "in", room)
@@ -275,7 +275,7 @@ def test_a_frame_while_a_confirmed_target_waits_for_its_room_looks_for_the_targe
     asked = _record_frames(executor)
     executor.watch()
     assert set(builder.supports) <= set(asked[-1])  # as a rule the watch asks for supports too
-    executor._unplaced.append(SimpleNamespace(label=builder.task.target,
+    executor.sensing.unplaced.append(SimpleNamespace(label=builder.task.target,
                                               position=(50.0, 50.0, 0.8)))
     executor.watch()
     assert asked[-1] == [builder.task.target]

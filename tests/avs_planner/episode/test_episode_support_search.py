@@ -15,7 +15,6 @@ from avs_planner.dt import ViewCone
 from avs_planner.dt.domain import ActionKind, DTAction
 from avs_planner.dt.session import DTResult, DTStatus, DTStep
 from avs_planner.episode.driving import TARGET_SEEN, _split_leg
-from avs_planner.episode.dt_search import ViewConeSearch
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import StepOutcome, StepStatus
 from avs_planner.episode.trace import Trace
@@ -47,7 +46,7 @@ def test_a_room_search_skips_objects_the_mind_knows(corridor) -> None:
     mind, _, executor = corridor
     room, (x, y) = _here(mind)
     mind.add_object("table", (x + 0.5, y, 0.4))
-    search = ViewConeSearch(executor, "table", "in", room)
+    search = executor.view_cone_search("table", "in", room)
     assert not search._inside(Seen(1, "table", (x + 0.8, y, 0.4), 0.9), "in", room)
     assert search._inside(Seen(2, "table", (x - 1.5, y, 0.4), 0.9), "in", room)
 
@@ -72,9 +71,9 @@ def test_split_leg_returns_the_leg_and_the_rest() -> None:
 def test_a_route_through_a_wall_is_not_clear(corridor) -> None:
     _, _, executor = corridor
     x, y, _ = executor.robot.pose
-    assert executor._clear([(x, y), (x + 1.0, y)])
-    assert not executor._clear([(x, y), (x, y + 1.5)])  # the office1 wall at y = 4
-    assert not executor._clear([(x, y)])
+    assert executor.driver.clear([(x, y), (x + 1.0, y)])
+    assert not executor.driver.clear([(x, y), (x, y + 1.5)])  # the office1 wall at y = 4
+    assert not executor.driver.clear([(x, y)])
 
 
 def test_uncertain_rooms_are_found_nearest_first_and_skipped_once_visited(corridor) -> None:
@@ -183,7 +182,7 @@ def test_a_room_search_thins_the_unseen_count_whether_or_not_it_found_one(corrid
     status = DTStatus.CONFIRMED if found else DTStatus.REJECTED
     seen = Seen(1, "table", (x + 1.0, y, 0.4), 0.9) if found else None
     result = DTResult(status, 0.9, 2.0, looked, detection=seen)
-    outcome = ViewConeSearch(executor, "table", "in", room)._conclude(
+    outcome = executor.view_cone_search("table", "in", room)._conclude(
         result, "table", "in", room, made)
     assert outcome.status is StepStatus.DONE
     assert mind.cmap.objects.remaining(room, "table") == pytest.approx(
@@ -234,9 +233,9 @@ def test_a_drive_stops_once_the_watch_confirms_the_target(corridor, monkeypatch)
                 self.result = DTResult(DTStatus.REJECTED, 0.5, 0.0, ())
 
     monkeypatch.setattr("avs_planner.episode.dt_search.DTSession", MovesFirst)
-    monkeypatch.setattr(executor, "drive_to",
+    monkeypatch.setattr(executor.driver, "drive_to",
                         lambda goal, stop=None: StepOutcome(StepStatus.DONE, TARGET_SEEN))
-    outcome = ViewConeSearch(executor, target, "in", room).run()
+    outcome = executor.view_cone_search(target, "in", room).run()
     assert outcome.status is StepStatus.DONE and outcome.detail == TARGET_SEEN
     assert executor.dt_session.actions == [DTAction(ActionKind.REJECT)]
     assert builder.failed_in.get((target, room), 0) == 0

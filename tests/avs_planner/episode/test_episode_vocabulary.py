@@ -55,7 +55,7 @@ def test_a_reading_the_knowledge_cannot_use_is_a_warning() -> None:
         episode.executor.look_around()
         episode.robot.classify_place = lambda: "garage"  # a classifier of another vocabulary
         episode.mind.classified.clear()
-        episode.executor._classify()
+        episode.executor.sensing.classify()
         warnings = [e for e in events if e["type"] == "warning"]
         assert warnings and "garage_like" in warnings[0]["detail"]
     finally:
