@@ -11,12 +11,13 @@ do, for every skill at once (a test's robot proxy, settings given after the exec
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 from avs_planner.cp.search import DEFAULT_REWARD
 from avs_planner.dt import DetectorModel
 from avs_planner.episode.mind import Mind
+from avs_planner.episode.outcome import SeenLike
 from avs_planner.episode.robot_api import Robot
 from avs_planner.episode.state_builder import StateBuilder
 from avs_planner.episode.viewcones import CameraModel
@@ -104,9 +105,19 @@ class Stats:
     detections: list[tuple[float, float, str, bool]] = field(default_factory=list)
 
 
+@dataclass(frozen=True)
+class Listener:
+    """Labels some part of the mind wants to hear of in every frame, and what it does with
+    their detections (with the robot's position when the frame was taken)."""
+
+    labels: tuple[str, ...]
+    observe: Callable[[list[SeenLike], tuple[float, float]], None]
+
+
 @dataclass
 class SkillContext:
-    """One episode's parts every skill works with (see the module's doc)."""
+    """One episode's parts every skill works with (see the module's doc). `listeners`: see
+    `detect`."""
 
     robot: Robot
     mind: Mind
@@ -116,3 +127,20 @@ class SkillContext:
     stats: Stats
     emit: Event
     seed: int = 0
+    listeners: list[Listener] = field(default_factory=list)
+
+    def detect(self, labels: Sequence[str]) -> list[SeenLike]:
+        """One frame of the detector, for `labels`: every skill takes its frames here. The
+        same frame is asked for the listeners' labels too (a detector reports all it
+        recognises in one frame, at no extra sensing time); each listener hears of the
+        detections of its labels, the skill gets those of its own."""
+        asked = list(labels)
+        extra = list(dict.fromkeys(lb for listener in self.listeners for lb in listener.labels
+                                   if lb not in asked))
+        if not self.listeners:
+            return list(self.robot.detect(asked))
+        frame = list(self.robot.detect(asked + extra))
+        where = (float(self.robot.pose[0]), float(self.robot.pose[1]))
+        for listener in self.listeners:
+            listener.observe([s for s in frame if s.label in listener.labels], where)
+        return [s for s in frame if s.label in asked]

@@ -182,7 +182,7 @@ class ViewConeSearch:
 
     def _detect_once(self, label: str, relation: str, location: str,
                      also: Sequence[str] = ()) -> SeenLike | None:
-        frame = self.context.robot.detect([label, *also])
+        frame = self.context.detect([label, *also])
         if also:
             self.sensing.glimpse(frame, list(also), self.head)
         seen = [s for s in frame if s.label == label]

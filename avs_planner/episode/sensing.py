@@ -122,7 +122,7 @@ class Sensing:
         # a frame (a second) before the target could be reported
         glimpsing = self.glimpses is not None and not self.unplaced
         labels = [label, *ctx.builder.supports] if glimpsing else [label]
-        frame = ctx.robot.detect(labels)
+        frame = ctx.detect(labels)
         first = [s for s in frame if s.label == label]
         if glimpsing:
             self.glimpse(frame, labels)
@@ -185,7 +185,7 @@ class Sensing:
         repeats twice at the same spot is practically never seen, while a real object missed
         in 1 frame of 5 still passes 9 times in 10. One short with some frame agreeing is
         ambiguous: up to `confirm_extra` more frames are taken (once)."""
-        robot, cfg = self.context.robot, self.context.config
+        cfg = self.context.config
         agree = cfg.agree[0] if agree is None else agree
         needed = cfg.confirm_needed if needed is None else needed
         frames = cfg.confirm_frames if frames is None else frames
@@ -193,7 +193,7 @@ class Sensing:
         extended = False
         while k < frames:
             if any(s.label == seen.label and math.dist(s.position, seen.position) <= agree
-                   for s in robot.detect([seen.label])):
+                   for s in self.context.detect([seen.label])):
                 hits += 1
             k += 1
             if hits >= needed:

@@ -48,6 +48,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from avs_planner.dt import ViewCone
+from avs_planner.episode.context import Listener
 from avs_planner.episode.mind import KnownObject
 from avs_planner.episode.viewcones import ConeSet, _room_cells, room_cones
 from avs_planner.episode.viewcones import _in_wedge as _in_room_wedge
@@ -299,24 +300,14 @@ def knowledge_for(task_qsr: QsrKnowledge | None, target: str
 def install(executor: Executor, task_qsr: QsrKnowledge | None, target: str
             ) -> QsrCones | None:  # fmt: skip
     """Give the executor QSR-weighted support cones for `target` when QSRs are known for it,
-    and tap the robot adapter's `detect` so that every look also reports landmark labels."""
+    and listen to every frame for landmark labels (`SkillContext.detect`)."""
     known = knowledge_for(task_qsr, target)
     if known is None:
         return None
     qsr = QsrCones(executor, known[0], target, known[1])
     if not qsr.labels:
         return None
-    robot = executor.robot
-    detect = robot.detect
-
-    def tapped(labels: Sequence[str]) -> list[Any]:
-        asked = list(labels)
-        extra = [lb for lb in qsr.labels if lb not in asked]
-        seen = detect(asked + extra)
-        qsr.observe(seen, tuple(robot.pose[:2]))
-        return [s for s in seen if s.label in asked]
-
-    robot.detect = tapped
+    executor.context.listeners.append(Listener(qsr.labels, qsr.observe))
     executor.qsr_cones = qsr
     executor.emit("belief", qsr_cones_for=target, knowledge=known[1],
                   landmark_labels=list(qsr.labels))

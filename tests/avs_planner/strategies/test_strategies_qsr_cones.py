@@ -10,6 +10,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from avs_planner.episode.context import SkillContext, Stats
 from avs_planner.episode.executor import ExecutorConfig
 from avs_planner.episode.mind import KnownObject, Mind
 from avs_planner.episode.viewcones import CameraModel, support_cones
@@ -63,9 +64,14 @@ def _executor(robot: FakeRobot | None = None) -> SimpleNamespace:
     mind.grid = _grid()
     mind.objects["counter1"] = COUNTER
     events: list[tuple[str, dict]] = []
-    return SimpleNamespace(mind=mind, config=CONFIG, camera=CAMERA, seed=0,
-                           robot=robot or FakeRobot(), qsr_cones=None, events=events,
-                           emit=lambda kind, **fields: events.append((kind, fields)))
+    robot = robot or FakeRobot()
+
+    def emit(kind: str, **fields: object) -> None:
+        events.append((kind, fields))
+
+    context = SkillContext(robot, mind, None, CAMERA, CONFIG, Stats(), emit)  # type: ignore[arg-type]
+    return SimpleNamespace(mind=mind, config=CONFIG, camera=CAMERA, seed=0, robot=robot,
+                           qsr_cones=None, events=events, emit=emit, context=context)
 
 
 def _knowledge(side: str):  # noqa: ANN202
@@ -125,13 +131,16 @@ def test_no_landmark_seen_or_another_label_keeps_the_uniform_cones():
     assert qsr.support_cones("cup", COUNTER, 0.6, "k") is None
 
 
-def test_install_taps_the_detector_for_landmark_labels_and_hides_them_from_callers():
+def test_install_listens_to_every_frame_for_landmark_labels_and_hides_them_from_callers():
+    """Every frame a skill takes (`SkillContext.detect`) also asks for the landmark labels; the
+    robot itself is not touched (its members cannot be replaced: replacing its `detect` made
+    every episode with QSR cones end in an internal error)."""
     robot = FakeRobot()
     ex = _executor(robot)
     qsr = install(ex, _knowledge("right"), "cup")
     assert ex.qsr_cones is qsr and qsr.labels == ("keyboard",)
     for _ in range(2):
-        seen = robot.detect(["cup"])
+        seen = ex.context.detect(["cup"])
         assert [s.label for s in seen] == ["cup"]  # the caller gets what it asked for
     assert robot.asked[-1] == ["cup", "keyboard"]  # one frame for both: no extra time
     assert [lm.label for lm in qsr.landmarks()] == ["keyboard"]
@@ -182,3 +191,15 @@ def test_room_cones_keep_the_uniform_set_and_coverage_and_lean_half_on_the_densi
     assert by_id["r-1"] > 0.2 and by_id["r-0"] < 0.3  # towards the keyboard's right
     assert by_id["r-1"] <= 0.5 * 0.5 + 0.5 * 0.2 + 1e-9  # only half follows the density
     assert qsr.room_cones("stapler", "lab", 0.8, "r") is None
+
+
+@pytest.mark.parametrize("mode", ["on", "observe"])
+def test_an_episode_with_qsr_cones_runs_to_its_end(mode: str) -> None:
+    """The option end to end on the QSR desks world: the keyboard is found (both modes
+    ended in an internal error while `install` replaced the fenced robot's `detect`)."""
+    from avs_planner.harness import Episode, EpisodeSpec
+
+    summary = Episode(EpisodeSpec.from_dict(
+        {"target": "keyboard", "world": "qsr_desks", "seed": 0,
+         "strategy_options": {"qsr_cones": mode}})).run()
+    assert summary["outcome"] == "found" and summary["correct"], summary["reason"]
