@@ -135,10 +135,10 @@ class SkillContext:
         recognises in one frame, at no extra sensing time); each listener hears of the
         detections of its labels, the skill gets those of its own."""
         asked = list(labels)
-        extra = list(dict.fromkeys(lb for listener in self.listeners for lb in listener.labels
-                                   if lb not in asked))
         if not self.listeners:
             return list(self.robot.detect(asked))
+        extra = list(dict.fromkeys(lb for listener in self.listeners for lb in listener.labels
+                                   if lb not in asked))
         frame = list(self.robot.detect(asked + extra))
         where = (float(self.robot.pose[0]), float(self.robot.pose[1]))
         for listener in self.listeners:

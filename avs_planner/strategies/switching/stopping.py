@@ -61,9 +61,13 @@ class Remaining:
     `within`: for each option's cost bound c (ascending), P(target in the spaces of the
     options costing at most c)."""
 
-    p: float
     options: tuple[Option, ...]
     within: tuple[tuple[float, float], ...] = ()
+
+    @property
+    def p(self) -> float:
+        """P(target in space not yet searched): that within the dearest option's cost."""
+        return self.within[-1][1] if self.within else 0.0
 
     @classmethod
     def of(cls, options: Iterable[Option], mass: Callable[[float], float],
@@ -77,7 +81,7 @@ class Remaining:
         for option in sorted(options, key=lambda o: o.cost):
             total += mass(option.p)
             within.append((option.cost, p_any(total)))
-        return cls(within[-1][1] if within else 0.0, options, tuple(within))
+        return cls(options, tuple(within))
 
     def best(self, reward: float) -> Option | None:
         """The option worth most on its own (for traces)."""
