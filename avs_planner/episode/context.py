@@ -89,6 +89,10 @@ class ExecutorConfig:
     # directions the detector looks in at a new place (`look_around`): 2 is ahead and behind;
     # 6 covers the whole turn with the camera's 60 degree field of view
     look_headings: int = 2
+    # every frame also asks for the knowledge's furniture labels, and one that the frames
+    # with its spot in view mostly showed becomes a known object: evidence for its room's
+    # category (`episode/landmarks.py`); the switching strategy turns this on
+    landmarks: bool = False
 
 
 @dataclass
@@ -106,12 +110,22 @@ class Stats:
 
 
 @dataclass(frozen=True)
+class FrameView:
+    """Where a frame was taken from: the robot's pose (x, y, yaw) and the head's pan and tilt
+    as the skills last set them (`SkillContext.look`)."""
+
+    pose: tuple[float, float, float]
+    pan: float = 0.0
+    tilt: float = 0.0
+
+
+@dataclass(frozen=True)
 class Listener:
     """Labels some part of the mind wants to hear of in every frame, and what it does with
-    their detections (with the robot's position when the frame was taken)."""
+    their detections (with where the frame was taken from)."""
 
     labels: tuple[str, ...]
-    observe: Callable[[list[SeenLike], tuple[float, float]], None]
+    observe: Callable[[list[SeenLike], FrameView], None]
 
 
 @dataclass
@@ -128,6 +142,13 @@ class SkillContext:
     emit: Event
     seed: int = 0
     listeners: list[Listener] = field(default_factory=list)
+    head: tuple[float, float] = (0.0, 0.0)  # (pan, tilt) last set through `look`
+
+    def look(self, pan: float, tilt: float) -> None:
+        """Point the head; the skills point it here, so a frame's listeners know where it
+        looked."""
+        self.robot.look(pan, tilt)
+        self.head = (float(pan), float(tilt))
 
     def detect(self, labels: Sequence[str]) -> list[SeenLike]:
         """One frame of the detector, for `labels`: every skill takes its frames here. The
@@ -140,7 +161,8 @@ class SkillContext:
         extra = list(dict.fromkeys(lb for listener in self.listeners for lb in listener.labels
                                    if lb not in asked))
         frame = list(self.robot.detect(asked + extra))
-        where = (float(self.robot.pose[0]), float(self.robot.pose[1]))
+        x, y, yaw = self.robot.pose
+        view = FrameView((float(x), float(y), float(yaw)), *self.head)
         for listener in self.listeners:
-            listener.observe([s for s in frame if s.label in listener.labels], where)
+            listener.observe([s for s in frame if s.label in listener.labels], view)
         return [s for s in frame if s.label in asked]

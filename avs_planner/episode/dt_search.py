@@ -89,7 +89,7 @@ class ViewConeSearch:
                     interrupted = True
                     break
                 robot.turn_to(cone.pose[2])
-                robot.look(*(cone.head or (0.0, 0.0)))
+                ctx.look(*(cone.head or (0.0, 0.0)))
                 self.head = cone.head or (0.0, 0.0)
                 if cone.torso is not None:
                     robot.set_torso(cone.torso)

@@ -30,6 +30,7 @@ from avs_planner.episode.context import Event, ExecutorConfig, SkillContext, Sta
 from avs_planner.episode.driving import TARGET_SEEN, Driver, Point, Pose
 from avs_planner.episode.dt_search import ViewConeSearch
 from avs_planner.episode.glimpses import Glimpses
+from avs_planner.episode.landmarks import RoomLandmarks, landmark_labels
 from avs_planner.episode.mind import KnownObject, Mind
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
 from avs_planner.episode.robot_api import Robot
@@ -60,6 +61,9 @@ class Executor:
         self.dt_session: DTSession | None = None  # the last SEARCHFOROBJECT's (for observers)
         if config.glimpses:
             self.enable_glimpses()
+        self.landmarks: RoomLandmarks | None = None
+        if config.landmarks:
+            self.enable_landmarks()
 
     # ---- the context and the skills' state, as the strategies and the harness read it -------
 
@@ -151,6 +155,18 @@ class Executor:
     def enable_glimpses(self) -> None:
         """Frames taken in passing become evidence (`Sensing.enable_glimpses`)."""
         self.sensing.enable_glimpses()
+
+    def enable_landmarks(self) -> None:
+        """Every frame also asks for room landmarks (`episode/landmarks.py`); once."""
+        if self.landmarks is not None:
+            return
+        # the frames' geometry (field of view, range, line of sight): the glimpses' own, or
+        # the same without their evidence when glimpses are off
+        views = self.glimpses or Glimpses(self.mind, self.camera, 1.0,
+                                          support_body=self.config.support_radius)
+        labels = landmark_labels(self.mind.cmap.knowledge, self.builder.labels)
+        self.landmarks = RoomLandmarks(self.context, labels, self.sensing.known_near, views)
+        self.context.listeners.append(self.landmarks.listener())
 
     def look_around(self) -> None:
         """The first view of a place: scans both ways, the detector watching

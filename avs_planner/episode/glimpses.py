@@ -90,7 +90,7 @@ class Glimpses:
         points, rooms = (candidate_cells(self.mind) if labels or shown
                          else (np.zeros((0, 2)), np.zeros(0, dtype=object)))
         if len(points):
-            seen = self._in_view(points, pose, pan, tilt, self.camera.support_height)
+            seen = self.in_view(points, pose, pan, tilt, self.camera.support_height)
             keys = [tuple(k) for k in self._keys(points).tolist()]
             masks = [(label, seen) for label in labels]
             for label, where in shown.items():
@@ -167,23 +167,24 @@ class Glimpses:
     def _top_in_view(self, centre: tuple[float, float], pose: tuple[float, float, float],
                      pan: float, tilt: float, top: float) -> np.ndarray:
         """Which points of the top (`_top_points` around `centre`, at height `top`) are in
-        the frame (`_in_frame`); none unless the centre has a free line of sight up to the
+        the frame (`in_frame`); none unless the centre has a free line of sight up to the
         support's own body."""
         points = np.asarray(centre, dtype=float) + self._top_points
-        seen = self._in_frame(points, pose, pan, tilt, top)
+        seen = self.in_frame(points, pose, pan, tilt, top)
         if seen.any():
             point = np.array([centre], dtype=float)
-            if not self._line_of_sight(np.asarray(pose[:2]), point, self.support_body)[0]:
+            if not self.line_of_sight(np.asarray(pose[:2]), point, self.support_body)[0]:
                 seen[:] = False
         return seen
 
     def _keys(self, points: np.ndarray) -> np.ndarray:
         return np.round(points / self.mind.grid.resolution).astype(np.int64)
 
-    def _in_frame(self, points: np.ndarray, pose: tuple[float, float, float], pan: float,
-                  tilt: float, height: float) -> np.ndarray:
-        """Points (at `height`) inside the frame: within the horizontal and vertical fields
-        of view and between `min_range` and `max_range` (no line of sight tested)."""
+    def in_frame(self, points: np.ndarray, pose: tuple[float, float, float], pan: float,
+                 tilt: float, height: float | np.ndarray) -> np.ndarray:
+        """Points (at `height`, one for all or one each) inside the frame: within the
+        horizontal and vertical fields of view and between `min_range` and `max_range` (no
+        line of sight tested)."""
         cam = self.camera
         d = points - np.asarray(pose[:2])
         r = np.hypot(d[:, 0], d[:, 1])
@@ -195,17 +196,17 @@ class Glimpses:
             ok &= np.abs(elevation - tilt) <= cam.vfov / 2
         return ok
 
-    def _in_view(self, points: np.ndarray, pose: tuple[float, float, float], pan: float,
+    def in_view(self, points: np.ndarray, pose: tuple[float, float, float], pan: float,
                  tilt: float, height: float) -> np.ndarray:
-        """Points (at `height`) inside the frame (`_in_frame`) with a free line of sight."""
-        ok = self._in_frame(points, pose, pan, tilt, height)
+        """Points (at `height`) inside the frame (`in_frame`) with a free line of sight."""
+        ok = self.in_frame(points, pose, pan, tilt, height)
         if not ok.any():
             return ok
         idx = np.flatnonzero(ok)
-        ok[idx] = self._line_of_sight(np.asarray(pose[:2]), points[idx])
+        ok[idx] = self.line_of_sight(np.asarray(pose[:2]), points[idx])
         return ok
 
-    def _line_of_sight(self, origin: np.ndarray, points: np.ndarray, body: float = 0.0
+    def line_of_sight(self, origin: np.ndarray, points: np.ndarray, body: float = 0.0
                        ) -> np.ndarray:
         """True where every grid cell between `origin` and the point is known free, leaving
         out the robot's own footprint (its laser never sees the cells under it) and the last

@@ -196,12 +196,13 @@ class Mind:
         return any(math.dist(d.centre, position) < clearance
                    for d in self.place_map.doors.values())
 
-    def room_at(self, position: tuple[float, float]) -> str | None:
+    def room_at(self, position: tuple[float, float], floor_only: bool = False) -> str | None:
         """The room whose mapped floor holds `position` (`PlaceMap.room_at`): None beyond a
         door the robot has not passed. The room of the nearest place credited a kitchen's
         table and cereal box seen through its door to the corridor the robot looked from, and
-        the corridor's readings then outweighed them (the room ended "corridor 1.00")."""
-        return self.place_map.room_at(self.grid, position)
+        the corridor's readings then outweighed them (the room ended "corridor 1.00").
+        `floor_only`: None too where no mapped floor is near (else the nearest place's room)."""
+        return self.place_map.room_at(self.grid, position, nearest_place=not floor_only)
 
     def nearest_room(self, position: tuple[float, float]) -> str | None:
         """The room of the place nearest to `position` (None before any room exists)."""

@@ -116,7 +116,7 @@ class Sensing:
             return None
         ctx = self.context
         label = ctx.builder.task.target
-        ctx.robot.look(0.0, ahead_tilt(ctx.camera))
+        ctx.look(0.0, ahead_tilt(ctx.camera))
         # once a target is confirmed and only waits for the scan to give it a room, what the
         # frame shows of supports no longer matters: confirming a desk seen in passing took
         # a frame (a second) before the target could be reported

@@ -113,8 +113,8 @@ class Verifier:
         x, y, _ = ctx.robot.pose
         dx, dy = obj.position[0] - x, obj.position[1] - y
         ctx.robot.turn_to(math.atan2(dy, dx))
-        ctx.robot.look(0.0, -math.atan2(ctx.camera.height - obj.position[2],
-                                        max(math.hypot(dx, dy), 0.1)))
+        ctx.look(0.0, -math.atan2(ctx.camera.height - obj.position[2],
+                                  max(math.hypot(dx, dy), 0.1)))
         seen = self.sensing.confirm(obj, needed=1, frames=frames)
         ctx.emit("observation", label=obj.label, detected=seen, verifying=True,
                  position=[round(v, 2) for v in obj.position])

@@ -138,13 +138,14 @@ class PlaceMap:
         return self._extents[1], self._extents[2], self._extents[3]
 
     def room_at(self, grid: OccupancyGrid, point: tuple[float, float],
-                reach: float = 1.0) -> str | None:
+                reach: float = 1.0, nearest_place: bool = True) -> str | None:
         """The room a point of the floor plan is in: the room holding the free cell nearest
         to it within `reach` m (an object seen stands on occupied cells: a table, a shelf;
         the floor around it tells the room). None when that free space is no room's: beyond
         a door, in a room seen but not entered (an object seen there is not evidence about
         the room the robot looked from). With no free cell that near (the map around the
-        point not seen yet), the room of the nearest place, as before any extent is known."""
+        point not seen yet), the room of the nearest place, as before any extent is known,
+        or None without `nearest_place`."""
         if not self.rooms:
             return None
         owner, ids, labels = self._room_extents(grid)
@@ -160,6 +161,8 @@ class PlaceMap:
                     i, j = candidates[int(np.argmin(d))] + lo
                     k = int(owner[i, j])
                     return ids[k - 1] if k else None
+        if not nearest_place:
+            return None
         place, _ = self._nearest_place(np.asarray(point, dtype=float))
         return self.room_of(place) if place is not None else None
 

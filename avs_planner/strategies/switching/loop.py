@@ -77,6 +77,9 @@ class LoopConfig:
     glimpses: bool = True
     # directions the detector looks in at each new place (`Executor.look_around`)
     look_headings: int = 6
+    # every frame also asks for furniture that tells a room's kind, kept when the frames
+    # that had its spot in view mostly showed it (`episode/landmarks.py`)
+    landmarks: bool = True
     # price moves and searches in the robot's own seconds (`BuilderConfig.seconds`), the
     # unit R is in (docs/results.md, "Development worlds, 2026-11-28: a building's rate")
     seconds: bool = True
@@ -86,9 +89,11 @@ class LoopConfig:
 
     def executor_config(self, base: ExecutorConfig | None = None) -> ExecutorConfig:
         """The executor's settings these loop settings decide (R, the watch, glimpses, the
-        look around), over `base`: the episode builds its executor with them once."""
+        look around, room landmarks), over `base`: the episode builds its executor with them
+        once."""
         return replace(base or ExecutorConfig(), miss_penalty=self.reward, watch=self.watch,
-                       glimpses=self.glimpses, look_headings=self.look_headings)
+                       glimpses=self.glimpses, look_headings=self.look_headings,
+                       landmarks=self.landmarks)
 
     def builder_config(self, base: BuilderConfig | None = None) -> BuilderConfig:
         """The state builder's settings these loop settings decide (costs in seconds)."""

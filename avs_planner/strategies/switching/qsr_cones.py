@@ -48,7 +48,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from avs_planner.dt import ViewCone
-from avs_planner.episode.context import Listener
+from avs_planner.episode.context import FrameView, Listener
 from avs_planner.episode.mind import KnownObject
 from avs_planner.episode.viewcones import ConeSet, _room_cells, room_cones
 from avs_planner.episode.viewcones import _in_wedge as _in_room_wedge
@@ -91,8 +91,10 @@ class QsrCones:
 
     # -- perception --
 
-    def observe(self, seen: Sequence[Any], robot_xy: tuple[float, float]) -> None:
-        """Detections of landmark labels (anything with `label` and `position`)."""
+    def observe(self, seen: Sequence[Any], view: FrameView) -> None:
+        """Detections of landmark labels (anything with `label` and `position`) in a frame
+        taken from `view`."""
+        robot_xy = (view.pose[0], view.pose[1])
         for s in seen:
             if s.label in self.labels:
                 self.tracker.add(s.label, tuple(s.position), robot_xy)

@@ -52,6 +52,8 @@ def switching_loop():
         executor.watching = executor.config.watch
         if executor.config.glimpses and executor.glimpses is None:
             executor.enable_glimpses()
+        if executor.config.landmarks:
+            executor.enable_landmarks()
         builder.config = config.builder_config(builder.config)
         return SwitchingLoop(builder, executor, trace, config, should_stop)
 

@@ -137,7 +137,7 @@ def test_a_frame_does_not_see_through_walls(corridor) -> None:
     x, y = mind.place_map.places[mind.place_map.current_place].position
     wall = occupied[np.hypot(*(occupied - [x, y]).T).argmin()]  # the nearest wall cell
     beyond = wall + 1.0 * (wall - np.array([x, y])) / np.linalg.norm(wall - np.array([x, y]))
-    clear = g._line_of_sight(np.array([x, y]), np.array([wall, beyond]))
+    clear = g.line_of_sight(np.array([x, y]), np.array([wall, beyond]))
     assert clear[0] and not clear[1]  # the wall cell itself is seen; behind it is not
 
 

@@ -10,7 +10,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from avs_planner.episode.context import SkillContext, Stats
+from avs_planner.episode.context import FrameView, SkillContext, Stats
 from avs_planner.episode.executor import ExecutorConfig
 from avs_planner.episode.mind import KnownObject, Mind
 from avs_planner.episode.viewcones import CameraModel, support_cones
@@ -81,7 +81,8 @@ def _knowledge(side: str):  # noqa: ANN202
 
 def _seen_twice(qsr: QsrCones) -> None:
     for _ in range(2):
-        qsr.observe([Seen("keyboard", KEYBOARD), Seen("monitor", MONITOR)], (3.0, 4.0))
+        qsr.observe([Seen("keyboard", KEYBOARD), Seen("monitor", MONITOR)],
+                    FrameView((3.0, 4.0, 0.0)))
 
 
 def _covers(cone, point: tuple[float, float]) -> bool:  # noqa: ANN001
@@ -123,7 +124,8 @@ def test_cone_weights_favour_the_described_side_of_the_keyboard(side, there, not
 def test_no_landmark_seen_or_another_label_keeps_the_uniform_cones():
     ex = _executor()
     qsr = QsrCones(ex, _knowledge("right"), "cup", "task")
-    qsr.observe([Seen("keyboard", KEYBOARD)], (3.0, 4.0))  # one sighting is no landmark
+    # one sighting is no landmark
+    qsr.observe([Seen("keyboard", KEYBOARD)], FrameView((3.0, 4.0, 0.0)))
     assert qsr.support_cones("cup", COUNTER, 0.6, "k") is None
     _seen_twice(qsr)
     assert qsr.support_cones("stapler", COUNTER, 0.6, "k") is None  # not the QSR target
