@@ -23,8 +23,9 @@ when the survey ends (the QSR paper's time is search time with known maps); summ
 times.
 
 After a found object, the knowledge learns from it (`learn_from_observation` with the surveyed
-landmarks): kept in this process for the next search without task descriptions, and written to
-`learn_file` when that option names a file.
+landmarks), written to `learn_file` when that option names a file; the next search reads it from
+there. Nothing is kept in the process: an episode's result depends only on its inputs (a
+service worker or a campaign process runs many episodes, in any order).
 """
 
 from __future__ import annotations
@@ -72,11 +73,6 @@ from conceptual_map.qsr import (
 MAX_DRIVE_FAILURES = 5  # selected poses the robot could not reach before giving up
 
 
-# knowledge learnt in this process, for searches whose task carries no descriptions
-_LEARNT: dict[str, QsrKnowledge] = {}
-_PROCESS = "process"
-
-
 def run_qsr(ctx: SearchContext) -> SearchResult:
     return QsrSearch(ctx, ViewMethod.QSR).run()
 
@@ -87,11 +83,6 @@ def run_supporting_planes(ctx: SearchContext) -> SearchResult:
 
 def run_random(ctx: SearchContext) -> SearchResult:
     return QsrSearch(ctx, ViewMethod.RANDOM).run()
-
-
-def forget_learnt() -> None:
-    """Drop what this process learnt (tests, fresh experiments)."""
-    _LEARNT.clear()
 
 
 # ---- the search ----------------------------------------------------------------------------
@@ -124,16 +115,14 @@ class QsrSearch:
     # -- knowledge --
 
     def _knowledge(self) -> tuple[QsrKnowledge, str]:
-        """The task's descriptions; else `learn_file` when it exists; else (when learning)
-        what this process learnt; else the default knowledge."""
+        """The task's descriptions; else `learn_file` when it exists; else the default
+        knowledge."""
         ctx = self.ctx
         if ctx.qsr is not None:
             return ctx.qsr, "task"
         path = str(self.opt.get("learn_file") or "")
         if path and Path(path).exists():
             return load_qsr(path), path
-        if self.opt["learn"] and _PROCESS in _LEARNT:
-            return _LEARNT[_PROCESS], "learnt in this process"
         return load_qsr(), "default"
 
     # -- the loop --
@@ -447,8 +436,7 @@ class QsrSearch:
         self.ctx.trace.emit("belief", qsr_learnt=[d.text() for d in update.credited])
         if not update.credited:
             return
-        if self.knowledge_from != "task":
-            _LEARNT[_PROCESS] = update.knowledge
+        self.knowledge = update.knowledge
         path = str(self.opt.get("learn_file") or "")
         if path:
             import yaml

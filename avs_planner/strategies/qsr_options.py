@@ -33,7 +33,7 @@ OPTIONS: dict[str, Any] = {
     "depth_columns": 64,  # depth frame size (columns x rows)
     "depth_rows": 48,
     "watch": False,  # the detector watches for the target while driving to a view pose
-    "learn": True,  # after a found object, update the knowledge kept for the next search
+    "learn": True,  # after a found object, update the knowledge (written to learn_file)
     "learn_file": "",  # QSR YAML read at start (when it exists) and written after learning
 }
 

@@ -12,7 +12,6 @@ from avs_planner.harness import run_episode
 from avs_planner.harness.runner import EpisodeSpec
 from avs_planner.qsr import LandmarkTracker, open_side
 from avs_planner.strategies import get_strategy
-from avs_planner.strategies.qsr import forget_learnt
 from conceptual_map.metric import OccupancyGrid
 from conceptual_map.qsr import load_qsr
 
@@ -52,26 +51,23 @@ def test_the_search_monitor_gives_up_on_an_absent_object():
     assert summary["views_processed"] >= summary["details"]["poses"] >= 1
 
 
-def test_a_found_cup_teaches_the_knowledge_kept_for_the_next_search(tmp_path):
-    forget_learnt()
+def test_a_found_cup_teaches_the_knowledge_the_next_search_reads_from_its_file(tmp_path):
     path = tmp_path / "learnt.yaml"
     before = {d.key: d.count for d in load_qsr().descriptions_for("cup")}
-    try:
-        summary = run_episode(_spec("qsr", options={"learn": True, "learn_file": str(path)}))
-        assert summary["outcome"] == "found" and summary["details"]["knowledge"] == "default"
-        learnt = load_qsr(path)  # written after the find, in the format load_qsr reads
-        after = {d.key: d.count for d in learnt.descriptions_for("cup")}
-        gained = {k: after[k] - before.get(k, 0.0) for k in after if after[k] != before.get(k)}
-        assert gained and all(v == 1.0 for v in gained.values())
-        # the next search in this process without a file uses what was learnt
-        short = {"survey_stops": 0, "abort_s": 1.0}
-        again = run_episode(_spec("qsr", options={"learn": True, **short}))
-        assert again["details"]["knowledge"] == "learnt in this process"
-        # ... unless learning is off (independent trials, as in bench/qsr_experiment.py)
-        off = run_episode(_spec("qsr", options={"learn": False, **short}))
-        assert off["details"]["knowledge"] == "default"
-    finally:
-        forget_learnt()
+    summary = run_episode(_spec("qsr", options={"learn": True, "learn_file": str(path)}))
+    assert summary["outcome"] == "found" and summary["details"]["knowledge"] == "default"
+    learnt = load_qsr(path)  # written after the find, in the format load_qsr reads
+    after = {d.key: d.count for d in learnt.descriptions_for("cup")}
+    gained = {k: after[k] - before.get(k, 0.0) for k in after if after[k] != before.get(k)}
+    assert gained and all(v == 1.0 for v in gained.values())
+    short = {"survey_stops": 0, "abort_s": 1.0}
+    # the next search that names the file starts from what was learnt
+    again = run_episode(_spec("qsr", options={"learn": True, "learn_file": str(path), **short}))
+    assert again["details"]["knowledge"] == str(path)
+    # one that names none starts from the default knowledge: nothing is kept in the process
+    # (a service worker or a campaign process runs many episodes in any order)
+    fresh = run_episode(_spec("qsr", options={"learn": True, **short}))
+    assert fresh["details"]["knowledge"] == "default"
 
 
 def test_task_descriptions_are_validated_with_clear_errors():
