@@ -118,20 +118,31 @@ def test_every_frame_asks_for_the_landmarks_and_the_skill_gets_its_own_labels(co
     asked: list[list[str]] = []
     heard: list[list[str]] = []
 
+    views: list[FrameView] = []
+
     class Camera:
-        pose = (0.0, 0.0, 0.0)
+        pose = (1.0, 2.0, 0.5)
 
         def detect(self, labels):  # noqa: ANN001, ANN202
             asked.append(list(labels))
             return [Seen("toilet", (1.0, 0.0, 0.4)), Seen("cerealbox", (1.0, 0.5, 0.9))]
 
+        def look(self, pan: float, tilt: float) -> None:
+            pass
+
     ctx.robot = Camera()  # type: ignore[assignment]
-    ctx.listeners.append(Listener(("toilet",), lambda seen, where: heard.append(
-        [s.label for s in seen])))
+
+    def hear(seen, view: FrameView) -> None:  # noqa: ANN001
+        heard.append([s.label for s in seen])
+        views.append(view)
+
+    ctx.listeners.append(Listener(("toilet",), hear))
     clock_frames = len(asked)
+    ctx.look(0.3, -0.2)  # the skills point the head here: listeners learn where it looked
     seen = ctx.detect(["cerealbox"])
     assert [s.label for s in seen] == ["cerealbox"]
     assert asked[clock_frames:] == [["cerealbox", "toilet"]] and heard == [["toilet"]]
+    assert views == [FrameView((1.0, 2.0, 0.5), 0.3, -0.2)]
 
 
 @pytest.mark.parametrize("on", [True, False])
