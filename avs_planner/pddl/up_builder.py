@@ -17,6 +17,10 @@ predicates, ...) raises `Unsupported`, and the caller reads the text with UP ins
 equivalence is tested on every file the project reads
 (`tests/avs_planner/pddl/test_pddl_fast_reader.py`).
 
+`build_lite` builds the same problem in the project's own model (`lite`), which offers the
+model calls the builder makes, without importing UP: `avs plan` grounds that one. What
+`lite` does not mirror raises there too, and the reader then builds UP's.
+
 The work is split in three modules: `up_text` tokenizes the text and takes its sections
 apart (and defines `Unsupported`), `up_expressions` turns s-expressions into UP expressions
 and effects, and this module declares types, fluents, objects and actions and assembles the
@@ -26,26 +30,10 @@ and effects, and this module declares types, fluents, objects and actions and as
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from types import SimpleNamespace
+from typing import TYPE_CHECKING, Any
 
-from unified_planning.environment import Environment, get_environment
-from unified_planning.model import (
-    Fluent,
-    FNode,
-    InstantaneousAction,
-    Object,
-    Parameter,
-    Problem,
-    Type,
-)
-from unified_planning.model.effect import EffectKind
-from unified_planning.model.metrics import (
-    MaximizeExpressionOnFinalState,
-    MinimizeActionCosts,
-    MinimizeExpressionOnFinalState,
-    MinimizeMakespan,
-)
-
+from avs_planner.pddl import lite
 from avs_planner.pddl.up_expressions import Effect, ExpressionTranslator
 from avs_planner.pddl.up_text import (
     OBJECT,
@@ -65,17 +53,67 @@ from avs_planner.pddl.up_text import (
     typed_groups,
 )
 
-__all__ = ["Unsupported", "build_problem", "tokenize"]
+if TYPE_CHECKING:
+    from unified_planning.environment import Environment
+    from unified_planning.model import (
+        Fluent,
+        FNode,
+        InstantaneousAction,
+        Object,
+        Parameter,
+        Problem,
+        Type,
+    )
+
+__all__ = ["Unsupported", "build_lite", "build_problem", "tokenize"]
 
 
 def build_problem(domain_text: str, problem_text: str,
                   environment: Environment | None = None) -> Problem:
     """The `Problem` UP's `PDDLReader().parse_problem_string(domain_text, problem_text)`
     builds, or `Unsupported` (or any error UP's model raises) for text left to UP."""
+    from unified_planning.environment import get_environment
+
     for text in (domain_text, problem_text):
         check_number_types(text)
-    return _Builder(get_environment(environment)).build(tokenize(domain_text),
-                                                        tokenize(problem_text))
+    return _Builder(get_environment(environment), _up_kit()).build(tokenize(domain_text),
+                                                                   tokenize(problem_text))
+
+
+def build_lite(domain_text: str, problem_text: str, names_shared: bool = False
+               ) -> lite.Problem:
+    """The same problem in the project's own model (`lite`), without importing UP; raises
+    `Unsupported` or `lite.ModelError` (or another error) for text it leaves to UP. With
+    `names_shared`, a type, predicate and action may share a name (UP's `error_used_name`
+    lifted, as the reader lifts it)."""
+    for text in (domain_text, problem_text):
+        check_number_types(text)
+    builder = _Builder(lite.environment(names_shared), lite)  # type: ignore[arg-type]
+    return builder.build(tokenize(domain_text), tokenize(problem_text))  # type: ignore[return-value]
+
+
+def _up_kit() -> SimpleNamespace:
+    """UP's model classes the builder uses (`lite` offers the same names)."""
+    from unified_planning.model import (
+        Fluent,
+        InstantaneousAction,
+        Object,
+        Problem,
+        Variable,
+    )
+    from unified_planning.model.effect import EffectKind
+    from unified_planning.model.metrics import (
+        MaximizeExpressionOnFinalState,
+        MinimizeActionCosts,
+        MinimizeExpressionOnFinalState,
+        MinimizeMakespan,
+    )
+    return SimpleNamespace(
+        Problem=Problem, Fluent=Fluent, Object=Object, Variable=Variable,
+        InstantaneousAction=InstantaneousAction, EffectKind=EffectKind,
+        MinimizeActionCosts=MinimizeActionCosts, MinimizeMakespan=MinimizeMakespan,
+        MinimizeExpressionOnFinalState=MinimizeExpressionOnFinalState,
+        MaximizeExpressionOnFinalState=MaximizeExpressionOnFinalState)
 
 
 @dataclass
@@ -100,8 +138,8 @@ class _Builder(ExpressionTranslator):
         problem_name, psections = define(problem_nodes, "problem")
         pparts = problem_parts(psections)
 
-        problem = Problem(domain_name, self.env,
-                          initial_defaults={self.tm.BoolType(): self.em.FALSE()})
+        problem = self.kit.Problem(domain_name, self.env,
+                                   initial_defaults={self.tm.BoolType(): self.em.FALSE()})
         predicates = [signature(p) for p in parts.get(":predicates", [])]
         functions = [signature(f) for f in function_declarations(parts.get(":functions"))]
         constants = typed_groups(parts.get(":constants", []), variables=False)
@@ -202,7 +240,7 @@ class _Builder(ExpressionTranslator):
     def _fluent(self, name: str, groups: TypedGroups, kind: Type) -> Fluent:
         if name in self.fluents:
             raise Unsupported(f"fluent {name} twice")
-        fluent = Fluent(name, kind, self._parameters(groups), self.env)
+        fluent = self.kit.Fluent(name, kind, self._parameters(groups), self.env)
         self.fluents[name] = fluent
         return fluent
 
@@ -213,7 +251,7 @@ class _Builder(ExpressionTranslator):
             for name in names:
                 if name in self.objects:
                     raise Unsupported(f"object {name} twice")
-                obj = self.objects[name] = Object(name, kind, self.env)
+                obj = self.objects[name] = self.kit.Object(name, kind, self.env)
                 made.append(obj)
         return made
 
@@ -221,7 +259,8 @@ class _Builder(ExpressionTranslator):
 
     def _action(self, node: list[Sexpr], groups: TypedGroups) -> _Action:
         _, precondition, effect = action_parts(node)
-        action = InstantaneousAction(str(node[1]), self._parameters(groups), self.env)
+        action = self.kit.InstantaneousAction(str(node[1]), self._parameters(groups),
+                                              self.env)
         built = _Action(action, {p.name: p for p in action.parameters})
         if precondition is not None:
             action.add_precondition(self._expression(precondition, built.parameters, {}))
@@ -234,9 +273,10 @@ class _Builder(ExpressionTranslator):
         """Add the effects through the model API; with action costs, the first effect on
         `total-cost` becomes the action's cost instead (as UP's reader does)."""
         action = built.action
-        add = {EffectKind.ASSIGN: action.add_effect,
-               EffectKind.INCREASE: action.add_increase_effect,
-               EffectKind.DECREASE: action.add_decrease_effect}
+        kinds = self.kit.EffectKind
+        add = {kinds.ASSIGN: action.add_effect,
+               kinds.INCREASE: action.add_increase_effect,
+               kinds.DECREASE: action.add_decrease_effect}
         for kind, fluent, value, condition, forall in built.effects:
             if costs_from is not None and fluent is costs_from and action not in costs:
                 costs[action] = value
@@ -291,7 +331,8 @@ class _Builder(ExpressionTranslator):
             for kind, fluent, value, condition, _ in built.effects:
                 if cost in free(value) or cost in free(condition):
                     return None
-                if fluent is cost and (kind != EffectKind.INCREASE or not condition.is_true()):
+                if fluent is cost and (kind != self.kit.EffectKind.INCREASE
+                                       or not condition.is_true()):
                     return None
         start = None
         for fluent_exp, value in init:
@@ -311,12 +352,13 @@ class _Builder(ExpressionTranslator):
 
     def _metric(self, metric: list[Sexpr], costs_from: FNode | None,
                 costs: dict[InstantaneousAction, FNode]) -> Any:
+        kit = self.kit
         if costs_from is not None:
-            return MinimizeActionCosts(costs, self.em.Int(0))
+            return kit.MinimizeActionCosts(costs, self.em.Int(0))
         direction, node = metric
         if direction == "minimize" and node == ["total-time"]:
-            return MinimizeMakespan()
+            return kit.MinimizeMakespan()
         expression = self._expression(node, None, {})
         if direction == "minimize":
-            return MinimizeExpressionOnFinalState(expression)
-        return MaximizeExpressionOnFinalState(expression)
+            return kit.MinimizeExpressionOnFinalState(expression)
+        return kit.MaximizeExpressionOnFinalState(expression)

@@ -1,7 +1,9 @@
 """Expressions and effects of the fast reading path, made with UP's expression manager.
 
-`up_builder` builds the `Problem` UP's `PDDLReader` would build. This module holds the part
-that turns s-expressions (from `up_text`) into UP's `FNode`s: the name tables of one read
+`up_builder` builds the `Problem` UP's `PDDLReader` would build (or the same problem in the
+project's own model, `lite`, which offers the same calls: `kit` names the model's classes).
+This module holds the part that turns s-expressions (from `up_text`) into the model's
+`FNode`s: the name tables of one read
 (types, fluents, objects, resolved through dicts where UP's reader scans lists), signatures
 and quantified variables, expressions resolved in the order UP's reader resolves them, and
 action effects listed in the order UP's reader adds them (breadth first). It is the base of
@@ -12,10 +14,7 @@ from __future__ import annotations
 
 from collections import OrderedDict, deque
 from fractions import Fraction
-
-from unified_planning.environment import Environment
-from unified_planning.model import Fluent, FNode, Object, Parameter, Type, Variable
-from unified_planning.model.effect import EffectKind
+from typing import TYPE_CHECKING, Any
 
 from avs_planner.pddl.up_text import (
     OBJECT,
@@ -26,16 +25,24 @@ from avs_planner.pddl.up_text import (
     typed_groups,
 )
 
+if TYPE_CHECKING:  # UP's model, or the project's own (`lite`), which mirrors it
+    from unified_planning.environment import Environment
+    from unified_planning.model import Fluent, FNode, Object, Parameter, Type, Variable
+    from unified_planning.model.effect import EffectKind
+
 # (kind, fluent, value, condition, forall variables) of one effect, before it is added
-Effect = tuple[EffectKind, FNode, FNode, FNode, tuple[Variable, ...]]
+Effect = tuple["EffectKind", "FNode", "FNode", "FNode", tuple["Variable", ...]]
 
 
 class ExpressionTranslator:
     """The names of one read and the expressions over them. Names resolve through dicts
-    (UP's reader scans the problem's lists)."""
+    (UP's reader scans the problem's lists). `kit` holds the model's classes (`Problem`,
+    `Fluent`, `Object`, `Variable`, `InstantaneousAction`, `EffectKind` and the metrics):
+    UP's, or `lite`'s, whose calls are the same."""
 
-    def __init__(self, environment: Environment):
+    def __init__(self, environment: Environment, kit: Any):
         self.env = environment
+        self.kit = kit
         self.em = environment.expression_manager
         self.tm = environment.type_manager
         em = self.em
@@ -70,7 +77,7 @@ class ExpressionTranslator:
     def _variables(self, node: Sexpr) -> dict[str, Variable]:
         if not isinstance(node, list):
             raise Unsupported("quantifier without a variable list")
-        return {name: Variable(name, kind, self.env)
+        return {name: self.kit.Variable(name, kind, self.env)
                 for name, kind in self._parameters(typed_groups(node, variables=True)).items()}
 
     # ---- expressions ------------------------------------------------------------------
@@ -138,6 +145,7 @@ class ExpressionTranslator:
         UP); a `when` whose condition simplifies to false is dropped."""
         em = self.em
         true = em.TRUE()
+        kinds = self.kit.EffectKind
         effects: list[Effect] = []
         queue: deque[tuple[Sexpr, FNode, dict[str, Variable]]] = deque([(effect, true, {})])
         while queue:
@@ -160,12 +168,12 @@ class ExpressionTranslator:
                 if n != 2:
                     raise Unsupported("odd not")
                 fluent = self._expression(node[1], params, variables)
-                effects.append((EffectKind.ASSIGN, fluent, em.FALSE(), condition, forall))
+                effects.append((kinds.ASSIGN, fluent, em.FALSE(), condition, forall))
             elif head in ("assign", "increase", "decrease"):
                 if n != 3:
                     raise Unsupported(f"odd {head}")
-                kind = {"assign": EffectKind.ASSIGN, "increase": EffectKind.INCREASE,
-                        "decrease": EffectKind.DECREASE}[str(head)]
+                kind = {"assign": kinds.ASSIGN, "increase": kinds.INCREASE,
+                        "decrease": kinds.DECREASE}[str(head)]
                 effects.append((kind, self._expression(node[1], params, variables),
                                 self._expression(node[2], params, variables),
                                 condition, forall))
@@ -176,7 +184,7 @@ class ExpressionTranslator:
                     raise Unsupported("odd forall")
                 queue.append((node[2], condition, self._variables(node[1])))
             elif isinstance(head, str):
-                effects.append((EffectKind.ASSIGN, self._expression(node, params, variables),
+                effects.append((kinds.ASSIGN, self._expression(node, params, variables),
                                 true, condition, forall))
             else:
                 raise Unsupported("a list as effect head")

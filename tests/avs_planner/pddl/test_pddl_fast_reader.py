@@ -5,9 +5,10 @@ test, the AVS domain with its problems and generated ones, the PDDL files and ca
 `tests/`) the text `read_text` hands to UP is built both ways and compared: a canonical dump
 (types with parents, objects, fluents with defaults, actions' parameters, preconditions and
 effects in order, explicit initial values, goals, metrics; all as UP prints them) and UP's
-own `Problem.__eq__`. For the IPC instance-1 set both Problems are also ground. Exact string
-equality holds everywhere, no normalisation is needed (both sides build their expressions
-in one environment, so the very same nodes).
+own `Problem.__eq__`; the same builder filling the project's own model (`lite`) prints the
+same too. For the IPC instance-1 set both Problems are also ground. Exact string equality
+holds everywhere, no normalisation is needed (both sides build their expressions in one
+environment, so the very same nodes).
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from avs_planner.pddl.model import ProbabilisticProblem
 from avs_planner.pddl.probabilistic import translate_domain
 from avs_planner.pddl.reader import _names_shared, apply_repairs
 from avs_planner.pddl.sexpr import parse_sexprs
-from avs_planner.pddl.up_builder import Unsupported, build_problem
+from avs_planner.pddl.up_builder import Unsupported, build_lite, build_problem
 from bench.avs_generator import AvsSize, generate
 from tests.avs_planner.cp.pddl_cases import lamps
 from tests.ipc import domain_for, instances, ipc_folders, require_ipc
@@ -78,8 +79,12 @@ def both(domain: str, problem: str) -> tuple[Problem, Problem]:
 
 
 def assert_same(domain: str, problem: str) -> tuple[Problem, Problem]:
+    """The builder's Problem is UP's reader's; so is the builder's `lite` model, printed."""
     fast, reference = both(domain, problem)
-    assert canonical(fast) == canonical(reference)
+    expected = canonical(reference)  # before `==`: UP's Problem.__eq__ fills in defaults
+    assert canonical(fast) == expected
+    up_domain, up_problem, shared = up_texts(domain, problem)
+    assert canonical(build_lite(up_domain, up_problem, shared)) == expected
     assert fast == reference
     return fast, reference
 
