@@ -11,9 +11,9 @@ arrays in the layout of `fact_rows.py`, so the rest of the build treats every ro
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
-from unified_planning.model import FNode
 
 from avs_planner.cp.conditional import Variant, expand_rows, variants
 from avs_planner.cp.encoding import AtomSpace, Columns
@@ -23,6 +23,9 @@ from avs_planner.cp.schema import LiftedSchema
 from avs_planner.cp.task import Atom
 from avs_planner.cp.unsupported import UnsupportedError, in_action
 from avs_planner.errors import PlanningError
+
+if TYPE_CHECKING:  # UP's model, or the project's own (`pddl.lite`): the same methods
+    from unified_planning.model import FNode
 
 
 def _read_params(nodes: Sequence[FNode]) -> frozenset[str]:

@@ -15,11 +15,14 @@ from __future__ import annotations
 import itertools
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from unified_planning.model import Effect, FNode, Type
 
 from avs_planner.errors import PlanningError
+
+if TYPE_CHECKING:  # UP's model, or the project's own (`pddl.lite`): the same methods
+    from unified_planning.model import Effect, FNode, Type
 
 AtomTemplate = tuple[str, ...]
 Literal = tuple[int, bool]  # (atom code, positive)

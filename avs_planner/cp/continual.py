@@ -66,7 +66,7 @@ class ContinualPlanner:
         self.min_success = min_success
         self.threshold = probability_threshold
         self.cache = cache or GroundingCache()
-        self.state = world_state(pproblem.problem)
+        self.state = world_state(pproblem.model)
         self.plan: tuple[PlanStep, ...] = ()
         self.results: list[PlanResult] = []
 

@@ -14,12 +14,15 @@ import math
 import operator
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from fractions import Fraction
+from typing import TYPE_CHECKING
 
 import numpy as np
-from unified_planning.model import FNode, Problem, Type
 
 from avs_planner.cp.task import Atom
 from avs_planner.errors import PlanningError
+
+if TYPE_CHECKING:  # UP's model, or the project's own (`pddl.lite`): the same methods
+    from unified_planning.model import FNode, Problem, Type
 
 Columns = Mapping[str, np.ndarray]  # parameter ("?x") -> object ids, one per binding
 MAX_CODE = 2**62
@@ -353,7 +356,7 @@ class _ArithExpr:
 
 
 def compile_vector(node: FNode | None, where: str, default: float) -> VectorExpr:
-    """A numeric UP expression (constants, fluent terms, + - * /) over arrays of bindings."""
+    """A numeric expression (constants, fluent terms, + - * /) over arrays of bindings."""
     if node is None:
         return ConstantExpr(default)
     if node.is_constant():

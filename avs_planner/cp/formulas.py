@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Iterable, Mapping
-
-from unified_planning.model import FNode, OperatorKind, Type
+from typing import TYPE_CHECKING
 
 from avs_planner.cp.task import Atom
 from avs_planner.errors import PlanningError
+
+if TYPE_CHECKING:  # nodes of UP's model or of the project's own (`pddl.lite`): same methods
+    from unified_planning.model import FNode, Type
 
 Literal = tuple[Atom, bool]
 Clause = frozenset[Literal]
@@ -21,14 +23,14 @@ Cnf = list[Clause]
 TRUE: Cnf = []
 FALSE: Cnf = [frozenset()]
 MAX_CLAUSES = 4096
-_FLUENT, _AND, _OR, _NOT = (OperatorKind.FLUENT_EXP, OperatorKind.AND, OperatorKind.OR,
-                            OperatorKind.NOT)
-_IMPLIES, _FORALL, _EXISTS = OperatorKind.IMPLIES, OperatorKind.FORALL, OperatorKind.EXISTS
-_BOOL, _EQUALS = OperatorKind.BOOL_CONSTANT, OperatorKind.EQUALS
-_PARAM, _VARIABLE, _OBJECT = (OperatorKind.PARAM_EXP, OperatorKind.VARIABLE_EXP,
-                              OperatorKind.OBJECT_EXP)
+# node kinds by the name of their `node_type` (UP's `OperatorKind`, or `lite`'s of the
+# same names)
+_FLUENT, _AND, _OR, _NOT = "FLUENT_EXP", "AND", "OR", "NOT"
+_IMPLIES, _FORALL, _EXISTS = "IMPLIES", "FORALL", "EXISTS"
+_BOOL, _EQUALS = "BOOL_CONSTANT", "EQUALS"
+_PARAM, _VARIABLE, _OBJECT = "PARAM_EXP", "VARIABLE_EXP", "OBJECT_EXP"
 _TERMS = (_PARAM, _VARIABLE, _OBJECT)
-_COMPARISONS = (OperatorKind.LT, OperatorKind.LE)  # UP reads > and >= as < and <= swapped
+_COMPARISONS = ("LT", "LE")  # UP reads > and >= as < and <= swapped
 
 
 def unsupported_condition(node: FNode, what: str) -> str:
@@ -41,7 +43,7 @@ class FormulaGrounder:
     """Grounds one formula under a binding of parameters/variables to object names.
 
     Each formula is compiled once into nested closures (its node kinds, fluent names,
-    argument keys and quantifier domains read from UP's nodes up front), which are then
+    argument keys and quantifier domains read from the nodes up front), which are then
     called per binding: reading the nodes again for each binding cost more than the
     grounding itself on quantified conditions."""
 
@@ -59,34 +61,34 @@ class FormulaGrounder:
         return hit[1](binding, positive)
 
     def _compile(self, node: FNode) -> _Grounding:
-        kind = node.node_type
-        if kind is _FLUENT:
+        kind = node.node_type.name
+        if kind == _FLUENT:
             return self._fluent(node)
-        if kind is _AND or kind is _OR:
+        if kind == _AND or kind == _OR:
             parts = [self._compile(a) for a in node.args]
-            conjunction = kind is _AND
+            conjunction = kind == _AND
 
             def junction(binding, positive):
                 cnfs = [p(binding, positive) for p in parts]
                 return _and(cnfs) if conjunction == positive else _or(cnfs)
             return junction
-        if kind is _NOT:
+        if kind == _NOT:
             inner = self._compile(node.arg(0))
             return lambda binding, positive: inner(binding, not positive)
-        if kind is _IMPLIES:
+        if kind == _IMPLIES:
             left, right = self._compile(node.arg(0)), self._compile(node.arg(1))
 
             def implies(binding, positive):
                 cnfs = [left(binding, not positive), right(binding, positive)]
                 return _or(cnfs) if positive else _and(cnfs)
             return implies
-        if kind is _FORALL or kind is _EXISTS:
+        if kind == _FORALL or kind == _EXISTS:
             return self._quantifier(node)
-        if kind is _BOOL:
+        if kind == _BOOL:
             value = node.bool_constant_value()
             return lambda binding, positive: TRUE if value == positive else FALSE
-        if kind is _EQUALS:
-            if not all(a.node_type in _TERMS for a in node.args):
+        if kind == _EQUALS:
+            if not all(a.node_type.name in _TERMS for a in node.args):
                 raise PlanningError(unsupported_condition(node, "numeric equality"))
             left, right = _term(node.arg(0)), _term(node.arg(1))
 
@@ -94,7 +96,7 @@ class FormulaGrounder:
                 return TRUE if (_value(left, binding) == _value(right, binding)) == positive \
                     else FALSE
             return equals
-        what = "a numeric comparison" if kind in _COMPARISONS else kind.name.lower()
+        what = "a numeric comparison" if kind in _COMPARISONS else kind.lower()
         raise PlanningError(unsupported_condition(node, what))
 
     def _fluent(self, node: FNode) -> _Grounding:
@@ -134,12 +136,12 @@ _Term = tuple[str | None, str | None]  # (binding key, None) or (None, object na
 
 
 def _term(node: FNode) -> _Term:
-    kind = node.node_type
-    if kind is _PARAM:
+    kind = node.node_type.name
+    if kind == _PARAM:
         return "?" + node.parameter().name, None
-    if kind is _VARIABLE:
+    if kind == _VARIABLE:
         return "?v:" + node.variable().name, None
-    if kind is _OBJECT:
+    if kind == _OBJECT:
         return None, node.object().name
     raise PlanningError(f"unsupported argument {node}")
 

@@ -18,16 +18,16 @@ from collections import OrderedDict
 from collections.abc import Iterator
 from contextlib import contextmanager
 from fractions import Fraction
+from typing import TYPE_CHECKING
 
 import numpy as np
-from unified_planning.model import FNode, InstantaneousAction, Problem
 
 from avs_planner.cp.action_table import ActionTable
 from avs_planner.cp.compact import compact
 from avs_planner.cp.derived import derived, ids_of, reachable, relevant, task_rows
 from avs_planner.cp.encoding import ConstantExpr, NumericValues
 from avs_planner.cp.formulas import FALSE, FormulaGrounder
-from avs_planner.cp.schema import LiftedSchema, compile_schemas
+from avs_planner.cp.schema import LiftedSchema, compile_schemas, is_instantaneous
 from avs_planner.cp.settled import SettledAtoms, settled_atoms
 from avs_planner.cp.structure import GroundStructure, bitset, build_structure
 from avs_planner.cp.task import Atom, GroundTask, TaskArrays, WorldState
@@ -35,6 +35,9 @@ from avs_planner.cp.unsupported import UnsupportedError
 from avs_planner.errors import PlanningError, SourcePosition
 from avs_planner.pddl.diagnostics import Diagnostic, Severity
 from avs_planner.pddl.model import ProbabilisticProblem
+
+if TYPE_CHECKING:  # or the project's own model (`pddl.lite`), read through the same methods
+    from unified_planning.model import FNode, Problem
 
 
 def world_state(problem: Problem) -> WorldState:
@@ -82,7 +85,7 @@ def static_fluent_names(problem: Problem) -> frozenset[str]:
     expression UP also makes (for its unused fluents), which cost ~1 ms per cold call."""
     changed = set()
     for action in problem.actions:
-        if not isinstance(action, InstantaneousAction) or action.simulated_effect is not None:
+        if not is_instantaneous(action) or action.simulated_effect is not None:
             return frozenset(f.name for f in problem.get_static_fluents())
         changed.update(e.fluent.fluent().name for e in action.effects)
     if problem.events or problem.processes or problem.timed_effects:
@@ -270,7 +273,7 @@ class GroundingCache:
         known = self._problem_keys.get(id(pproblem))
         if known is not None and known[0] is pproblem:
             return known[1], known[2]
-        problem = pproblem.problem
+        problem = pproblem.model
         static_names = static_fluent_names(problem)
         key = _HashOnce((
             tuple(problem.actions),
@@ -290,14 +293,14 @@ class GroundingCache:
         hit = self._initial.get(id(pproblem))
         if hit is not None and hit[0] is pproblem:
             return hit[1]
-        state = world_state(pproblem.problem)
+        state = world_state(pproblem.model)
         self._initial[id(pproblem)] = (pproblem, state)  # a strong ref keeps the id unique
         while len(self._initial) > self.size:
             self._initial.popitem(last=False)
         return state
 
     def structure(self, pproblem: ProbabilisticProblem, state: WorldState) -> GroundStructure:
-        problem = pproblem.problem
+        problem = pproblem.model
         schema_key, static_names = self._keys(pproblem)
         schemas = self.schemas(pproblem)
         objects = self._problem_keys[id(pproblem)][3]
@@ -318,7 +321,7 @@ class GroundingCache:
         hit = self._settled_atoms.get(id(pproblem))
         if hit is not None and hit[0] is pproblem and hit[1] is schemas:
             return hit[2]
-        settled = settled_atoms(pproblem.problem, schemas, static_names)
+        settled = settled_atoms(pproblem.model, schemas, static_names)
         self._settled_atoms[id(pproblem)] = (pproblem, schemas, settled)  # a strong ref
         while len(self._settled_atoms) > self.size:
             self._settled_atoms.popitem(last=False)
@@ -396,7 +399,7 @@ def _ground(
     n = len(st.facts)
     init_ids = [i for i in map(st.fact_index.get, state.true_atoms) if i is not None]
     init = bitset(init_ids)
-    goal, goal_neg, impossible = _goal(pproblem.problem, st, state.true_atoms)
+    goal, goal_neg, impossible = _goal(pproblem.model, st, state.true_atoms)
     reached = np.zeros(n + 2, dtype=bool)
     reached[init_ids] = True
     reached[n] = True  # the padding of preconditions

@@ -1,4 +1,5 @@
-"""Lifted action schemas compiled from a UP problem into plain tuples the grounder joins over.
+"""Lifted action schemas compiled from a problem (UP's model or the project's own, `pddl.lite`,
+read through the methods both have) into plain tuples the grounder joins over.
 
 Terms are strings: a parameter is `?name`, anything else is an object name. Numeric
 expressions (action costs, success probabilities) become `encoding.VectorExpr`s, evaluated
@@ -8,15 +9,7 @@ for many bindings at once from the numeric values of the state.
 from __future__ import annotations
 
 from dataclasses import dataclass
-
-from unified_planning.model import (
-    Action,
-    FNode,
-    InstantaneousAction,
-    MinimizeActionCosts,
-    Problem,
-    Type,
-)
+from typing import TYPE_CHECKING
 
 from avs_planner.cp.conditional import CondEffect, compile_effect
 from avs_planner.cp.encoding import VectorExpr, compile_vector
@@ -24,7 +17,11 @@ from avs_planner.cp.encoding import term as _term
 from avs_planner.cp.formulas import unsupported_condition
 from avs_planner.cp.unsupported import in_action
 from avs_planner.errors import PlanningError
+from avs_planner.pddl import lite
 from avs_planner.pddl.model import ProbabilisticProblem
+
+if TYPE_CHECKING:
+    from unified_planning.model import Action, FNode, InstantaneousAction, Problem, Type
 
 Term = str
 AtomTemplate = tuple[str, ...]  # (predicate, term, ...)
@@ -107,9 +104,19 @@ def _split_effects(action: InstantaneousAction) -> tuple[list, list, list]:
     return add, delete, conditional
 
 
+def is_instantaneous(action: Action | lite.InstantaneousAction) -> bool:
+    """Whether the action is instantaneous (`lite` has no other kind; a UP action means UP
+    is loaded already)."""
+    if isinstance(action, lite.InstantaneousAction):
+        return True
+    from unified_planning.model import InstantaneousAction
+
+    return isinstance(action, InstantaneousAction)
+
+
 def _cost_exprs(problem: Problem) -> tuple[dict[str, FNode], FNode | None]:
     for metric in problem.quality_metrics:
-        if isinstance(metric, MinimizeActionCosts):
+        if metric.is_minimize_action_costs():
             # `get_action_cost` hashes the action (a walk over all its conditions and
             # effects); the metric normally holds the problem's own action objects.
             own = {id(a): c for a, c in metric.costs.items()}
@@ -124,7 +131,7 @@ def compile_schemas(
 ) -> tuple[LiftedSchema, ...]:
     """Compile every action of the problem; raises PlanningError naming what is unsupported.
     `static_names`: the problem's static fluents, if the caller already knows them."""
-    problem = pproblem.problem
+    problem = pproblem.model
     static = (static_names if static_names is not None
               else {f.name for f in problem.get_static_fluents()})
     costs, _default = _cost_exprs(problem)  # default is 0 when a metric is given
@@ -141,7 +148,7 @@ def compile_schemas(
 def _compile(pproblem: ProbabilisticProblem, action: Action, static: set[str] | frozenset[str],
              costs: dict[str, FNode], has_metric: bool) -> LiftedSchema:
     """One action as a `LiftedSchema`; raises PlanningError on what is unsupported."""
-    if not isinstance(action, InstantaneousAction):
+    if not is_instantaneous(action):
         raise PlanningError(f"action {action.name}: only instantaneous actions are supported")
     parts = _split_preconditions(action, static)
     add, delete, conditional = _split_effects(action)

@@ -26,13 +26,16 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
-from unified_planning.model import Problem, Type
 
 from avs_planner.cp.encoding import AtomSpace, fluent_template, objects_by_type
 from avs_planner.cp.schema import AtomTemplate, LiftedSchema
 from avs_planner.cp.task import Atom, WorldState
+
+if TYPE_CHECKING:  # UP's model, or the project's own (`pddl.lite`): the same methods
+    from unified_planning.model import Problem, Type
 
 MAX_ADDABLE = 200_000  # a fluent whose addable atoms are more than this is left alone
 

@@ -16,9 +16,9 @@ layouts and bitsets are `fact_rows.py`. Their public names are re-exported here.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
-from unified_planning.model import Problem
 
 from avs_planner.cp.bindings import (
     DENSE_CODES,
@@ -36,6 +36,9 @@ from avs_planner.cp.schema import LiftedSchema
 from avs_planner.cp.settled import NO_KEY, NOTHING_SETTLED, Key, SettledAtoms
 from avs_planner.cp.task import Atom
 from avs_planner.errors import PlanningError
+
+if TYPE_CHECKING:  # UP's model, or the project's own (`pddl.lite`): the same methods
+    from unified_planning.model import Problem
 
 try:  # the compiled join, encoding and numbering; the numpy code computes the same
     from avs_planner.cp import _ground

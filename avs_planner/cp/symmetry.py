@@ -12,12 +12,15 @@ from __future__ import annotations
 from collections import OrderedDict, defaultdict
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-from unified_planning.model import FNode, Problem
 
 from avs_planner.cp.task import Atom, GroundTask, WorldState
 from avs_planner.pddl.model import ProbabilisticProblem
+
+if TYPE_CHECKING:  # UP's model, or the project's own (`pddl.lite`): the same methods
+    from unified_planning.model import FNode, Problem
 
 Pair = tuple[str, str]
 
@@ -44,7 +47,7 @@ def _named_objects(pproblem: ProbabilisticProblem) -> frozenset[str]:
 
 
 def _walk_named(pproblem: ProbabilisticProblem) -> set[str]:
-    problem = pproblem.problem
+    problem = pproblem.model
     roots: list[FNode] = list(problem.goals) + list(pproblem.success.values())
     for action in problem.actions:
         roots.extend(action.preconditions)
@@ -119,7 +122,7 @@ def find_symmetries(
     pproblem: ProbabilisticProblem, state: WorldState, task: GroundTask
 ) -> Symmetries:
     """Interchangeable object groups of this task in this state (none if nothing is)."""
-    problem: Problem = pproblem.problem
+    problem: Problem = pproblem.model
     named = _named_objects(pproblem)
     by_type: dict[str, list[str]] = defaultdict(list)
     for obj in problem.all_objects:

@@ -68,7 +68,7 @@ def build_problem(
     problem.add_goal(term(goal))
     for metric in up.quality_metrics:
         problem.add_quality_metric(metric)
-    return ProbabilisticProblem(problem, base.success, str(DOMAIN_FILE), f"<{name}>")
+    return ProbabilisticProblem(problem, base.up_success, str(DOMAIN_FILE), f"<{name}>")
 
 
 _SKELETONS: dict[tuple, ProbabilisticProblem] = {}

@@ -1,10 +1,20 @@
-"""The probabilistic planning task: a unified-planning `Problem` plus success probabilities.
+"""The probabilistic planning task: a planning model plus success probabilities.
 
 This is the contract between the PDDL reader (which builds it) and the planners (which ground
-and search it). An action `a` with effect `(probabilistic P E)` becomes, in `problem`, an action
-whose effect is `E` (what happens when it succeeds), and `success[a.name]` holds `P` as a UP
-real-valued expression over `a`'s parameters (a constant, or static numeric fluents whose
-values the problem's `:init` gives). Actions with no entry succeed with probability 1.
+and search it). An action `a` with effect `(probabilistic P E)` becomes, in `model`, an action
+whose effect is `E` (what happens when it succeeds), and `success[a.name]` holds `P` as a
+real-valued expression of the model over `a`'s parameters (a constant, or static numeric
+fluents whose values the problem's `:init` gives). Actions with no entry succeed with
+probability 1.
+
+The model is a unified-planning (UP) `Problem`, or, as the reader builds it where it can, the
+project's own `lite.Problem`, which offers the part of UP's model API the planner reads (the
+same names and methods: `actions`, `fluents`, `all_objects`, `explicit_initial_values`,
+`goals`, `quality_metrics`; nodes with `is_and()`, `args`, `fluent()`, ...; effects with
+`fluent`, `value`, `condition`, `forall`), without importing UP. `success` holds nodes of the
+model's kind. Whoever needs UP objects (UP's engines and plan validators, the episode's
+problem builder) asks for `problem` and `up_success`: the model itself if it is UP's, else
+UP's problem of the same text, built once when first asked.
 """
 
 from __future__ import annotations
@@ -12,11 +22,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from fractions import Fraction
-
-from unified_planning.model import FNode, Problem
+from typing import TYPE_CHECKING, Any
 
 from avs_planner.errors import SourcePosition
+from avs_planner.pddl import lite
 from avs_planner.pddl.diagnostics import Diagnostic
+
+if TYPE_CHECKING:
+    from unified_planning.model import FNode, Problem
 
 ASSUMPTIVE_PREFIX = "assume-"
 
@@ -43,10 +56,10 @@ class SourceMap:
 
 @dataclass(frozen=True)
 class ProbabilisticProblem:
-    """A UP problem whose actions succeed with probability `success[name]` (default 1)."""
+    """A problem whose actions succeed with probability `success[name]` (default 1)."""
 
-    problem: Problem
-    success: Mapping[str, FNode] = field(default_factory=dict)
+    model: Problem | lite.Problem  # what the planner grounds; see the module's docstring
+    success: Mapping[str, Any] = field(default_factory=dict)  # nodes of the model's kind
     domain_file: str = "<domain>"
     problem_file: str = "<problem>"
     # What the reader accepted or repaired (undeclared requirements, shared names, ...)
@@ -55,6 +68,21 @@ class ProbabilisticProblem:
     # What the reader's checks found that the planner cannot ground (the reader still reads
     # it, as unified-planning does); the planner refuses the first, at its position
     not_grounded: tuple[Diagnostic, ...] = ()
+
+    @property
+    def problem(self) -> Problem:
+        """The UP problem: the model, or UP's problem of the text the model was read from
+        (built when first asked; this imports UP)."""
+        if lite.is_lite(self.model):
+            return self.model.to_up()[0]  # type: ignore[union-attr]
+        return self.model  # type: ignore[return-value]
+
+    @property
+    def up_success(self) -> Mapping[str, FNode]:
+        """`success` as UP expressions of `problem`."""
+        if lite.is_lite(self.model):
+            return self.model.to_up()[1]  # type: ignore[union-attr]
+        return self.success
 
     def is_assumptive(self, action_name: str) -> bool:
         """Assumptive actions only set beliefs; the executor does not run them, it watches them."""
