@@ -4,8 +4,9 @@ our whole reading against Fast Downward's translator.
 Run: `.venv/bin/python -m bench.reading_bench [--quick]`. Per IPC instance 1 (plus the pair
 with the largest domain, trucks' 365 KB `domain-5`) and per generated AVS problem of 40, 80,
 160 and 320 places it times, median of 3, on the text `read_text` hands to UP (translated,
-repaired): UP's `PDDLReader` and the builder, side by side; then the whole `read_text`
-(our checks, pre-pass and the Problem) with the fast path and with UP's reader only.
+repaired): UP's `PDDLReader` and the builder, side by side, and the same builder filling
+the project's own model (`lite`, what `read_text` returns where it can); then the whole
+`read_text` (our checks, pre-pass and the model) as it reads now and with UP's reader only.
 
 Then, in the same run, Fast Downward's translator on the same domain and problem files (an
 AVS problem written to a scratch file first): the very command FD's driver runs for
@@ -46,7 +47,7 @@ from avs_planner.pddl.check import NAME_CLASH, PddlSource, check_read
 from avs_planner.pddl.probabilistic import translate_domain
 from avs_planner.pddl.reader import _names_shared, apply_repairs
 from avs_planner.pddl.sexpr import parse_sexprs
-from avs_planner.pddl.up_builder import build_problem
+from avs_planner.pddl.up_builder import build_lite, build_problem
 from bench.avs_generator import AvsSize, generate
 from bench.pddl_bench import best_of
 
@@ -81,13 +82,14 @@ def cases(quick: bool) -> list[tuple[str, str, str]]:
 
 @contextmanager
 def ups_reader_only() -> Iterator[None]:
-    """`read_text` as before the fast path: UP's reader builds every Problem."""
-    fast = reader_module._fast_build
+    """`read_text` as before the fast paths: UP's reader builds every Problem."""
+    fast, lite = reader_module._fast_build, reader_module._lite_read
     reader_module._fast_build = lambda domain, problem: None
+    reader_module._lite_read = lambda *args: None
     try:
         yield
     finally:
-        reader_module._fast_build = fast
+        reader_module._fast_build, reader_module._lite_read = fast, lite
 
 
 def up_text(domain: str, problem: str) -> tuple[str, bool]:
@@ -99,16 +101,19 @@ def up_text(domain: str, problem: str) -> tuple[str, bool]:
             any(d.code == NAME_CLASH for d in checked.lenient))
 
 
-def measure(domain: str, problem: str, repeats: int) -> tuple[float, float, float, float]:
-    """Seconds for UP's reader, the builder, read_text with UP's reader, read_text."""
+def measure(domain: str, problem: str, repeats: int
+            ) -> tuple[float, float, float, float, float]:
+    """Seconds for UP's reader, the builder, the builder on `lite`, read_text with UP's
+    reader, read_text."""
     text, shared = up_text(domain, problem)
     with _names_shared(shared):
         up = best_of(repeats, lambda: PDDLReader().parse_problem_string(text, problem))
         built = best_of(repeats, lambda: build_problem(text, problem))
+    lite = best_of(repeats, lambda: build_lite(text, problem, shared))
     with ups_reader_only():
         read_up = best_of(repeats, lambda: read_text(domain, problem))
     read_fast = best_of(repeats, lambda: read_text(domain, problem))
-    return up, built, read_up, read_fast
+    return up, built, lite, read_up, read_fast
 
 
 @dataclass(frozen=True)
@@ -170,15 +175,17 @@ def main() -> None:
           "text; whole read_text with each; Fast Downward's translator on the same files")
     if fd_missing:
         print(f"NO FAST DOWNWARD: {fd_missing}; its columns are left empty")
-    print(f"{'pair':22s} {'KB':>6s} {'UP':>8s} {'builder':>8s} {'UP/bld':>7s}   "
+    print(f"{'pair':22s} {'KB':>6s} {'UP':>8s} {'builder':>8s} {'UP/bld':>7s} "
+          f"{'lite':>7s} {'bld/lite':>8s}   "
           f"{'read(UP)':>9s} {'read':>7s} {'ratio':>6s}   "
           f"{'FD':>7s} {'FD own':>7s} {'FD prs':>7s} {'read/FD':>8s}")  # fmt: skip
     ipc_ratios: list[float] = []
     own_ratios: list[float] = []
     for label, domain, problem in all_cases:
-        up, built, read_up, read_fast = measure(domain, problem, repeats)
+        up, built, lite, read_up, read_fast = measure(domain, problem, repeats)
         size = (len(domain) + len(problem)) / 1024
-        row = (f"{label:22s} {size:6.0f} {up:8.3f} {built:8.3f} {up / built:6.0f}x   "
+        row = (f"{label:22s} {size:6.0f} {up:8.3f} {built:8.3f} {up / built:6.0f}x "
+               f"{lite:7.3f} {built / lite:7.1f}x   "
                f"{read_up:9.3f} {read_fast:7.3f} {read_up / read_fast:5.1f}x   ")
         if fd_missing:
             row += f"{'-':>7s} {'-':>7s} {'-':>7s} {'-':>8s}"

@@ -1,31 +1,35 @@
 """Read a probabilistic PDDL domain + problem into a `ProbabilisticProblem`.
 
 Order: our own checks first (they know positions), then the probabilistic pre-pass, then
-unified-planning's PDDLReader on the translated text; whatever UP still rejects becomes a
-`PddlError` with the position UP or pyparsing reported.
+the model of the translated text. That is the project's own (`lite`, built by
+`up_builder.build_lite`, without importing unified-planning) where it takes the text, with
+the UP problem of the same text built when someone asks for it (`ProbabilisticProblem.problem`);
+else UP's (`_up_parse`: the fast builder, else UP's PDDLReader), and whatever UP still rejects
+becomes a `PddlError` with the position UP or pyparsing reported.
 """
 
 from __future__ import annotations
 
 import re
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from fractions import Fraction
+from functools import partial
 from pathlib import Path
-
-import pyparsing
-from unified_planning.environment import get_environment
-from unified_planning.io import PDDLReader
-from unified_planning.model import Action, FNode, Problem
+from typing import TYPE_CHECKING, Any
 
 from avs_planner.errors import PddlError, SourcePosition
+from avs_planner.pddl import lite
 from avs_planner.pddl.check import NAME_CLASH, PddlSource, check_read
 from avs_planner.pddl.model import ProbabilisticProblem, SourceMap
 from avs_planner.pddl.probabilistic import translate_domain
 from avs_planner.pddl.sexpr import Atom, Node, SList, is_number, parse_sexprs
 from avs_planner.pddl.structure import Domain, Report, find_define, read_problem
-from avs_planner.pddl.up_builder import build_problem
+from avs_planner.pddl.up_builder import build_lite, build_problem
+
+if TYPE_CHECKING:
+    from unified_planning.model import Action, FNode, Problem
 
 _UP_POSITION = re.compile(r"line:?\s*(\d+),\s*col:?\s*(\d+)", re.IGNORECASE)
 
@@ -58,15 +62,45 @@ def read_text(
     repairs = checked.domain.repairs if checked.domain is not None else []
     text = apply_repairs(translation.text, repairs)
     shared = any(d.code == NAME_CLASH for d in checked.lenient)
-    with _names_shared(shared):
-        problem = _up_parse(text, problem_text, domain_name, problem_name)
-    success = {
-        name: _success_expression(problem, name, nodes, domain_name)
-        for name, nodes in translation.probabilities.items()
-    }
+    up_read = partial(_up_read, text, problem_text, shared, translation.probabilities,
+                      domain_name, problem_name)
+    read = _lite_read(text, problem_text, shared, translation.probabilities, domain_name)
+    if read is None:
+        read = up_read()
+    else:
+        read[0].counterpart = up_read  # the UP problem, when someone asks for it
+    model, success = read
     sources = _sources(checked.domain, problem_text, domain_name, problem_name)
-    return ProbabilisticProblem(problem, success, domain_name, problem_name, checked.lenient,
+    return ProbabilisticProblem(model, success, domain_name, problem_name, checked.lenient,
                                 sources, checked.not_grounded)
+
+
+def _up_read(domain: str, problem_text: str, shared: bool, probabilities: Mapping[str, list],
+             domain_name: str, problem_name: str) -> tuple[Problem, dict[str, FNode]]:
+    """UP's problem of the (translated, repaired) text and its success expressions."""
+    with _names_shared(shared):
+        problem = _up_parse(domain, problem_text, domain_name, problem_name)
+    success = {name: _success_expression(problem, name, nodes, domain_name)
+               for name, nodes in probabilities.items()}
+    return problem, success
+
+
+def _lite_read(domain: str, problem_text: str, shared: bool,
+               probabilities: Mapping[str, list], domain_name: str
+               ) -> tuple[lite.Problem, dict[str, Any]] | None:
+    """The project's own model of the text and its success expressions, or None where UP
+    reads it (a construct `lite` leaves to UP, or anything UP would refuse: UP's reading
+    then reports it as before). A probability our own code refuses (a `PddlError`) is
+    refused alike either way."""
+    try:
+        model = build_lite(domain, problem_text, shared)
+        success = {name: _success_expression(model, name, nodes, domain_name)
+                   for name, nodes in probabilities.items()}
+    except PddlError:
+        raise
+    except Exception:  # noqa: BLE001 - Unsupported, ModelError, ...: UP reads it
+        return None
+    return model, success
 
 
 def _sources(domain: Domain | None, problem_text: str, domain_name: str, problem_name: str
@@ -108,6 +142,8 @@ def _names_shared(shared: bool) -> Iterator[None]:
     """Let a type, predicate and action share a name (IPC floortile's `up`, freecell's
     `suit`) by lifting UP's `error_used_name` while reading. UP's reader builds the metric
     in the global environment, so the flag is lifted there, and restored after."""
+    from unified_planning.environment import get_environment
+
     environment = get_environment()
     before = environment.error_used_name
     environment.error_used_name = before and not shared
@@ -135,6 +171,8 @@ def _up_parse(domain: str, problem: str, domain_name: str, problem_name: str) ->
     built = _fast_build(domain, problem)
     if built is not None:
         return built
+    from unified_planning.io import PDDLReader
+
     try:
         return PDDLReader().parse_problem_string(domain, problem)
     except Exception as exc:  # noqa: BLE001 - UP raises many kinds; all become PddlError
@@ -160,6 +198,8 @@ def _fast_build(domain: str, problem: str) -> Problem | None:
 
 def _domain_fails(domain: str) -> bool:
     """Which file UP's complaint is about: the domain if it fails on its own."""
+    from unified_planning.io import PDDLReader
+
     try:
         PDDLReader().parse_problem_string(domain, None)
     except Exception:  # noqa: BLE001
@@ -168,6 +208,8 @@ def _domain_fails(domain: str) -> bool:
 
 
 def _convert(exc: Exception, file: str) -> PddlError:
+    import pyparsing
+
     if isinstance(exc, pyparsing.ParseBaseException):
         return PddlError(f"syntax error: {exc.msg}", file, exc.lineno, exc.col)
     message = str(exc).strip() or type(exc).__name__
@@ -178,7 +220,8 @@ def _convert(exc: Exception, file: str) -> PddlError:
 
 
 def _success_expression(problem: Problem, action: str, nodes: list[Node], file: str) -> FNode:
-    """The product of an action's probability terms, as a UP expression."""
+    """The product of an action's probability terms, as an expression of the problem's
+    model (UP's, or `lite`'s: the same calls)."""
     em = problem.environment.expression_manager
     up_action = problem.action(action)
     factors = [_term(problem, up_action, node, file) for node in nodes]

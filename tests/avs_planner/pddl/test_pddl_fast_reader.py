@@ -280,7 +280,8 @@ def test_constructs_left_to_up_read_as_before(domain, name, monkeypatch):
     with pytest.raises(Unsupported):
         build_problem(domain, problem)
     now = _read_or_error(domain, problem)
-    monkeypatch.setattr(reader_module, "_fast_build", lambda d, p: None)  # UP's reader only
+    monkeypatch.setattr(reader_module, "_lite_read", lambda *args: None)  # UP's reader only
+    monkeypatch.setattr(reader_module, "_fast_build", lambda d, p: None)
     assert now == _read_or_error(domain, problem)
 
 
@@ -289,7 +290,7 @@ def test_fast_path_reads_without_ups_reader(monkeypatch):
     def refuse(*_args: object) -> None:
         raise AssertionError("UP's reader was called")
 
-    monkeypatch.setattr(reader_module.PDDLReader, "parse_problem_string", refuse)
+    monkeypatch.setattr(PDDLReader, "parse_problem_string", refuse)
     problem = read_text((AVS / "domain.pddl").read_text(),
                         (AVS / "problems" / "corridor.pddl").read_text()).problem
     assert problem.has_action("move")
