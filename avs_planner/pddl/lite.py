@@ -93,9 +93,6 @@ class Type:
     def is_real_type(self) -> bool:
         return False
 
-    def is_time_type(self) -> bool:
-        return False
-
     def is_user_type(self) -> bool:
         return False
 
@@ -171,20 +168,20 @@ class TypeManager:
     def __init__(self) -> None:
         self._user: dict[tuple[str, UserType | None], UserType] = {}
 
-    def BoolType(self) -> Type:  # noqa: N802 - UP's names
+    def BoolType(self) -> Type:
         return BOOL
 
-    def IntType(self, lower: object = None, upper: object = None) -> Type:  # noqa: N802
+    def IntType(self, lower: object = None, upper: object = None) -> Type:
         if lower is not None or upper is not None:
             raise ModelError("bounded integer types are not mirrored")
         return INT
 
-    def RealType(self, lower: object = None, upper: object = None) -> Type:  # noqa: N802
+    def RealType(self, lower: object = None, upper: object = None) -> Type:
         if lower is not None or upper is not None:
             raise ModelError("bounded real types are not mirrored")
         return REAL
 
-    def UserType(self, name: str, father: Type | None = None) -> Type:  # noqa: N802
+    def UserType(self, name: str, father: Type | None = None) -> Type:
         if father is not None and not isinstance(father, UserType):
             raise ModelError("the father of a user type must be a user type")
         key = (name, father)
@@ -301,14 +298,6 @@ class FNode:
         assert self.node_type is _K.BOOL_CONSTANT
         return self._payload
 
-    def int_constant_value(self) -> int:
-        assert self.node_type is _K.INT_CONSTANT
-        return self._payload
-
-    def real_constant_value(self) -> Fraction:
-        assert self.node_type is _K.REAL_CONSTANT
-        return self._payload
-
     def fluent(self) -> Fluent:
         assert self.node_type is _K.FLUENT_EXP
         return self._payload
@@ -359,9 +348,6 @@ class FNode:
     def is_implies(self) -> bool:
         return self.node_type is _K.IMPLIES
 
-    def is_iff(self) -> bool:
-        return False
-
     def is_exists(self) -> bool:
         return self.node_type is _K.EXISTS
 
@@ -379,12 +365,6 @@ class FNode:
 
     def is_object_exp(self) -> bool:
         return self.node_type is _K.OBJECT_EXP
-
-    def is_timing_exp(self) -> bool:
-        return False
-
-    def is_dot(self) -> bool:
-        return False
 
     def is_plus(self) -> bool:
         return self.node_type is _K.PLUS
@@ -474,32 +454,32 @@ class ExpressionManager:
                 raise ModelError(f"cannot make an expression of {arg!r}")
         return out
 
-    # noqa: N802 below - the names are UP's
-    def And(self, *args: Any) -> FNode:  # noqa: N802
+    # the constructors, named as UP's expression manager names them
+    def And(self, *args: Any) -> FNode:
         items = tuple(self.auto_promote(*args))
         if not items:
             return self._true
         return items[0] if len(items) == 1 else self._node(_K.AND, items)
 
-    def Or(self, *args: Any) -> FNode:  # noqa: N802
+    def Or(self, *args: Any) -> FNode:
         items = tuple(self.auto_promote(*args))
         if not items:
             return self._false
         return items[0] if len(items) == 1 else self._node(_K.OR, items)
 
-    def Not(self, expression: Any) -> FNode:  # noqa: N802
+    def Not(self, expression: Any) -> FNode:
         (node,) = self.auto_promote(expression)
         if node.node_type is _K.NOT:
             return node.args[0]
         return self._node(_K.NOT, (node,))
 
-    def Implies(self, left: Any, right: Any) -> FNode:  # noqa: N802
+    def Implies(self, left: Any, right: Any) -> FNode:
         return self._node(_K.IMPLIES, tuple(self.auto_promote(left, right)))
 
-    def Exists(self, expression: Any, *variables: Variable) -> FNode:  # noqa: N802
+    def Exists(self, expression: Any, *variables: Variable) -> FNode:
         return self._quantifier(_K.EXISTS, expression, variables)
 
-    def Forall(self, expression: Any, *variables: Variable) -> FNode:  # noqa: N802
+    def Forall(self, expression: Any, *variables: Variable) -> FNode:
         return self._quantifier(_K.FORALL, expression, variables)
 
     def _quantifier(self, kind: OperatorKind, expression: Any,
@@ -508,73 +488,73 @@ class ExpressionManager:
             raise ModelError("a quantifier needs variables")
         return self._node(kind, tuple(self.auto_promote(expression)), variables)
 
-    def FluentExp(self, fluent: Fluent, params: Iterable[Any] = ()) -> FNode:  # noqa: N802
+    def FluentExp(self, fluent: Fluent, params: Iterable[Any] = ()) -> FNode:
         args = tuple(self.auto_promote(params))
         if fluent.arity != len(args):
             raise ModelError(f"fluent {fluent.name} has arity {fluent.arity}, not {len(args)}")
         return self._node(_K.FLUENT_EXP, args, fluent)
 
-    def ParameterExp(self, param: Parameter) -> FNode:  # noqa: N802
+    def ParameterExp(self, param: Parameter) -> FNode:
         return self._node(_K.PARAM_EXP, (), param)
 
-    def VariableExp(self, var: Variable) -> FNode:  # noqa: N802
+    def VariableExp(self, var: Variable) -> FNode:
         return self._node(_K.VARIABLE_EXP, (), var)
 
-    def ObjectExp(self, obj: Object) -> FNode:  # noqa: N802
+    def ObjectExp(self, obj: Object) -> FNode:
         return self._node(_K.OBJECT_EXP, (), obj)
 
-    def TRUE(self) -> FNode:  # noqa: N802
+    def TRUE(self) -> FNode:
         return self._true
 
-    def FALSE(self) -> FNode:  # noqa: N802
+    def FALSE(self) -> FNode:
         return self._false
 
-    def Bool(self, value: bool) -> FNode:  # noqa: N802
+    def Bool(self, value: bool) -> FNode:
         return self._true if value else self._false
 
-    def Int(self, value: int) -> FNode:  # noqa: N802
+    def Int(self, value: int) -> FNode:
         if not isinstance(value, int) or isinstance(value, bool):
             raise ModelError(f"expecting int, got {type(value).__name__}")
         return self._node(_K.INT_CONSTANT, (), value)
 
-    def Real(self, value: Fraction) -> FNode:  # noqa: N802
+    def Real(self, value: Fraction) -> FNode:
         if not isinstance(value, Fraction):
             raise ModelError(f"expecting Fraction, got {type(value).__name__}")
         return self._node(_K.REAL_CONSTANT, (), value)
 
-    def Plus(self, *args: Any) -> FNode:  # noqa: N802
+    def Plus(self, *args: Any) -> FNode:
         items = tuple(self.auto_promote(*args))
         if not items:
             return self.Int(0)
         return items[0] if len(items) == 1 else self._node(_K.PLUS, items)
 
-    def Minus(self, left: Any, right: Any) -> FNode:  # noqa: N802
+    def Minus(self, left: Any, right: Any) -> FNode:
         return self._node(_K.MINUS, tuple(self.auto_promote(left, right)))
 
-    def Times(self, *args: Any) -> FNode:  # noqa: N802
+    def Times(self, *args: Any) -> FNode:
         items = tuple(self.auto_promote(*args))
         if not items:
             return self.Int(1)
         return items[0] if len(items) == 1 else self._node(_K.TIMES, items)
 
-    def Div(self, left: Any, right: Any) -> FNode:  # noqa: N802
+    def Div(self, left: Any, right: Any) -> FNode:
         return self._node(_K.DIV, tuple(self.auto_promote(left, right)))
 
-    def LE(self, left: Any, right: Any) -> FNode:  # noqa: N802
+    def LE(self, left: Any, right: Any) -> FNode:
         return self._node(_K.LE, tuple(self.auto_promote(left, right)))
 
-    def GE(self, left: Any, right: Any) -> FNode:  # noqa: N802
+    def GE(self, left: Any, right: Any) -> FNode:
         left, right = self.auto_promote(left, right)
         return self._node(_K.LE, (right, left))
 
-    def LT(self, left: Any, right: Any) -> FNode:  # noqa: N802
+    def LT(self, left: Any, right: Any) -> FNode:
         return self._node(_K.LT, tuple(self.auto_promote(left, right)))
 
-    def GT(self, left: Any, right: Any) -> FNode:  # noqa: N802
+    def GT(self, left: Any, right: Any) -> FNode:
         left, right = self.auto_promote(left, right)
         return self._node(_K.LT, (right, left))
 
-    def Equals(self, left: Any, right: Any) -> FNode:  # noqa: N802
+    def Equals(self, left: Any, right: Any) -> FNode:
         return self._node(_K.EQUALS, tuple(self.auto_promote(left, right)))
 
 
@@ -822,12 +802,6 @@ class Effect:
     def is_decrease(self) -> bool:
         return self.kind is EffectKind.DECREASE
 
-    def is_continuous_increase(self) -> bool:
-        return False
-
-    def is_continuous_decrease(self) -> bool:
-        return False
-
     @property
     def environment(self) -> Environment:
         return ENVIRONMENT
@@ -975,22 +949,6 @@ class _Metric:
     def is_minimize_action_costs() -> bool:
         return False
 
-    @staticmethod
-    def is_minimize_sequential_plan_length() -> bool:
-        return False
-
-    @staticmethod
-    def is_minimize_makespan() -> bool:
-        return False
-
-    @staticmethod
-    def is_minimize_expression_on_final_state() -> bool:
-        return False
-
-    @staticmethod
-    def is_maximize_expression_on_final_state() -> bool:
-        return False
-
     @property
     def environment(self) -> Environment:
         return ENVIRONMENT
@@ -1026,10 +984,6 @@ class MinimizeActionCosts(_Metric):
 
 
 class MinimizeMakespan(_Metric):
-    @staticmethod
-    def is_minimize_makespan() -> bool:
-        return True
-
     def __repr__(self) -> str:
         return "minimize makespan"
 
@@ -1049,17 +1003,9 @@ class _ExpressionMetric(_Metric):
 class MinimizeExpressionOnFinalState(_ExpressionMetric):
     _word = "minimize"
 
-    @staticmethod
-    def is_minimize_expression_on_final_state() -> bool:
-        return True
-
 
 class MaximizeExpressionOnFinalState(_ExpressionMetric):
     _word = "maximize"
-
-    @staticmethod
-    def is_maximize_expression_on_final_state() -> bool:
-        return True
 
 
 # ---- the problem ------------------------------------------------------------------------
