@@ -25,8 +25,10 @@ compares both models, printed and ground, on every file the project reads.
 The modules, each one concept: `kinds` (node and effect kinds, `ModelError`), `declarations`
 (types and their manager, parameters, variables, objects, fluents), `nodes` (the expression
 node and the walks finding its fluents and free variables), `expression_manager` (one node per
-content, typed and checked, with UP's shortcuts), `simplifier`, `shared_environment` (the
-managers reads share), `actions` (actions and effects), `metrics` and `problem` (with its UP
+content, typed and checked, with UP's shortcuts), `interning` (the weak-valued tables behind
+the managers: a node or type is kept while something holds it, so a process reading many
+texts does not accumulate them), `simplifier`, `shared_environment` (the managers reads
+share), `actions` (actions and effects), `metrics` and `problem` (with its UP
 counterpart, `to_up`). The builder takes this package as its kit of model classes, so what it
 names is imported here.
 """

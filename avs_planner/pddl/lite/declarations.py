@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections import OrderedDict
 from collections.abc import Iterator
 
+from avs_planner.pddl.lite.interning import WeakTable
 from avs_planner.pddl.lite.kinds import ModelError
 
 # ---- types ------------------------------------------------------------------------------
@@ -73,7 +74,7 @@ BOOL, INT, REAL = _BoolType(), _IntType(), _RealType()
 class UserType(Type):
     """A user type; one object per (name, father), as UP's type manager keeps them."""
 
-    __slots__ = ("name", "father")
+    __slots__ = ("name", "father", "__weakref__")
 
     def __init__(self, name: str, father: UserType | None = None):
         self.name = name
@@ -97,8 +98,15 @@ class UserType(Type):
 
 
 class TypeManager:
+    """The types; one user type per (name, father) while something holds it (`interning`)."""
+
     def __init__(self) -> None:
-        self._user: dict[tuple[str, UserType | None], UserType] = {}
+        self._user: WeakTable[UserType] = WeakTable()
+
+    @property
+    def table_size(self) -> int:
+        """How many user types the table holds (those a live problem or node still uses)."""
+        return len(self._user)
 
     def BoolType(self) -> Type:
         return BOOL
@@ -119,7 +127,7 @@ class TypeManager:
         key = (name, father)
         found = self._user.get(key)
         if found is None:
-            found = self._user[key] = UserType(name, father)
+            found = self._user.setdefault(key, UserType(name, father))
         return found
 
 

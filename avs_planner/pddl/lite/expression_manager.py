@@ -19,6 +19,7 @@ from avs_planner.pddl.lite.declarations import (
     Variable,
     _numeric,
 )
+from avs_planner.pddl.lite.interning import WeakTable
 from avs_planner.pddl.lite.kinds import (
     _ARITHMETIC,
     _BOOLEAN,
@@ -33,13 +34,20 @@ _Content = tuple[OperatorKind, tuple[FNode, ...], Any]
 
 class ExpressionManager:
     """Makes the nodes, one per content, each typed (and checked) as UP's type checker
-    types it; the constructors UP's builder calls, with UP's shortcuts."""
+    types it; the constructors UP's builder calls, with UP's shortcuts. A node stays in the
+    table while something holds it (`interning`), so reading text after text in one process
+    does not grow it."""
 
     def __init__(self) -> None:
-        self._nodes: dict[_Content, FNode] = {}
-        self._next_id = 1
+        self._nodes: WeakTable[FNode] = WeakTable()
+        self._next_id = 1  # never reused: a node made again after its first died hashes anew
         self._true = self._node(_K.BOOL_CONSTANT, (), True)
         self._false = self._node(_K.BOOL_CONSTANT, (), False)
+
+    @property
+    def table_size(self) -> int:
+        """How many nodes the table holds (those something still references)."""
+        return len(self._nodes)
 
     def _node(self, kind: OperatorKind, args: tuple[FNode, ...], payload: Any = None) -> FNode:
         content = (kind, args, payload)

@@ -15,7 +15,7 @@ if TYPE_CHECKING:
 class FNode:
     """An expression node, shared per content (compare with `is`); UP's `FNode` methods."""
 
-    __slots__ = ("node_type", "args", "_payload", "node_id", "type")
+    __slots__ = ("node_type", "args", "_payload", "node_id", "type", "__weakref__")
 
     def __init__(self, kind: OperatorKind, args: tuple[FNode, ...], payload: Any, node_id: int,
                  type_: Type):
