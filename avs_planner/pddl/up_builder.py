@@ -208,34 +208,40 @@ class _Builder(ExpressionTranslator):
                 if name == OBJECT:
                     father = None  # and for the rest of this group, as UP's reader does
                 declared[name] = father
-        types = self.types
-
-        def declare(name: str, father_name: str | None, depth: int) -> None:
-            if name in types:
-                return
-            if depth > len(declared):
-                raise Unsupported("a cycle in the type hierarchy")
-            father: Type | None = None
-            if father_name is None:
-                father = None
-            elif father_name in types:
-                father = types[father_name]
-            elif father_name in declared:
-                if father_name == name:
-                    raise Unsupported(f"type {name} is its own parent")
-                declare(father_name, declared[father_name], depth + 1)
-                father = types[father_name]
-            elif father_name == OBJECT and not object_root:
-                father = None
-            else:
-                father = types[father_name] = self.tm.UserType(father_name, None)
-            types[name] = self.tm.UserType(name, father)
-            problem._add_user_type(types[name])
-
         for name, father_name in declared.items():
-            declare(name, father_name, 0)
+            self._declare_type(problem, declared, object_root, name, father_name, 0)
+        types = self.types
         if object_root and OBJECT not in types:
             types[OBJECT] = self.tm.UserType(OBJECT, None)
+
+    def _declare_type(self, problem: Problem, declared: dict[str, str | None],
+                      object_root: bool, name: str, father_name: str | None,
+                      depth: int) -> None:
+        """Declare `name` under `father_name`, its undeclared ancestors first (a method, not
+        a closure calling itself: that cycle kept the problem until the garbage collector
+        ran)."""
+        types = self.types
+        if name in types:
+            return
+        if depth > len(declared):
+            raise Unsupported("a cycle in the type hierarchy")
+        father: Type | None = None
+        if father_name is None:
+            father = None
+        elif father_name in types:
+            father = types[father_name]
+        elif father_name in declared:
+            if father_name == name:
+                raise Unsupported(f"type {name} is its own parent")
+            self._declare_type(problem, declared, object_root, father_name,
+                               declared[father_name], depth + 1)
+            father = types[father_name]
+        elif father_name == OBJECT and not object_root:
+            father = None
+        else:
+            father = types[father_name] = self.tm.UserType(father_name, None)
+        types[name] = self.tm.UserType(name, father)
+        problem._add_user_type(types[name])
 
     def _fluent(self, name: str, groups: TypedGroups, kind: Type) -> Fluent:
         if name in self.fluents:
