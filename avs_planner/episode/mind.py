@@ -149,6 +149,8 @@ class Mind:
         self.grid.integrate_scan(scan)
         events = self.place_map.follow(self.grid, poses, time)
         self._feed.apply(events)
+        if events:
+            self._place_objects()
         self._drop_stale_objects()
         return events
 
@@ -247,6 +249,22 @@ class Mind:
                 return        # attach what it saw to (a merged room passes it to its heir)
             where = room
         self.cmap.observe_search(label, where, min(1.0, coverage), p_detect)
+
+    def _place_objects(self) -> None:
+        """Objects stand where the map now puts their floor: one seen through a door before
+        the space beyond was a room of its own was credited to the room the robot looked
+        from (a kitchen's table to the corridor, which stayed "corridor 1.00" and the kitchen
+        without its table); once the map parts that space into its own room, the object and
+        what stands on it move there, and both rooms' evidence with them."""
+        for oid, obj in list(self.objects.items()):
+            if obj.support is not None:
+                continue  # it moves with its support
+            room = self.room_at(obj.position[:2], floor_only=True)
+            record = self.cmap.objects.objects.get(oid)
+            if room is None or record is None or room == record.room \
+                    or not self.cmap.graph.has_room(room):
+                continue
+            self.cmap.move_object(oid, room)
 
     def _drop_stale_objects(self) -> None:
         """Rooms merge as the map grows: keep objects' rooms in step with the ledger."""

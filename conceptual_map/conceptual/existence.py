@@ -360,6 +360,33 @@ class ObjectLedger:
                 del records[key]
         self._counts.pop(room, None)
 
+    def move_object(self, object_id: str, room: str) -> str:
+        """A detected object turned out to stand in `room` (the map parted the space it was
+        credited to): it moves there with what stands on or in it, and its count with it.
+        Returns the room it was in."""
+        record = self.objects.get(object_id)
+        if record is None:
+            raise ConceptualError(f"unknown object {object_id!r}")
+        if record.support is not None:
+            raise ConceptualError(f"object {object_id!r} is {record.relation} "
+                                  f"{record.support!r}: it moves with it")
+        old = record.room
+        if old == room:
+            return old
+        moving = [object_id]
+        for oid in moving:  # what stands on it, and on that, ...
+            moving += [o for o, r in self.objects.items() if r.support == oid and o not in moving]
+        for oid in moving:
+            r = self.objects[oid]
+            self.objects[oid] = ObjectRecord(oid, r.label, room, r.relation, r.support)
+        counts = self._counts.get(old)
+        if counts is not None:
+            counts[record.label] -= 1
+            if counts[record.label] <= 0:
+                del counts[record.label]
+        self._counts.setdefault(room, Counter())[record.label] += 1
+        return old
+
     def move_room(self, gone: str, keep: str) -> None:
         """Objects and room-level searches of `gone` now belong to `keep` (rooms merged).
 

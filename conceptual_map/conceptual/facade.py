@@ -179,6 +179,17 @@ class ConceptualMap:
         self._refresh_object_evidence(room)
         return record.object_id
 
+    def move_object(self, object_id: str, room: str) -> None:
+        """A detected object stands in `room`, not where it was credited (the map has since
+        parted that space into rooms): it moves with what stands on it, and both rooms'
+        object evidence follows."""
+        self.graph.require_room(room)
+        old = self.objects.move_object(object_id, room)
+        if old != room:
+            self._refresh_object_evidence(room)
+            if self.graph.has_room(old):
+                self._refresh_object_evidence(old)
+
     def forget_object(self, object_id: str) -> None:
         """A detected object proved false (not seen again where it was): as if never seen."""
         record = self.objects.remove(object_id)

@@ -59,6 +59,7 @@ class PlaceMap:
         self._walled: frozenset[str] = frozenset()
         self._walls_key: tuple | None = None
         self._extents: tuple | None = None  # (key, owner, room ids, free regions): room_extents
+        self._sizes: tuple[np.ndarray, np.ndarray] | None = None  # (free regions, their sizes)
         # the grid's cell states when the free space was last probed for doors (`_doors_in_view`
         # probes again only near cells that changed since)
         self._door_probed: tuple | None = None
@@ -154,7 +155,15 @@ class PlaceMap:
         lo = np.maximum(cell - r, 0)
         hi = np.minimum(cell + r + 1, owner.shape)
         if np.all(hi > lo):
-            candidates = np.argwhere(labels[lo[0]:hi[0], lo[1]:hi[1]] > 0)
+            window = labels[lo[0]:hi[0], lo[1]:hi[1]]
+            # free space no room owns and too small for the robot to stand in is a speck
+            # (a cell the laser saw between a table's legs), not a room beyond a door
+            if self._sizes is None or self._sizes[0] is not labels:
+                self._sizes = (labels, np.bincount(labels.ravel()))
+            sizes = self._sizes[1]
+            speck = (owner[lo[0]:hi[0], lo[1]:hi[1]] == 0) & \
+                (sizes[window] * grid.resolution ** 2 < np.pi * self.config.robot_radius ** 2)
+            candidates = np.argwhere((window > 0) & ~speck)
             if len(candidates):
                 d = np.linalg.norm(candidates + lo - cell, axis=1)
                 if d.min() * grid.resolution <= reach:

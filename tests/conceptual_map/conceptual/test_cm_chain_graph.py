@@ -82,6 +82,30 @@ def test_merge_rooms_keeps_places_links_and_objects():
     _assert_matches_exact(cmap, explicit=False, atol=1e-6)
 
 
+def test_moving_an_object_moves_it_with_what_stands_on_it_and_its_evidence():
+    """A table seen through a door was credited to the corridor; once the room beyond is a
+    room of its own, the table and the cereal box on it belong there."""
+    cmap = _building()
+    table = cmap.observe_object("table", "corr")
+    box = cmap.observe_object("cerealbox", "corr", on=table)
+    corridor_before = cmap.room_category("corr")["kitchen"]
+    kitchen_before = cmap.room_category("r1")["kitchen"]
+    cmap.move_object(table, "r1")
+    records = cmap.objects.objects
+    assert records[table].room == "r1" and records[box].room == "r1"
+    assert records[box].support == table
+    assert cmap.p_object_at("table", "r1") == 1.0
+    assert cmap.room_category("r1")["kitchen"] > kitchen_before
+    assert cmap.room_category("corr")["kitchen"] < corridor_before
+    _assert_matches_exact(cmap, explicit=False, atol=1e-6)
+    cmap.move_object(table, "r1")  # already there: nothing changes
+    assert records[table].room == "r1"
+    with pytest.raises(ConceptualError, match="moves with it"):
+        cmap.move_object(box, "r2")
+    with pytest.raises(ConceptualError, match="unknown object"):
+        cmap.move_object("object99", "r2")
+
+
 def test_remove_place_drops_its_evidence():
     cmap = _building()
     before = cmap.room_category("r1")["kitchen"]
