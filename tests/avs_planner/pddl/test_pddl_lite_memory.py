@@ -18,18 +18,20 @@ from avs_planner.pddl import lite, read_text
 ROOT = Path(__file__).resolve().parents[3]
 AVS = ROOT / "domains" / "avs"
 
+# every name carries `i`: nodes of names other tests in the process also use (a `room`
+# type, objects `r1`, `r2`) may be held by them, and would not be counted as this read's
 DOMAIN = """(define (domain d{i})
   (:requirements :strips :typing)
-  (:types box{i} - thing{i} room)
-  (:predicates (at{i} ?b - box{i} ?r - room) (moved{i}))
-  (:action move{i} :parameters (?b - box{i} ?from ?to - room)
+  (:types box{i} - thing{i} room{i})
+  (:predicates (at{i} ?b - box{i} ?r - room{i}) (moved{i}))
+  (:action move{i} :parameters (?b - box{i} ?from ?to - room{i})
     :precondition (at{i} ?b ?from)
     :effect (and (not (at{i} ?b ?from)) (at{i} ?b ?to) (moved{i}))))
 """
 PROBLEM = """(define (problem p{i}) (:domain d{i})
-  (:objects b{i} - box{i} r1 r2 - room)
-  (:init (at{i} b{i} r1))
-  (:goal (and (at{i} b{i} r2) (moved{i}))))
+  (:objects b{i} - box{i} ra{i} rb{i} - room{i})
+  (:init (at{i} b{i} ra{i}))
+  (:goal (and (at{i} b{i} rb{i}) (moved{i}))))
 """
 
 
@@ -53,7 +55,7 @@ def test_reading_200_problems_does_not_grow_the_tables() -> None:
     before = sizes()
     one = read(0)
     nodes_one = sizes()[0] - before[0]
-    assert nodes_one > 10  # a problem's nodes are in the table while it is held
+    assert nodes_one > 0  # a problem's nodes are in the table while it is held
     del one
     for k in range(200):
         model = read(0 if k % 2 else k + 1)
