@@ -3,7 +3,8 @@
 Subcommand modules are discovered and imported to build the parser, so each keeps pybullet,
 unified-planning, matplotlib and FastAPI imports inside the function that runs the command.
 `avs plan` and `avs domain check` read and ground PDDL on the project's own model
-(`pddl.lite`): they do not import unified-planning at all (it alone took ~0.8 s).
+(`pddl.lite`): they do not import unified-planning at all (it alone took ~0.8 s); nor does a
+search episode (`avs simulate`), which builds each replan's problem in that model.
 """
 
 from __future__ import annotations
