@@ -3,7 +3,8 @@
 Subcommand modules are discovered and imported to build the parser, so each keeps pybullet,
 unified-planning, matplotlib and FastAPI imports inside the function that runs the command.
 `avs plan` and `avs domain check` read and ground PDDL on the project's own model
-(`pddl.lite`): they do not import unified-planning at all (it alone took ~0.8 s).
+(`pddl.lite`): they do not import unified-planning at all (it alone took ~0.8 s); nor does a
+search episode (`avs simulate`), which builds each replan's problem in that model.
 """
 
 from __future__ import annotations
@@ -45,3 +46,16 @@ def test_plan_and_domain_check_do_not_import_unified_planning(argv: list[str]) -
                          check=True, cwd=ROOT)
     assert out.stdout.strip().splitlines()[-1] == "no UP 0", out.stderr
 
+
+
+def test_a_search_episode_does_not_import_unified_planning(tmp_path: Path) -> None:
+    """The episode builds and plans each replan's problem on `pddl.lite` (episode/domain.py)."""
+    argv = ["simulate", "--scenario", "a", "--seed", "1", "--time-budget", "30",
+            "--out", str(tmp_path / "episode")]
+    code = (f"import sys; from avs_planner.cli import main; rc = main({argv!r}); "
+            "print('UP' if 'unified_planning' in sys.modules else 'no UP', rc)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, cwd=ROOT)
+    last = out.stdout.strip().splitlines()[-1]
+    assert last.startswith("no UP "), out.stdout + out.stderr
+    assert (tmp_path / "episode" / "trace.jsonl").exists()

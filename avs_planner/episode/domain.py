@@ -1,19 +1,23 @@
-"""The AVS domain, read once, and UP problems built from a state without reparsing PDDL.
+"""The AVS domain, read once, and problems built from a state without reparsing PDDL.
 
-Reading PDDL through unified-planning takes about a second; the switching loop rebuilds its
-problem after every action, so it copies the domain's fluents and actions into a fresh UP
-`Problem` and sets objects and initial values directly.
+The switching loop rebuilds its problem after every action, so it copies the domain's
+fluents and actions into a fresh `Problem` of the same model as the domain's (the project's
+own `pddl.lite`, as the reader builds it: an episode then never imports unified-planning;
+UP's only if the reader had to read the domain with UP) and sets objects and initial values
+directly, through the calls both models share.
 """
 
 from __future__ import annotations
 
+import importlib
+from fractions import Fraction
 from functools import cache
 from pathlib import Path
-
-from unified_planning.model import Object, Problem
+from types import ModuleType
+from typing import Any
 
 from avs_planner.cp.task import Atom
-from avs_planner.pddl import ProbabilisticProblem, read_text
+from avs_planner.pddl import ProbabilisticProblem, lite, read_text
 
 DOMAIN_FILE = Path(__file__).resolve().parents[2] / "domains" / "avs" / "domain.pddl"
 
@@ -39,26 +43,41 @@ def build_problem(
     values: dict[Atom, float],
     goal: Atom,
 ) -> ProbabilisticProblem:
-    """A ProbabilisticProblem of the AVS domain with these objects, true atoms and values."""
+    """A ProbabilisticProblem of the AVS domain with these objects, true atoms and values,
+    in the domain's model; a `lite` one gives UP's problem of the same state when asked
+    (`.problem`, `.up_success`)."""
     base = base_problem()
-    up = base.problem
-    em = up.environment.expression_manager
-    problem = Problem(name, up.environment)
-    for fluent in up.fluents:
-        problem.add_fluent(fluent, default_initial_value=up.fluents_defaults.get(fluent))
-    problem.add_actions(up.actions)
-    for constant in up.all_objects:
+    problem = _fill(base.model, name, objects, atoms, values, goal)
+    if lite.is_lite(problem):
+        kept = ({t: list(names) for t, names in objects.items()}, dict(values))
+        problem.counterpart = lambda: (  # type: ignore[union-attr]
+            _fill(base.problem, name, kept[0], atoms, kept[1], goal), base.up_success)
+    # the actions are the domain's, so its success terms (nodes over their parameters) hold
+    return ProbabilisticProblem(problem, base.success, str(DOMAIN_FILE), f"<{name}>")
+
+
+def _fill(domain: Any, name: str, objects: dict[str, list[str]], atoms: frozenset[Atom],
+          values: dict[Atom, float], goal: Atom) -> Any:
+    """A problem of `domain`'s model (`lite`'s or UP's, through the calls both have) with the
+    domain's fluents, actions, constants and metric, and these objects, atoms and goal."""
+    kit = _model_kit(domain)
+    em = domain.environment.expression_manager
+    problem = kit.Problem(name, domain.environment)
+    for fluent in domain.fluents:
+        problem.add_fluent(fluent, default_initial_value=domain.fluents_defaults.get(fluent))
+    problem.add_actions(domain.actions)
+    for constant in domain.all_objects:
         if str(constant.type) == "relation":  # the domain's constants `in` and `on`
             problem.add_object(constant)
     by_name = {o.name: o for o in problem.all_objects}
     for type_name, names in objects.items():
-        user_type = up.user_type(type_name)
+        user_type = domain.user_type(type_name)
         for obj_name in names:
-            by_name[obj_name] = Object(obj_name, user_type)
+            by_name[obj_name] = kit.Object(obj_name, user_type)
             problem.add_object(by_name[obj_name])
 
-    def term(atom: Atom):  # noqa: ANN202 - a UP FNode
-        fluent = up.fluent(atom[0])
+    def term(atom: Atom) -> Any:  # a node of the domain's model
+        fluent = domain.fluent(atom[0])
         return em.FluentExp(fluent, [em.ObjectExp(by_name[a]) for a in atom[1:]])
 
     for atom in sorted(atoms):
@@ -66,9 +85,18 @@ def build_problem(
     for atom, value in sorted(values.items()):
         problem.set_initial_value(term(atom), em.Real(_fraction(value)))
     problem.add_goal(term(goal))
-    for metric in up.quality_metrics:
+    for metric in domain.quality_metrics:
         problem.add_quality_metric(metric)
-    return ProbabilisticProblem(problem, base.up_success, str(DOMAIN_FILE), f"<{name}>")
+    return problem
+
+
+def _model_kit(model: object) -> ModuleType:
+    """The module whose `Problem` and `Object` make a problem of `model`'s kind: `lite`, or
+    unified-planning's (imported only then: when the reader read the domain with UP, or
+    when UP's counterpart of a `lite` problem is asked for)."""
+    if lite.is_lite(model):
+        return lite
+    return importlib.import_module("unified_planning.model")
 
 
 _SKELETONS: dict[tuple, ProbabilisticProblem] = {}
@@ -88,7 +116,6 @@ def planning_problem(objects: dict[str, list[str]], goal: Atom) -> Probabilistic
     return problem
 
 
-def _fraction(value: float):  # noqa: ANN202 - Fraction, exact for UP
-    from fractions import Fraction
-
+def _fraction(value: float) -> Fraction:
+    """The value as the exact fraction both models take for a real."""
     return Fraction(round(float(value), 6)).limit_denominator(1_000_000)

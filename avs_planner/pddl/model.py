@@ -12,9 +12,11 @@ project's own `lite.Problem`, which offers the part of UP's model API the planne
 same names and methods: `actions`, `fluents`, `all_objects`, `explicit_initial_values`,
 `goals`, `quality_metrics`; nodes with `is_and()`, `args`, `fluent()`, ...; effects with
 `fluent`, `value`, `condition`, `forall`), without importing UP. `success` holds nodes of the
-model's kind. Whoever needs UP objects (UP's engines and plan validators, the episode's
-problem builder) asks for `problem` and `up_success`: the model itself if it is UP's, else
-UP's problem of the same text, built once when first asked.
+model's kind. Whoever needs UP objects (UP's engines and plan validators) asks for `problem`
+and `up_success`: the model itself if it is UP's, else UP's problem of the same text (or,
+for a problem the episode builds from a state, of the same state), built once when first
+asked. The episode builds its problems in the domain's model (`episode/domain.py`), so a
+search episode does not import UP.
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@ UP counterpart (`to_up`)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from typing import Any
 
 from avs_planner.pddl.lite.actions import InstantaneousAction
@@ -103,6 +103,10 @@ class Problem:
         self._actions[action.name] = action
         for parameter in action.parameters:
             self._add_user_type(parameter.type)
+
+    def add_actions(self, actions: Iterable[InstantaneousAction]) -> None:
+        for action in actions:
+            self.add_action(action)
 
     def set_initial_value(self, fluent: Any, value: Any) -> None:
         fluent_exp, value_exp = self._env.expression_manager.auto_promote(fluent, value)
