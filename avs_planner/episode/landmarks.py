@@ -35,6 +35,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -88,10 +89,10 @@ class RoomLandmarks:
     """Landmarks in the frames the skills take, confirmed by hits against misses."""
 
     def __init__(self, context: SkillContext, labels: Sequence[str],
-                 known_near: Callable[[SeenLike], bool], views: Glimpses,
+                 known_near: Callable[[Any], bool], views: Glimpses,
                  model: LandmarkModel | None = None) -> None:
         self.context, self.labels = context, tuple(labels)
-        self.known_near = known_near
+        self.known_near = known_near  # reads `label` and `position` (a sighting, a candidate)
         self.views = views  # the frames' geometry: field of view, range, line of sight
         self.model = model or LandmarkModel()
         self.agree = context.config.agree[1]
@@ -166,8 +167,7 @@ class RoomLandmarks:
         if room is None:
             return
         self.candidates.remove(c)
-        if any(o.label == c.label and math.dist(o.position[:2], c.position[:2])
-               <= self.context.config.same_object for o in mind.objects.values()):
+        if self.known_near(c):
             return
         obj = mind.add_object(c.label, c.position, room=room)
         self.confirmed += 1
