@@ -91,7 +91,7 @@ class ConeSets:
             if support is None:
                 return StepOutcome(StepStatus.FAILED, f"{location} is not a known object")
             if p is None:  # on it and in it, where the knowledge puts the label
-                p = p_at_support(mind, label, location)
+                p = p_at_support(mind, label, location, self._another(label))
             made = (self.support_views is None and self.qsr_cones
                     and self.qsr_cones.support_cones(label, support, p, key)) or \
                 (self.support_views or partial(support_cones, relations=support_relations(
@@ -100,7 +100,7 @@ class ConeSets:
             if location not in mind.place_map.rooms:
                 return StepOutcome(StepStatus.FAILED, f"{location} is not a known room")
             if p is None:
-                p = mind.cmap.p_object_at(label, location)
+                p = mind.cmap.p_object_at(label, location, another=self._another(label))
             made = (self.qsr_cones and self.qsr_cones.room_cones(label, location, p, key)) or \
                 room_cones(mind, location, label, p, camera, key)
         self.cones[(label, relation, location)] = made
@@ -113,14 +113,20 @@ class ConeSets:
             return StepOutcome(StepStatus.FAILED, "no view cone reachable")
         return StepOutcome(StepStatus.DONE, f"{len(made.cones)} cones")
 
+    def _another(self, label: str) -> bool:
+        """The task wants one more `label` beyond those reported (`Probabilities.another`)."""
+        task = self.context.builder.task
+        return label == task.target and bool(task.exclude)
+
     def location_belief(self, label: str, relation: str, location: str) -> float:
         """The map's P(ObjectAt) of the location itself (not its supports; a support's
         spaces the knowledge puts the label in: on it, in it)."""
         mind = self.context.mind
         try:
             if relation == "on":
-                return p_at_support(mind, label, location)
-            return mind.cmap.p_object_at(label, location, include_sublocations=False)
+                return p_at_support(mind, label, location, self._another(label))
+            return mind.cmap.p_object_at(label, location, include_sublocations=False,
+                                         another=self._another(label))
         except ConceptualError:  # a location the map no longer has: no rescaling
             return 0.0
 

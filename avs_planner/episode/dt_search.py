@@ -178,7 +178,9 @@ class ViewConeSearch:
         builder = self.context.builder
         if self.sensing.glimpses is None or label != builder.task.target:
             return []
-        return [s for s in builder.supports if s != label]
+        # the labels the task also wants: the frame is evidence where it shows none of
+        # them (a confirmed one is the watch's to find, as the robot drives on)
+        return [*builder.task.watch, *(s for s in builder.supports if s != label)]
 
     def _detect_once(self, label: str, relation: str, location: str,
                      also: Sequence[str] = ()) -> SeenLike | None:
@@ -205,6 +207,8 @@ class ViewConeSearch:
                 high = 0.0
             reach = cfg.support_radius
             near = math.dist(seen.position[:2], support.position[:2]) <= reach
+            if near and self.context.builder.task.exclude and self.sensing.known_near(seen):
+                return False  # one reported before: the task wants another one
             return near and top + low <= seen.position[2] <= top + high
         if mind.room_at(seen.position[:2]) != location:
             return False

@@ -110,7 +110,7 @@ class Probabilities:
         prior = float(cmap.room_marginal(obj.room) @ cmap.p_any(label, lam))
         if prior <= 0.0:
             return 1.0
-        return min(1.0, p_at_support(self.mind, label, oid) / prior)
+        return min(1.0, p_at_support(self.mind, label, oid, self.another(label)) / prior)
 
     def settled_on(self, label: str, oid: str) -> bool:
         """The map's belief that `label` is on the known object `oid` (its lambda thinned by
@@ -123,7 +123,13 @@ class Probabilities:
         if all(cmap.objects.remaining(where, label) >= 1.0
                for where in support_spaces(self.mind, label, oid)):
             return False
-        return p_at_support(self.mind, label, oid) < self.config.min_probability
+        return p_at_support(self.mind, label, oid, self.another(label)) \
+            < self.config.min_probability
+
+    def another(self, label: str) -> bool:
+        """The task wants one more `label` beyond those it reported (it counts every
+        instance): a place where one was found is not certain to hold another."""
+        return label == self.task.target and bool(self.task.exclude)
 
     def could_hold(self, room: str) -> bool:
         """Under some category, the target may still be in `room` (on its known supports
@@ -131,7 +137,8 @@ class Probabilities:
         cmap = self.mind.cmap
         if not cmap.graph.has_room(room):
             return False
-        p = cmap.p_object_at_per_category(self.task.target, room)
+        p = cmap.p_object_at_per_category(self.task.target, room,
+                                           another=self.another(self.task.target))
         return float(np.max(p)) >= self.config.min_probability
 
     def support_useful(self, support: str, category: str) -> bool:

@@ -115,22 +115,30 @@ class Sensing:
         if not self.watching:
             return None
         ctx = self.context
-        label = ctx.builder.task.target
+        task = ctx.builder.task
+        label = task.target
         ctx.look(0.0, ahead_tilt(ctx.camera))
         # once a target is confirmed and only waits for the scan to give it a room, what the
         # frame shows of supports no longer matters: confirming a desk seen in passing took
         # a frame (a second) before the target could be reported
         glimpsing = self.glimpses is not None and not self.unplaced
-        labels = [label, *ctx.builder.supports] if glimpsing else [label]
+        wanted = [label, *task.watch]
+        labels = [*wanted, *ctx.builder.supports] if glimpsing else wanted
         frame = ctx.detect(labels)
-        first = [s for s in frame if s.label == label]
         if glimpsing:
             self.glimpse(frame, labels)
-        if not first or self.known_near(first[0]):
-            return None
+        first = [s for s in frame if s.label == label]
+        if not task.watch:
+            if not first or self.known_near(first[0]):
+                return None
+        else:  # the first of the wanted labels (the target before the others) not known yet
+            first = [s for lab in wanted for s in frame
+                     if s.label == lab and not self.known_near(s)][:1]
+            if not first:
+                return None
         seen = first[0]
         again = self.confirm(seen)
-        ctx.emit("observation", label=label, detected=bool(again), watching=True,
+        ctx.emit("observation", label=seen.label, detected=bool(again), watching=True,
                  position=[round(v, 2) for v in seen.position])
         if not again:
             return None
@@ -158,6 +166,15 @@ class Sensing:
             ctx.emit("belief", glimpsed=changed)
         for seen in frame:
             if seen.label == target or self.known_near(seen):
+                continue
+            if seen.label in ctx.builder.task.watch:
+                # a label the task also wants, seen in any frame (the DT's looks too): as
+                # the watch does for the target, with its care (`confirm`'s defaults)
+                again = self.confirm(seen)
+                ctx.emit("observation", label=seen.label, detected=bool(again),
+                         watching=True, position=[round(v, 2) for v in seen.position])
+                if again:
+                    self._keep_wanted(seen)
                 continue
             if ctx.mind.room_at(seen.position[:2]) is None:
                 continue
@@ -212,19 +229,43 @@ class Sensing:
         obj = None
         for seen in list(self.unplaced):
             room = ctx.mind.room_at(seen.position[:2])
-            if room is None and seen.label == ctx.builder.task.target:
+            if room is None and (seen.label == ctx.builder.task.target
+                                 or seen.label in ctx.builder.task.watch):
                 # a target seen through a door is reported from here; its room (evidence
                 # about the room's category) is the nearest known one until it is entered
                 room = ctx.mind.nearest_room(seen.position[:2])
             if room is None:
                 continue
             self.unplaced.remove(seen)
-            obj = ctx.mind.add_object(seen.label, seen.position, room=room)
-            self.found_sids[obj.id] = seen.id
+            found = ctx.mind.add_object(seen.label, seen.position, room=room)
+            self.found_sids[found.id] = seen.id
+            if seen.label != ctx.builder.task.target:
+                self._kept(seen, found)
+                continue
+            obj = found
             self.seen_while_moving[obj.id] = {
                 ("label-of", obj.id, seen.label), ("detected", obj.id),
                 ("related", obj.id, "in", obj.room)}
         return obj
+
+    def _keep_wanted(self, seen: SeenLike) -> None:
+        """A confirmed detection of a label the task also wants becomes a known object in
+        the room it stands in, else the nearest known one (as a target seen through a door)."""
+        mind = self.context.mind
+        room = mind.room_at(seen.position[:2]) or mind.nearest_room(seen.position[:2])
+        if room is None:
+            self.unplaced.append(seen)
+            return
+        obj = mind.add_object(seen.label, seen.position, room=room)
+        self.found_sids[obj.id] = seen.id
+        self._kept(seen, obj)
+
+    def _kept(self, seen: SeenLike, obj: KnownObject) -> None:
+        """A label the task also wants (`SearchTask.watch`) is known now: reported in its
+        own turn (the planner's problem of this turn has no such label)."""
+        self.context.emit("observation", label=seen.label, detected=True, watching=True,
+                          position=[round(v, 2) for v in seen.position], object=obj.id,
+                          wanted=True)
 
     def known_near(self, seen: SeenLike) -> bool:
         """A detection of an object the mind already knows (same label, within

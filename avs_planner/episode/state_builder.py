@@ -30,10 +30,18 @@ from avs_planner.pddl import ProbabilisticProblem
 
 @dataclass(frozen=True)
 class SearchTask:
-    """Report an object of `target`, optionally in a room of `category`."""
+    """Report an object of `target`, optionally in a room of `category`.
+
+    A task of several objects (`harness/tasks.py`) searches for one label at a time and
+    names the others it still wants as `watch`: the detector looks for them too wherever it
+    looks for the target, and one it confirms becomes a known object (reported in its own
+    turn). `exclude`: known objects of the target already reported (a task that counts every
+    instance): the planner does not see them, so it searches for another one."""
 
     target: str
     category: str | None = None
+    watch: tuple[str, ...] = ()
+    exclude: frozenset[str] = frozenset()
 
 
 @dataclass(frozen=True)
@@ -279,6 +287,7 @@ class StateBuilder:
 
     def _known_objects(self) -> list[str]:
         return sorted(o.id for o in self.mind.objects.values() if o.label in self.labels
+                      and o.id not in self.task.exclude
                       and (o.support is None or o.support in self.mind.objects))
 
     def _topology(self, places: set[str], placeholders: set[str], atoms: set[Atom],

@@ -92,17 +92,20 @@ def support_spaces(mind: Mind, label: str, oid: str) -> list[RelatedSpace]:
     return [RelatedSpace(r, oid) for r in relations]
 
 
-def p_at_support(mind: Mind, label: str, oid: str) -> float:
+def p_at_support(mind: Mind, label: str, oid: str, another: bool = False) -> float:
     """P(at least one `label` on or in the known object `oid`, where the knowledge lists it),
     after the looks so far: the lambdas left in its spaces add up under each room
     category before the category belief averages them (one space: the conceptual map's
-    `p_object_at` of it)."""
+    `p_object_at` of it). `another`: one more beyond those found there (a task counting
+    every instance: `ConceptualMap.p_object_at`)."""
     cmap = mind.cmap
     spaces = support_spaces(mind, label, oid)
-    per_space = [cmap.p_object_at_per_category(label, space, include_sublocations=False)
+    per_space = [cmap.p_object_at_per_category(label, space, include_sublocations=False,
+                                               another=another)
                  for space in spaces]
     if len(per_space) == 1:
-        return cmap.p_object_at(label, spaces[0], include_sublocations=False)
+        return cmap.p_object_at(label, spaces[0], include_sublocations=False,
+                               another=another)
     lam = sum(cmap.mass(label, p) for p in per_space)
     room = cmap.objects.objects[oid].room
     return float(cmap.room_marginal(room) @ cmap.p_any(label, lam))

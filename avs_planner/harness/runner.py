@@ -30,6 +30,7 @@ from avs_planner.harness.sim_robot import (
     load_spec,
     open_world,
 )
+from avs_planner.harness.tasks import NOT_NEEDED, TargetOutcome, TaskForm, TaskRun
 from avs_planner.reporting.snapshots import MapSnapshots
 from avs_planner.strategies import SearchContext, Strategy, get_strategy
 from conceptual_map.knowledge import Knowledge, load_knowledge
@@ -41,14 +42,17 @@ Emit = Callable[[dict[str, Any]], None]
 # the 1 m within which two detections of a label are taken for one object)
 REPORT_TOLERANCE = 0.5
 
-_KEYS = {"target", "category", "world", "world_file", "robot", "start_room", "start", "seed",
-         "time_budget_s", "wall_budget_s", "task_id", "output_dir", "pre_explore", "dt_policy",
+_KEYS = {"target", "targets", "mode", "count", "stop_below", "category", "world", "world_file",
+         "robot", "start_room", "start", "seed", "time_budget_s", "wall_budget_s", "task_id",
+         "output_dir", "pre_explore", "dt_policy",
          "strategy", "strategy_options", "generate", "qsr", "record", "view", "strict_labels"}
 
 
 @dataclass(frozen=True)
 class EpisodeSpec:
-    """What to search for, where, with which robot; see `avs_planner.jobs.run_episode`."""
+    """What to search for, where, with which robot; see `avs_planner.jobs.run_episode`.
+    `target` is the task's first label; `task` the whole task (several labels, how they
+    combine: `harness/tasks.py`), None for one label."""
 
     target: str
     world: str = "office"
@@ -72,14 +76,19 @@ class EpisodeSpec:
     # a target the knowledge does not list is refused (else it is searched for with the
     # knowledge's uninformed prior, `Knowledge.with_label`, and a `warning` event)
     strict_labels: bool = False
+    task: TaskForm | None = None
+
+    @property
+    def form(self) -> TaskForm:
+        """The task form (one label: `target`, found once)."""
+        return self.task or TaskForm((self.target,))
 
     @classmethod
     def from_dict(cls, spec: Mapping[str, Any]) -> EpisodeSpec:
         unknown = set(spec) - _KEYS
         if unknown:
             raise EpisodeError(f"episode spec: unknown keys {sorted(unknown)}")
-        if not isinstance(spec.get("target"), str) or not spec["target"]:
-            raise EpisodeError("episode spec: 'target' (an object label) is required")
+        form = TaskForm.from_spec(spec)
         options = spec.get("strategy_options") or {}
         if not isinstance(options, Mapping):
             raise EpisodeError(f"episode spec: 'strategy_options' must be a mapping, got "
@@ -96,7 +105,8 @@ class EpisodeSpec:
                 raise EpisodeError(f"episode spec: 'start' must be [x, y, yaw], got {start!r}")
             start = tuple(_number(v, "start") for v in start)
         return cls(
-            target=spec["target"], world=str(spec.get("world") or "office"),
+            target=form.targets[0], task=form if form.several else None,
+            world=str(spec.get("world") or "office"),
             category=spec.get("category"), robot=spec.get("robot"),
             start_room=spec.get("start_room"), start=start, seed=int(spec.get("seed") or 0),
             time_budget_s=_number(spec.get("time_budget_s", 1200.0), "time_budget_s"),
@@ -212,10 +222,14 @@ class Episode:
         self.world_spec = self._world_spec()
         knowledge = load_knowledge()
         # labels and categories as the knowledge spells them: "CerealBox" is the cerealbox
-        spec = self.spec = replace(spec, target=knowledge.spelled(spec.target),
+        task = spec.task.spelled(knowledge.spelled) if spec.task is not None else None
+        spec = self.spec = replace(spec, target=knowledge.spelled(spec.target), task=task,
                                    category=knowledge.spelled(spec.category)
                                    if isinstance(spec.category, str) else spec.category)
-        knowledge, self.warnings = target_knowledge(knowledge, spec.target, spec.strict_labels)
+        self.warnings = []
+        for label in spec.form.targets:
+            knowledge, warnings = target_knowledge(knowledge, label, spec.strict_labels)
+            self.warnings += warnings
         check_categories(self.world_spec, knowledge.categories)
         self.robot: SimRobot = open_world(self.world_spec, spec.seed, knowledge.categories)
         self.mind = Mind.for_body(self.robot.body(), knowledge)  # its own body, not the world
@@ -225,8 +239,8 @@ class Episode:
                            else None, emit)
         # the strategy's settings, built once: what its executor and state builder run with
         executor_config, builder_config = self._strategy().configs(spec.strategy_options)
-        self.builder = StateBuilder(self.mind, SearchTask(spec.target, spec.category),
-                                    builder_config)
+        self.builder = StateBuilder(self.mind, SearchTask(
+            spec.target, spec.category, watch=spec.form.targets[1:]), builder_config)
         body = self.robot.body()
         self.camera = CameraModel(self.robot.camera_height, body.hfov, body.detect_range,
                                   vfov=body.vfov)
@@ -288,13 +302,20 @@ class Episode:
     def run(self) -> dict[str, Any]:
         try:
             self.trace.emit("start", target=self.spec.target, world=self.world_spec.name,
+                            **self._task_fields(),
                             robot=self.robot.model, pose=list(self.robot.pose),
                             seed=self.spec.seed, strategy=self.spec.strategy)
             for warning in self.warnings:
                 self.trace.emit("warning", **warning)
             start_clock, start_distance = self._pre_explore()
-            result = self._strategy().load()(self.context)
-            summary = self.summary(result, start_clock, start_distance)
+            search = self._strategy().load()
+            targets = None
+            if self.spec.task is not None:
+                task = TaskRun(self.spec.task, self.context, search).run()
+                result, targets = task.result, task.targets
+            else:
+                result = search(self.context)
+            summary = self.summary(result, start_clock, start_distance, targets)
             if self.out is not None:
                 write_summary(self.out / "summary.json", summary)
                 self._explanation()
@@ -327,21 +348,21 @@ class Episode:
         self.context.start_clock = self.robot.clock
         return self.robot.clock, self.executor.stats.distance
 
-    def summary(self, result: SearchResult, start_clock: float, start_distance: float
-                ) -> dict[str, Any]:
+    def summary(self, result: SearchResult, start_clock: float, start_distance: float,
+                targets: list[TargetOutcome] | None = None) -> dict[str, Any]:
         stats = self.executor.stats
-        found = result.found
-        obj = None
-        if found is not None:
-            sid = self.executor.found_sids.get(found.id)
-            obj = {"id": found.id, "label": found.label,
-                   "position": [round(v, 3) for v in found.position],
-                   "room": found.room, "truth": self._truth_of(sid, found.position)}
+        obj = None if result.found is None else self._report(result.found)
+        task: dict[str, Any] = {}
+        correct = bool(obj and obj["correct"])
+        if targets is not None:
+            parts = [self._target_part(t, start_clock) for t in targets]
+            reports = [o for part in parts for o in part["objects"]]
+            correct = bool(reports) and all(o["correct"] for o in reports)
+            task = {**self._task_fields(), "targets": parts}
         return {
             "outcome": result.outcome.value, "reason": result.reason,
-            "target": self.spec.target, "category": self.spec.category, "object": obj,
-            "correct": bool(obj and obj["truth"] and self._truth_label(obj["truth"])
-                            == self.spec.target),
+            "target": self.spec.form.name, "category": self.spec.category, "object": obj,
+            "correct": correct, **task,
             "sim_time_s": round(self.robot.clock - start_clock, 2),
             "distance_m": round(stats.distance - start_distance, 2),
             "plans": result.plans, "replans": result.replans,
@@ -355,6 +376,40 @@ class Episode:
             "wall_time_s": round(self.trace.wall, 2),
             **self._map_score(),
         }
+
+    def _task_fields(self) -> dict[str, Any]:
+        """A task of several: its form (`harness/tasks.py`); nothing for one label."""
+        form = self.spec.task
+        if form is None:
+            return {}
+        return {"task": {"targets": list(form.targets), "mode": form.mode, "count": form.count,
+                         **({"stop_below": form.stop_below} if form.count == "all" else {})}}
+
+    def _report(self, found: Any) -> dict[str, Any]:
+        """A reported object, with the world entry it names (scoring only) and whether that
+        is an instance of the reported label."""
+        sid = self.executor.found_sids.get(found.id)
+        truth = self._truth_of(sid, found.position, found.label)
+        return {"id": found.id, "label": found.label,
+                "position": [round(v, 3) for v in found.position], "room": found.room,
+                "truth": truth,
+                "correct": bool(truth and self._truth_label(truth) == found.label)}
+
+    def _target_part(self, target: TargetOutcome, start_clock: float) -> dict[str, Any]:
+        """One target's part of a task's summary: its outcome, the reports (checked against
+        the world: scoring only), the true instances in the world and how many distinct ones
+        the reports name."""
+        objects = [self._report(obj) for obj in target.found]
+        instances = sum(1 for thing in self.robot.world.detectables
+                        if thing.label == target.label)
+        return {"label": target.label,
+                "outcome": target.outcome.value if target.outcome else NOT_NEEDED,
+                "reason": target.reason, "objects": objects,
+                "sim_time_s": None if target.ended_at is None
+                else round(target.ended_at - start_clock, 2),
+                "turns": target.turns, "instances": instances,
+                "distinct": len({o["truth"] for o in objects if o["correct"]}),
+                "correct": all(o["correct"] for o in objects)}
 
     def _map_score(self) -> dict[str, Any]:
         """{"map_score": ...}: the mind's rooms scored against the world file's (the harness
@@ -370,17 +425,19 @@ class Episode:
         results = [e.get("result") for e in self.trace.events if e["type"] == "dt"]
         return {f"dt_{status}": results.count(status) for status in ("confirmed", "rejected")}
 
-    def _truth_of(self, sid: int | None, position: tuple[float, float, float]) -> str | None:
+    def _truth_of(self, sid: int | None, position: tuple[float, float, float],
+                  label: str | None = None) -> str | None:
         """The world entry a report names (scoring only: the robot never sees this). The
         detection it was made from says, when that was of the target; otherwise the nearest
         target instance within `REPORT_TOLERANCE` m of the reported spot does: the first frame
         of a confirmed detection may be a phantom beside the real object that the frames
         confirming and verifying it saw, and the report then still names the object."""
+        label = label or self.spec.target
         named = self.robot.truth_of.get(sid) if sid is not None else None
-        if named is not None and self._truth_label(named) == self.spec.target:
+        if named is not None and self._truth_label(named) == label:
             return named
         near = [(math.dist(thing.center, position), thing.name)
-                for thing in self.robot.world.detectables if thing.label == self.spec.target]
+                for thing in self.robot.world.detectables if thing.label == label]
         near = [entry for entry in near if entry[0] <= REPORT_TOLERANCE]
         return min(near)[1] if near else named
 
@@ -403,4 +460,4 @@ class Episode:
 
         assert self.out is not None
         draw_trajectory(self.mind, self.executor.stats, self.out / "trajectory.png",
-                        title=f"{self.spec.target} in {self.world_spec.name}")
+                        title=f"{self.spec.form.name} in {self.world_spec.name}")

@@ -36,6 +36,10 @@ class SearchContext:
     dump_dir: str | None = None
     start_clock: float = 0.0
     qsr: Any = None  # QsrKnowledge with the task's own QSR descriptions, or None (defaults)
+    # a task counting every instance (`harness/tasks.py`) stops when P(another one in space
+    # not yet searched) falls below this level, the task's own; a strategy with a give-up rule
+    # of its own (weighing the reward against costs) leaves the stop to that level
+    stop_below: float | None = None
 
     def budget_spent(self) -> str | None:
         """Why the search must stop now (a request, the simulated or wall budget), or None."""

@@ -313,39 +313,45 @@ class ConceptualMap:
         return posterior.mass(p)
 
     def p_object_at(
-        self, label: str, location: Location | tuple[str, str], include_sublocations: bool = True
+        self, label: str, location: Location | tuple[str, str], include_sublocations: bool = True,
+        *, another: bool = False,
     ) -> float:
         """P(ObjectAt L): at least one `label` at a room (with its related spaces) or related space.
 
         Sums, under each room category, the lambdas left unseen by searches over L and (for a
         room) the in/on spaces of its known objects that the knowledge lists for `label`, then
-        averages 1 - exp(-lambda) over the category belief.
+        averages 1 - exp(-lambda) over the category belief. `another`: one more beyond those
+        found (a task counting every instance): found ones do not make it 1, the unseen
+        lambda alone counts (Poisson counts in disjoint parts are independent).
         """
         location = _as_location(location)
-        residual = self._residual(label, location, include_sublocations)
+        residual = self._residual(label, location, include_sublocations, another)
         if residual is None:
             return 1.0
         return float(self.room_marginal(self._room_of(location)) @ self.p_any(label, residual))
 
     def p_object_at_per_category(
-        self, label: str, location: Location | tuple[str, str], include_sublocations: bool = True
+        self, label: str, location: Location | tuple[str, str], include_sublocations: bool = True,
+        *, another: bool = False,
     ) -> np.ndarray:
         """`p_object_at` under each room category (`knowledge.categories` order), before
-        the category belief averages it: 1 where a `label` was seen there."""
-        residual = self._residual(label, _as_location(location), include_sublocations)
+        the category belief averages it: 1 where a `label` was seen there (unless
+        `another`, as in `p_object_at`)."""
+        residual = self._residual(label, _as_location(location), include_sublocations, another)
         if residual is None:
             return np.ones(len(self.knowledge.categories))
         return self.p_any(label, residual)
 
-    def _residual(self, label: str, location: Location, include_sublocations: bool
-                  ) -> np.ndarray | None:
+    def _residual(self, label: str, location: Location, include_sublocations: bool,
+                  another: bool = False) -> np.ndarray | None:
         """Per category, the lambda of `label` left unseen by searches over the location
-        (and a room's in/on spaces); None where a `label` was seen there."""
+        (and a room's in/on spaces); None where a `label` was seen there (unless `another`:
+        then the unseen lambda, whatever was found)."""
         room = self._room_of(location)
         places = [location]
         if include_sublocations and not isinstance(location, RelatedSpace):
             places += self.objects.sublocations(room, label)
-        if any(self.objects.count(place, label) for place in places):
+        if not another and any(self.objects.count(place, label) for place in places):
             return None
         return sum(
             self.objects.location_lambda(label, place) * self.objects.remaining(place, label)

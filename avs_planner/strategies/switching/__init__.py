@@ -14,6 +14,7 @@ weighting in a comparison (the extra labels change the detector's noise draws)."
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 from avs_planner.episode.errors import EpisodeError
@@ -42,6 +43,11 @@ def run(ctx: SearchContext) -> SearchResult:
             qsr.weighting = mode == "on"
     config = loop_config(options, time_budget_s=ctx.time_budget_s,
                          wall_budget_s=ctx.wall_budget_s, dump_dir=ctx.dump_dir)
+    if ctx.stop_below is not None:
+        # counting every instance: the task's level decides when to stop (the caller ends
+        # the search there), not the reward against costs; a plan still needs the CP's
+        # success threshold
+        config = replace(config, worth_test=False, stop_rule=False)
     loop = SwitchingLoop(ctx.builder, ctx.executor, ctx.trace, config, ctx.should_stop)
     loop.start_clock = ctx.start_clock
     return loop.run()
