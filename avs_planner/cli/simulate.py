@@ -30,9 +30,18 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--style", help="generated world style "
                         "(office, apartment, lab; default office)")
     parser.add_argument("--rooms", type=int, help="generated world: number of rooms")
-    parser.add_argument("--target", help="object label to find, e.g. cerealbox; a label the "
+    parser.add_argument("--target", action="append", default=None, metavar="LABEL",
+                        help="object label to find, e.g. cerealbox; a label the "
                         "knowledge does not list is searched for with its uninformed prior "
-                        "(see domains/README.md), with a warning in the trace")
+                        "(see domains/README.md), with a warning in the trace. Repeat it for "
+                        "a task of several objects (docs/tasks.md)")
+    parser.add_argument("--mode", choices=["all", "any"], help="with several --target: find "
+                        "one of each (all, the default) or stop at the first of any")
+    parser.add_argument("--count", choices=["one", "all"], help="all: find every instance of "
+                        "the one --target, until P(another one unseen) < --stop-below")
+    parser.add_argument("--stop-below", type=float, metavar="P", help="with --count all: the "
+                        "probability of another one unseen at which the search stops "
+                        "(default 0.1)")
     parser.add_argument("--strict-labels", action="store_true", help="refuse a target label "
                         "the knowledge does not list (exit 1) instead of searching for it with "
                         "the uninformed prior")
@@ -104,7 +113,9 @@ def _check_label(spec: Any) -> None:
         from avs_planner.harness.runner import target_knowledge
         from conceptual_map.knowledge import load_knowledge
 
-        target_knowledge(load_knowledge(), spec.target, strict=True)
+        knowledge = load_knowledge()
+        for label in spec.form.targets:
+            target_knowledge(knowledge, label, strict=True)
 
 
 def _check_start(spec: Any) -> None:
@@ -146,8 +157,8 @@ def _check_flags(args: argparse.Namespace) -> None:
 def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
     _check_flags(args)
     spec = dict(base)
-    for key, value in (("world", args.world), ("target", args.target),
-                       ("category", args.category), ("robot", args.robot),
+    _task(args, spec)
+    for key, value in (("world", args.world), ("category", args.category), ("robot", args.robot),
                        ("seed", args.seed), ("time_budget_s", args.time_budget)):
         if value is not None:
             spec[key] = value
@@ -175,12 +186,31 @@ def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
         spec["record"] = True
     if args.view:
         spec["view"] = True
-    if not spec.get("target"):
+    if not spec.get("target") and not spec.get("targets"):
         raise ValueError("--target LABEL (or --scenario) is required")
     if args.out is None:
         args.out = str(_fresh_out(spec))
     spec["output_dir"] = args.out
     return spec
+
+
+def _task(args: argparse.Namespace, spec: dict[str, Any]) -> None:
+    """--target (once, or repeated for a task of several), --mode, --count, --stop-below into
+    the spec (a scenario's own target is replaced by the flags')."""
+    labels = args.target or []
+    if len(labels) > 1:
+        spec.pop("target", None)
+        spec["targets"] = labels
+    elif labels:
+        spec.pop("targets", None)
+        spec["target"] = labels[0]
+    for key, value in (("mode", args.mode), ("count", args.count),
+                       ("stop_below", args.stop_below)):
+        if value is not None:
+            spec[key] = value
+    if args.mode is not None and len(labels) < 2 and not spec.get("targets"):
+        raise ValueError("--mode combines several objects: repeat --target (e.g. --target "
+                         "cup --target book --mode any)")
 
 
 def _fresh_out(spec: dict[str, Any], root: Path = Path("runs")) -> Path:
@@ -190,7 +220,8 @@ def _fresh_out(spec: dict[str, Any], root: Path = Path("runs")) -> Path:
         world = f"gen-{gen.get('style', 'office')}-{gen.get('seed')}"
     else:
         world = Path(str(spec.get("world") or "office")).stem
-    stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", f"{world}-{spec['target']}")
+    what = spec.get("target") or "+".join(spec.get("targets") or ())
+    stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", f"{world}-{what}")
     out, n = root / stem, 1
     while out.exists():
         n += 1
@@ -268,7 +299,18 @@ def _print_summary(summary: dict[str, Any], out: Path) -> None:
     found = (f"found {obj.get('label')} at ({obj['position'][0]:.2f}, {obj['position'][1]:.2f})"
              f" in {obj.get('room')}" if obj else summary["outcome"].replace("_", " "))
     cp = summary["cp_time_s"]
+    if summary.get("targets"):
+        found = summary["outcome"].replace("_", " ")
     print(f"{summary['target']}: {found} ({summary['reason']})")
+    for part in summary.get("targets") or ():
+        where = "; ".join(f"{o['label']} at ({o['position'][0]:.2f}, {o['position'][1]:.2f}) "
+                          f"in {o['room']}" for o in part["objects"])
+        when = "" if part["sim_time_s"] is None else f" at {part['sim_time_s']:.1f} s"
+        if part["outcome"] == "not_needed":
+            print(f"  {part['label']}: {part['reason']}")
+            continue
+        print(f"  {part['label']}: {part['outcome'].replace('_', ' ')}{when}"
+              + (f": {where}" if where else f" ({part['reason']})"))
     print(f"  simulated {summary['sim_time_s']:.1f} s, drove {summary['distance_m']:.1f} m, "
           f"{summary['plans']} plans (CP {sum(cp):.2f} s), {summary['dt_calls']} DT searches "
           f"({summary.get('dt_confirmed', 0)} confirmed, {summary.get('dt_rejected', 0)} "
