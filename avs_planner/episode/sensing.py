@@ -30,6 +30,8 @@ from avs_planner.episode.viewcones import CameraModel
 Pose = tuple[float, float, float]
 
 
+SAME_SPOT = 0.05  # m: a look around this near where a task's turn began is the turn's first
+
 class Sensing:
     """Scans, looks and confirms for the executor (see the module's doc)."""
 
@@ -38,6 +40,9 @@ class Sensing:
         self.context = context
         self.found_sids = found_sids
         self.watching = watching  # the detector looks for the target as the robot moves
+        # where a task's next turn began (`harness/tasks.py`): a look around before the
+        # robot has left that spot is skipped (`look_around`)
+        self.resumed: tuple[float, float] | None = None
         self.glimpses: Glimpses | None = None
         self.unplaced: list[SeenLike] = []  # confirmed, waiting for the map to give a room
         self.seen_while_moving: dict[str, set[Atom]] = {}
@@ -59,6 +64,14 @@ class Sensing:
         updated once, after both scans). The detector watches in `look_headings` directions
         spread evenly over the turn (2: ahead and behind)."""
         ctx = self.context
+        resumed, self.resumed = self.resumed, None
+        if resumed is not None and math.dist(resumed, ctx.robot.pose[:2]) <= SAME_SPOT:
+            # a task's next turn, the robot where the last one left it: the map is there,
+            # and every frame of the turns before (driving, looking round, the DT's looks)
+            # watched for this turn's label too
+            ctx.emit("belief", looked_around="skipped: a task's next turn, whose label the "
+                                             "frames so far watched for")
+            return
         headings = max(2, ctx.config.look_headings)
         yaw = ctx.robot.pose[2]
         ctx.mind.integrate(ctx.robot.scan())

@@ -35,6 +35,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from avs_planner.cp.search import DEFAULT_REWARD
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.mind import KnownObject
 from avs_planner.episode.outcome import Outcome, SearchResult
@@ -210,6 +211,8 @@ class TaskRun:
         self.reported: set[str] = set()
         self.builders: dict[str, StateBuilder] = {ctx.builder.task.target: ctx.builder}
         self.result = SearchResult(Outcome.GAVE_UP, "")
+        self.turns = 0
+        self.turns_look: tuple[float, float] | None = None  # where the task looked round first
 
     # ---- the turns ---------------------------------------------------------------------
 
@@ -218,14 +221,19 @@ class TaskRun:
         ctx.trace.emit("task", targets=list(self.form.targets), mode=self.form.mode,
                        count=self.form.count, stop_below=self.form.stop_below
                        if self.form.count == "all" else None)
-        turns = 0
+        if not ctx.mind.place_map.rooms:
+            # the first look around, watching for every label, so that the first turn's
+            # label is chosen on a map; the first turn's strategy does not repeat it
+            ctx.executor.context.builder = self._builder(self.form.targets[0],
+                                                         self.form.targets[1:])
+            ctx.executor.look_around()
+            self.turns_look = tuple(ctx.robot.pose[:2])
         while not self._over():
             stop = ctx.budget_spent()
             if stop:
                 self._close_open(Outcome.TIMEOUT, stop)
                 break
-            turns += 1
-            if turns > MAX_TURNS:  # a safety net: every turn reports, closes or times out
+            if self.turns >= MAX_TURNS:  # a safety net: every turn reports, closes or times out
                 self._close_open(Outcome.GAVE_UP, f"{MAX_TURNS} turns taken")
                 break
             label = self.next_label()
@@ -251,9 +259,15 @@ class TaskRun:
         watch = tuple(other for other in self._open() if other != label)
         builder = self._builder(label, watch)
         ctx.executor.context.builder = builder
+        ctx.executor.sensing.take_seen()  # atoms of another label's problem: known objects now
         turn = _Turn(self, label, watch)
         target = self.outcomes[label]
         target.turns += 1
+        # a turn after the first goes on from where the robot stands: the strategy's first
+        # look around is skipped (`Sensing.resumed`)
+        ctx.executor.sensing.resumed = tuple(ctx.robot.pose[:2]) \
+            if self.turns or self.turns_look else None
+        self.turns += 1
         ctx.trace.emit("turn", target=label, status="start", watch=list(watch),
                        found=len(target.found))
         sub = replace(ctx, target=label, builder=builder, should_stop=turn,
@@ -304,8 +318,8 @@ class TaskRun:
         return None
 
     def next_label(self) -> str:
-        """The open label a known, unreported object has (the nearest), else the one the
-        mapped rooms most likely still hold (see the module's doc)."""
+        """The open label a known, unreported object has (the nearest), else the one whose
+        search is worth most going on from here (see the module's doc)."""
         open_ = self._open()
         ctx = self.ctx
         here = ctx.robot.pose[:2]
@@ -314,16 +328,22 @@ class TaskRun:
                  if obj.label in open_ and obj.id not in self.reported]
         if known:
             return min(known)[2]
-        return max(open_, key=lambda label: (self.p_mapped(label), -open_.index(label)))
+        if len(open_) == 1 or not ctx.mind.place_map.rooms:
+            return open_[0]
+        return max(open_, key=lambda label: (self.worth(label), -open_.index(label)))
 
-    def p_mapped(self, label: str) -> float:
-        """P(at least one `label` in the mapped rooms' space not yet searched)."""
-        cmap = self.ctx.mind.cmap
-        rooms = [r for r in self.ctx.mind.place_map.rooms if cmap.graph.has_room(r)]
-        if not rooms:  # nothing mapped yet (the task's first turn)
-            return 0.0
-        mass = sum(float(cmap.mass(label, cmap.p_unsearched(label, r))) for r in rooms)
-        return float(cmap.p_any(label, mass))
+    def worth(self, label: str) -> float:
+        """What searching on for `label` from here is worth at most: over the cost bounds c
+        of the conceptual map's options (rooms not searched through, what placeholders may
+        lead to: `stopping.remaining`), the largest R x P(found within c) - c, R the reward
+        the strategy plans with (the switching planner's objective; the stopping rule's
+        bound on any continuation)."""
+        ctx = self.ctx
+        reward = float(ctx.options.get("reward", DEFAULT_REWARD))
+        self._builder(label, ())
+        belief = remaining(ctx.mind, self.builders[label], ctx.robot.pose[:2],
+                           look_cost(ctx.mind.body, ctx.executor.config.look_headings))
+        return max((reward * p - cost for cost, p in belief.within), default=-math.inf)
 
     def p_another(self, label: str) -> float:
         """P(another `label` in space not yet searched, mapped or beyond the frontiers)."""
