@@ -10,9 +10,11 @@ from pydantic import (
     ConfigDict,
     Field,
     StringConstraints,
+    ValidationError,
     field_validator,
     model_validator,
 )
+from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from api.limits import (
     flatten_strings,
@@ -27,12 +29,23 @@ NAME_PATTERN = r"^[A-Za-z][A-Za-z0-9_-]{0,63}$"
 MAX_TEXT = 500_000
 OptionValue = bool | int | float | Annotated[str, Field(max_length=200)] | None
 OptionName = Annotated[str, StringConstraints(pattern=NAME_PATTERN)]
-# "exactly one of world / world_file / generate" for clients reading the schema (a present
-# null counts as absent, as the service reads it)
-_ONE_WORLD = {"oneOf": [
-    {"required": [name], "properties": {name: {"not": {"type": "null"}}}}
-    for name in ("world", "world_file", "generate")
-]}
+Label = Annotated[str, StringConstraints(pattern=NAME_PATTERN)]
+# a task's form, as the episode runner reads it (avs_planner/harness/tasks.py: MAX_TARGETS,
+# STOP_BELOW; tests/api/test_api_task_forms.py checks that they agree)
+MAX_TARGETS = 8
+STOP_BELOW = 0.1
+
+
+def _exactly_one(*names: str) -> dict[str, Any]:
+    """`oneOf` branches saying exactly one of `names` is given (a present null counts as
+    absent, as the service reads it), for clients reading the schema."""
+    return {"oneOf": [{"required": [name], "properties": {name: {"not": {"type": "null"}}}}
+                      for name in names]}
+
+
+# exactly one of world / world_file / generate, and one of target / targets
+_ONE_WORLD = _exactly_one("world", "world_file", "generate")
+_TASK_SCHEMA = {**_ONE_WORLD, "allOf": [_exactly_one("target", "targets")]}
 
 
 def world_file_problem(text: str) -> str | None:
@@ -86,16 +99,36 @@ class GeneratedWorld(BaseModel):
 
 
 class TaskCreate(BaseModel):
-    """Find `target` (a label) [in a room of `category`] in a world, with a robot.
+    """Find `target` (a label), or the `targets` (several labels, `mode` all or any), or
+    every instance of one label (`count: all`) [in a room of `category`] in a world, with a
+    robot.
 
-    Give exactly one of `world`, `world_file` and `generate`, and at most one of `start` and
-    `start_room`. Checked at submission against the knowledge base (category; target when
-    `strict_labels`), the world (start room, start pose free and inside a room) and the
-    strategy registry: 422 naming the field."""
+    Give exactly one of `target` and `targets`, exactly one of `world`, `world_file` and
+    `generate`, and at most one of `start` and `start_room`. Checked at submission against the
+    knowledge base (category; every target label when `strict_labels`), the world (start room,
+    start pose free and inside a room) and the strategy registry: 422 naming the field."""
 
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, json_schema_extra=_ONE_WORLD)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False,
+                              json_schema_extra=_TASK_SCHEMA)
 
-    target: str = Field(pattern=NAME_PATTERN, examples=["cerealbox"])
+    target: str | None = Field(
+        None, pattern=NAME_PATTERN, description="one object label (or give `targets`)",
+        examples=["cerealbox"])
+    targets: list[Label] | None = Field(
+        None, min_length=1, max_length=MAX_TARGETS,
+        description=f"several object labels, each once, at most {MAX_TARGETS} (or give "
+        "`target`): the task ends when one object of each is reported (`mode: all`) or the "
+        "first of any (`mode: any`)", examples=[["cup", "stapler"]])
+    mode: Literal["all", "any"] = Field(
+        "all", description="how `targets` combine: `all` finds one object of each label, "
+        "`any` ends at the first object of any of them")
+    count: Literal["one", "all"] = Field(
+        "one", description="`one`: report one object per label; `all`: every instance of "
+        "the one label given (the task stops when P(another one in space not yet searched) "
+        "falls below `stop_below`)")
+    stop_below: float | None = Field(
+        None, gt=0, lt=1, description=f"with `count: all` only: the probability of another "
+        f"instance below which the count stops; default {STOP_BELOW}", examples=[0.1])
     category: str | None = Field(None, pattern=NAME_PATTERN, examples=["kitchen"])
     world: str | None = Field(None, pattern=NAME_PATTERN, description="a built-in world name")
     world_file: str | None = Field(
@@ -163,6 +196,146 @@ class TaskCreate(BaseModel):
             raise ValueError("give at most one of 'start' and 'start_room'")
         return self
 
+    @model_validator(mode="after")
+    def _task_form(self) -> TaskCreate:
+        """The task form's rules (those of the episode runner's `TaskForm.from_spec`), each
+        error located at the field it is about."""
+        errors = task_form_problems(self.target, self.targets, self.count, self.stop_below)
+        if errors:
+            raise ValidationError.from_exception_data(type(self).__name__, [
+                InitErrorDetails(type=PydanticCustomError(kind, message), loc=(name,),
+                                 input=getattr(self, name))
+                for name, kind, message in errors])
+        return self
+
+    def as_request(self) -> dict[str, Any]:
+        """The task as stored and given to the episode runner: the body with defaults filled
+        in, less the task-form keys it does not use. A task of one label found once reads as
+        it did before `targets` existed (`target`, no `mode` or `count` at their defaults);
+        `targets` tasks keep `mode` and `count`; `stop_below` only when given."""
+        request = self.model_dump(mode="json")
+        for key in ("target", "targets", "stop_below"):
+            if request[key] is None:
+                del request[key]
+        if self.targets is None and self.count == "one":
+            for key, default in (("mode", "all"), ("count", "one")):
+                if request[key] == default:
+                    del request[key]
+        return request
+
+
+def task_form_problems(target: str | None, targets: list[str] | None, count: str,
+                       stop_below: float | None) -> list[tuple[str, str, str]]:
+    """(field, error type, message) for each rule of a task's form the values break: one of
+    `target` and `targets`, each label once, `count: all` with one label, `stop_below` with
+    `count: all` only (types and ranges are the fields' own)."""
+    errors = []
+    if target is not None and targets is not None:
+        errors.append(("targets", "value_error", "give 'target' (one label) or 'targets' (a "
+                       "list), not both"))
+    elif target is None and targets is None:
+        errors.append(("target", "missing", "Field required: give 'target' (one object "
+                       "label) or 'targets' (a list of labels)"))
+    if targets is not None:
+        twice = sorted({t for t in targets if targets.count(t) > 1})
+        if twice:
+            errors.append(("targets", "value_error", f"'targets' names {', '.join(twice)} "
+                           f"more than once (to find every instance, use count: all)"))
+        if count == "all" and len(targets) != 1:
+            errors.append(("count", "value_error", f"'count: all' finds every instance of "
+                           f"one label; 'targets' names {len(targets)}"))
+    if stop_below is not None and count != "all":
+        errors.append(("stop_below", "value_error", "'stop_below' applies to 'count: all' "
+                       "only"))
+    return errors
+
+
+def task_name(targets: list[str], mode: str = "all", count: str = "one") -> str:
+    """The task in a few words, as the episode's summary names it (`TaskForm.name`): "cup",
+    "cup and book", "cup or glass", "every chair"."""
+    if count == "all":
+        return f"every {targets[0]}"
+    if len(targets) == 1:
+        return targets[0]
+    joint = " and " if mode == "all" else " or "
+    return ", ".join(targets[:-1]) + joint + targets[-1]
+
+
+class TaskFormPublic(BaseModel):
+    """What a task asks for: its target labels, how they combine, and its name."""
+
+    targets: list[str] = Field(description="the target labels (one for a `target` task)")
+    mode: Literal["all", "any"] = Field(description="`all`: one object of each label; `any`: "
+                                        "the first object of any of them")
+    count: Literal["one", "all"] = Field(description="`all`: every instance of the label")
+    stop_below: float | None = Field(None, description="with `count: all`: the level P(another "
+                                     "one) must fall below (the default when not given)")
+    name: str = Field(description="the task in a few words, as the summary's `target` names "
+                      "it", examples=["cup and stapler"])
+    several: bool = Field(description="more than one object may be reported (several labels "
+                          "or `count: all`): the summary has `targets`")
+
+    @classmethod
+    def of_request(cls, request: dict[str, Any]) -> TaskFormPublic | None:
+        """The form of a stored request (any version: older ones have `target` only); None
+        when it names no target."""
+        targets = request.get("targets")
+        if not isinstance(targets, list) or not targets:
+            target = request.get("target")
+            targets = [target] if isinstance(target, str) and target else None
+        if targets is None or not all(isinstance(t, str) for t in targets):
+            return None
+        mode = request.get("mode") if request.get("mode") in ("all", "any") else "all"
+        count = request.get("count") if request.get("count") in ("one", "all") else "one"
+        stop = request.get("stop_below")
+        stop_below = (float(stop) if isinstance(stop, int | float) else STOP_BELOW) \
+            if count == "all" else None
+        return cls(targets=list(targets), mode=mode, count=count, stop_below=stop_below,
+                   name=task_name(targets, mode, count),
+                   several=len(targets) > 1 or count == "all")
+
+
+class ReportedObject(BaseModel):
+    """An object the robot reported, with the world entry it names (scoring only)."""
+
+    id: str
+    label: str
+    position: list[float] = Field(description="x, y, z (m)")
+    room: str | None = None
+    truth: str | None = Field(None, description="the world's object the report names (the "
+                              "robot never sees this)")
+    correct: bool = Field(description="the report names a true instance of its label")
+
+
+class TargetPublic(BaseModel):
+    """One target label's part of a finished task of several (the summary's `targets`)."""
+
+    label: str
+    outcome: str = Field(description="`found`, `gave_up`, `timeout` or `not_needed` (a task of "
+                         "`mode: any` ended before this label's turn)", examples=["found"])
+    reason: str = ""
+    objects: list[ReportedObject] = Field(default_factory=list,
+                                          description="the objects reported for it")
+    sim_time_s: float | None = Field(None, description="simulated seconds from the start "
+                                     "when its part ended (null: never)")
+    turns: int = Field(0, description="turns the robot spent searching for it")
+    instances: int | None = Field(None, description="true instances in the world (scoring "
+                                  "only)")
+    distinct: int | None = Field(None, description="distinct true instances the reports name")
+    correct: bool | None = Field(None, description="every report names a true instance")
+
+    @classmethod
+    def of_summary(cls, summary: dict[str, Any] | None) -> list[TargetPublic] | None:
+        """The summary's `targets`, or None when it has none (a task of one label found
+        once) or they are not in the expected shape."""
+        parts = (summary or {}).get("targets")
+        if not isinstance(parts, list):
+            return None
+        try:
+            return [cls.model_validate(part) for part in parts]
+        except ValidationError:
+            return None
+
 
 class TaskPublic(BaseModel):
     """A task as clients see it."""
@@ -170,6 +343,11 @@ class TaskPublic(BaseModel):
     id: str
     state: TaskState
     request: dict[str, Any]
+    task: TaskFormPublic | None = Field(None, description="what the task asks for (from `request`)")
+    targets: list[TargetPublic] | None = Field(
+        None, description="once a task of several (several labels or `count: all`) ended: "
+        "each label's part, from the summary's `targets`; null otherwise (a task of one label "
+        "has the summary's `outcome` and `object`)")
     created_at: float
     started_at: float | None = None
     finished_at: float | None = None

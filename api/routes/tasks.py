@@ -34,7 +34,16 @@ from api.manager import (
     QueueFullError,
     QuotaError,
 )
-from api.schemas import TOO_LARGE, Message, TaskCreate, TaskPublic, TasksPublic, TaskState
+from api.schemas import (
+    TOO_LARGE,
+    Message,
+    TargetPublic,
+    TaskCreate,
+    TaskFormPublic,
+    TaskPublic,
+    TasksPublic,
+    TaskState,
+)
 from api.store import StorageError, TaskRecord
 from api.worlds import world_files, world_path
 
@@ -61,12 +70,16 @@ _ERRORS: dict[int | str, dict[str, Any]] = {
 
 
 def to_public(task: TaskRecord, full: bool = True) -> TaskPublic:
-    """The client's view; lists (`full=False`) elide inline world files to their size."""
+    """The client's view; lists (`full=False`) elide inline world files to their size. The
+    task's form comes from its request, each target's part (a task of several) from its
+    summary."""
     request = task.request
     if not full and isinstance(request.get("world_file"), str):
         request = {**request, "world_file": f"<inline, {len(request['world_file'])} chars>"}
     return TaskPublic(
-        id=task.id, state=task.state, request=request, created_at=task.created_at,
+        id=task.id, state=task.state, request=request,
+        task=TaskFormPublic.of_request(task.request), targets=TargetPublic.of_summary(
+            task.result), created_at=task.created_at,
         started_at=task.started_at, finished_at=task.finished_at, summary=task.result,
         error=task.error, events=task.events, attempts=task.attempts,
     )
@@ -81,7 +94,7 @@ def _invalid(problems: list[tuple[str, str]], where: str = "body") -> HTTPExcept
 
 
 def _unknown_label(problem: Any) -> bool:
-    return problem.field == "target" and "unknown object label" in problem.message
+    return problem.field in ("target", "targets") and "unknown object label" in problem.message
 
 
 def _check_task(body: TaskCreate, request: dict, settings: SettingsDep,
@@ -124,10 +137,11 @@ def create_task(
     checker: TaskCheckerDep,
     idempotency_key: Annotated[str | None, Header(min_length=1, max_length=200)] = None,
 ) -> TaskPublic:
-    """Queue a search for `target`; 202 with the task (poll it or stream its events).
+    """Queue a search for `target` (or the `targets`); 202 with the task (poll it or stream
+    its events).
 
     422 when any field is wrong, checked now against the world and the knowledge base."""
-    request = body.model_dump(mode="json")
+    request = body.as_request()
     _check_task(body, request, settings, checker)
     digest = hashlib.sha256(json.dumps(request, sort_keys=True).encode()).hexdigest()
     try:

@@ -27,7 +27,18 @@
   }
 
   function body() {
-    const out = { world: $("f-world").value, target: $("f-target").value.trim() };
+    const out = { world: $("f-world").value };
+    // one label is a `target`; several (separated by commas) are `targets`, with the mode
+    const labels = $("f-target").value.split(/[\s,]+/).filter(Boolean);
+    if (labels.length > 1) {
+      out.targets = labels;
+      out.mode = $("f-mode").value;
+    } else {
+      out.target = labels[0] || "";
+    }
+    if ($("f-count").value === "all") out.count = "all";
+    const stop = $("f-stop").value.trim();
+    if (stop !== "") out.stop_below = Number(stop);
     const category = $("f-category").value.trim();
     if (category) out.category = category;
     if ($("f-robot").value) out.robot = $("f-robot").value;
@@ -43,7 +54,8 @@
   }
 
   const FIELDS = {
-    world: "f-world", target: "f-target", category: "f-category", robot: "f-robot",
+    world: "f-world", target: "f-target", targets: "f-target", mode: "f-mode", count: "f-count",
+    stop_below: "f-stop", category: "f-category", robot: "f-robot",
     start_room: "f-start-room", start: "f-x", seed: "f-seed", strategy: "f-strategy",
     time_budget_s: "f-budget",
   };
@@ -118,7 +130,7 @@
       const link = el("a", { href: `/tasks/${encodeURIComponent(task.id)}`, text: AVS.shortId(task.id) });
       return el("tr", { "data-id": task.id },
         el("td", {}, link),
-        el("td", { text: r.target + (r.category ? ` (${r.category})` : "") }),
+        el("td", { text: (task.task ? task.task.name : r.target || "") + (r.category ? ` (${r.category})` : "") }),
         el("td", { text: r.world || (r.generate ? `generated ${r.generate.style || "office"} ${r.generate.seed}` : "(inline)") }),
         el("td", { text: r.strategy || "switching" }),
         el("td", { text: r.seed ?? "" }),

@@ -44,6 +44,9 @@
   let plan = null;
   let state = "";
   let outcome = null;
+  let form = null; // the task's form (GET /v1/tasks/ID: `task`)
+  let targets = null; // a task of several: each label's part (AVS_TARGETS)
+  let taskStart = 0; // the simulated time of the `task` event
   function reset() {
     M = {
       grid: null, image: null, tinted: null, known: null, places: [], placeholders: [],
@@ -52,12 +55,14 @@
     };
     plan = null;
     outcome = null;
+    targets = null;
   }
   reset();
 
   let gridDirty = false;
   let tintDirty = false;
   let planDirty = false;
+  let targetsDirty = false;
   let decoding = 0;
   let drawPending = false;
   let unstamped = [];
@@ -67,7 +72,7 @@
       case "state":
         if (e.state === "running" && (e.attempt || 1) > 1) {
           reset(); // a requeued task runs again from the start
-          gridDirty = tintDirty = planDirty = true;
+          gridDirty = tintDirty = planDirty = targetsDirty = true;
         }
         state = e.state;
         break;
@@ -97,6 +102,18 @@
         break;
       case "done":
         outcome = { outcome: e.outcome, reason: e.reason };
+        break;
+      case "task":
+        taskStart = typeof e.t === "number" ? e.t : 0;
+        targets = AVS_TARGETS.open(e.targets || []);
+        targetsDirty = true;
+        break;
+      case "turn":
+      case "target":
+        if (targets) {
+          AVS_TARGETS.apply(targets, e, M.objects, taskStart);
+          targetsDirty = true;
+        }
         break;
       default:
         break;
@@ -157,6 +174,12 @@
       case "dt": return `search ${e.label} ${e.relation} ${e.location}: ${e.result} (p=${n(e.probability)})`;
       case "replan": return `${e.status}${e.action ? ` ${e.action}` : ""}${e.detail ? `: ${e.detail}` : ""}`;
       case "done": return `${e.outcome}: ${e.reason}`;
+      case "task": return `${(e.targets || []).join(", ")}: mode ${e.mode}, count ${e.count}` +
+        (e.stop_below !== null && e.stop_below !== undefined ? `, stop below ${e.stop_below}` : "");
+      case "turn": return `${e.target} ${e.status}` + (e.status === "start"
+        ? ((e.watch || []).length ? `, also watching for ${e.watch.join(", ")}` : "")
+        : `: ${e.outcome}${e.reason ? ` (${e.reason})` : ""}`);
+      case "target": return `${e.target}: ${e.outcome}${e.reason ? `: ${e.reason}` : ""}`;
       default: {
         const { t, wall, type, seq, retry, ...rest } = e;
         const text = JSON.stringify(rest);
@@ -197,6 +220,17 @@
       if (plan.current === i) classes.push("current");
       return el("li", { class: classes.join(" "), title: classes[0] === "assumptive" ? "an assumption the plan rests on" : "" }, step);
     }));
+  }
+
+  // a task of several: its targets' parts (hidden for a task of one label)
+  function renderTargets() {
+    targetsDirty = false;
+    const card = $("targets-card");
+    const parts = targets || (form && form.several ? AVS_TARGETS.open(form.targets, "waiting") : null);
+    card.hidden = !parts;
+    if (!parts) return;
+    $("targets-form").textContent = form ? `${form.name}: ${AVS_TARGETS.formText(form)}` : "";
+    $("targets").replaceChildren(AVS_TARGETS.table(parts, form));
   }
 
   function renderState() {
@@ -272,12 +306,21 @@
       const rows = [["state", task.state]];
       if (task.error) rows.push(["error", task.error]);
       const s = task.summary || {};
-      for (const key of ["outcome", "reason", "object", "correct", "sim_time_s", "distance_m", "plans",
+      // a task of several shows its targets' parts in their own card, not its first object
+      const several = Array.isArray(task.targets);
+      for (const key of ["target", "outcome", "reason", "object", "correct", "sim_time_s", "distance_m", "plans",
         "replans", "dt_calls", "views_processed", "wall_time_s"]) {
-        if (key in s) rows.push([key, s[key]]);
+        if (key in s && !(several && key === "object")) rows.push([key, s[key]]);
       }
       dl.replaceChildren(...rows.flatMap(([k, v]) => [el("dt", { text: k }),
         el("dd", {}, renderValue(v))]));
+      if (several) {
+        targets = task.targets; // the summary's parts: scored, with positions and times
+      } else if (form && form.several) { // ended without a summary's parts (cancelled, failed)
+        targets = targets || AVS_TARGETS.open(form.targets);
+        for (const part of targets) if (part.outcome === "open") part.outcome = "stopped";
+      }
+      renderTargets();
     }
     const files = [];
     if (["succeeded", "gave_up", "timeout"].includes(state)) {
@@ -634,6 +677,7 @@
     }
     renderLog(batch);
     if (planDirty) renderPlan();
+    if (targetsDirty) renderTargets();
     renderState();
     for (const e of batch) unstamped.push(e.seq);
     if (gridDirty) decodeGrid();
@@ -684,6 +728,8 @@
       !(typeof v === "object" && !Array.isArray(v) && !Object.keys(v).length)).flatMap(([k, v]) =>
       [el("dt", { text: k }), el("dd", { text: Array.isArray(v) ? v.join(", ") : typeof v === "object" ? JSON.stringify(v) : String(v) })]));
     state = answer.body.state;
+    form = answer.body.task || null;
+    renderTargets();
     renderState();
     scheduleDraw();
     page.stream = "live";

@@ -11,6 +11,7 @@ This is wiring, so it may read the world file through `sim`; it never builds a p
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cache, lru_cache
@@ -21,6 +22,7 @@ from matplotlib.path import Path as MplPath
 
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.harness.sim_robot import check_categories, free_spot, generated_spec
+from avs_planner.harness.tasks import TaskForm
 from avs_planner.strategies import get_strategy, strategy_names
 from conceptual_map.knowledge.loader import load_knowledge
 from conceptual_map.knowledge.model import Knowledge
@@ -76,25 +78,46 @@ def _check_strategy(task: Mapping[str, Any]) -> list[FieldProblem]:
 
 
 def _check_labels(task: Mapping[str, Any], knowledge: Knowledge) -> list[FieldProblem]:
+    """The task's form (`target` or `targets`, `mode`, `count`, `stop_below`: `TaskForm`)
+    and every target label, then the category, against the knowledge."""
     problems = []
-    target = task.get("target")
     # a task that does not say (the service's schema has no `strict_labels` yet) is checked
     # strictly, as before; `strict_labels: false` accepts a label the knowledge does not
     # list (the episode searches for it with the uninformed prior, `Knowledge.with_label`)
     strict = task.get("strict_labels", True)
     if not isinstance(strict, bool):
         problems.append(FieldProblem("strict_labels", f"must be true or false, got {strict!r}"))
-    if not isinstance(target, str) or not target:
-        problems.append(FieldProblem("target", "an object label is required"))
-    elif strict is not False and knowledge.spelled(target) not in knowledge.labels:
-        problems.append(FieldProblem("target", f"unknown object label {target!r}; "
-                                     f"the knowledge base knows {_listed(knowledge.labels)}"))
+    try:
+        form = TaskForm.from_spec(task)
+    except EpisodeError as exc:
+        problems.append(FieldProblem(_form_key(str(exc)),
+                                     str(exc).removeprefix("episode spec: ")))
+    else:
+        field = "targets" if task.get("targets") is not None else "target"
+        for label in form.targets:
+            if strict is not False and knowledge.spelled(label) not in knowledge.labels:
+                problems.append(FieldProblem(field, f"unknown object label {label!r}; the "
+                                             f"knowledge base knows {_listed(knowledge.labels)}"))
+        try:
+            form.spelled(knowledge.spelled)  # "Cup" and "cup" are one label twice
+        except EpisodeError as exc:
+            problems.append(FieldProblem(field, str(exc).removeprefix("episode spec: ")))
     category = task.get("category")
     if category is not None and (not isinstance(category, str)
                                  or knowledge.spelled(category) not in knowledge.categories):
         problems.append(FieldProblem("category", f"unknown room category {category!r}; the "
                                      f"knowledge base knows {_listed(knowledge.categories)}"))
     return problems
+
+
+_FORM_KEYS = ("targets", "target", "mode", "count", "stop_below")
+
+
+def _form_key(message: str) -> str:
+    """The task-form key a `TaskForm.from_spec` message names first (its messages quote it,
+    e.g. "'count: all' finds every instance of one label" or "'stop_below' must be ...")."""
+    found = re.search(r"'(" + "|".join(_FORM_KEYS) + r")\b", message)
+    return found.group(1) if found else "target"
 
 
 def _check_qsr(task: Mapping[str, Any]) -> list[FieldProblem]:

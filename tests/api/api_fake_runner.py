@@ -1,6 +1,7 @@
 """An injected episode runner for testing the task machinery (queueing, events, cancel,
-persistence) without the real switching loop. Its behaviour is chosen by the task's target label;
-it is loaded by file path in the worker process (see `api.worker_process.resolve`)."""
+persistence) without the real switching loop. Its behaviour is chosen by the task's target label
+(the first of `targets`); it is loaded by file path in the worker process (see
+`api.worker_process.resolve`)."""
 
 from __future__ import annotations
 
@@ -26,7 +27,7 @@ def _png_1x1() -> bytes:
 
 
 def run(spec: dict[str, Any], emit: Any, should_stop: Any) -> dict[str, Any]:
-    behaviour = spec["target"]
+    behaviour = spec["target"] if "target" in spec else spec["targets"][0]
     for i in range(3):
         emit({"t": float(i), "wall": 0.0, "type": "action", "step": i})
     if behaviour == "quick":
@@ -51,6 +52,8 @@ def run(spec: dict[str, Any], emit: Any, should_stop: Any) -> dict[str, Any]:
             time.sleep(0.02)
     if behaviour == "echo":  # what the episode runner was given
         return {"outcome": "found", "spec": spec}
+    if behaviour == "parts":  # a task of several, summarised as the real runner does
+        return _parts(spec)
     if behaviour == "drip":  # an event every 0.05 s until stopped (storage fault tests)
         deadline = time.monotonic() + 30
         step = 3
@@ -99,3 +102,27 @@ def _explained(spec: dict[str, Any], emit: Any) -> dict[str, Any]:
     if spec.get("record"):  # the real runner writes a Rerun recording
         (out / "recording.rrd").write_bytes(b"RRF2-not-a-real-recording")
     return {"outcome": "gave_up", "target": spec["target"]}
+
+
+def _parts(spec: dict[str, Any]) -> dict[str, Any]:
+    """The summary of a task of several: the first label found, the second given up, any
+    others not needed (the shape of `Episode.summary`'s `task` and `targets`)."""
+    labels = spec["targets"]
+    found = {"id": "object2", "label": labels[0], "position": [1.442, 7.58, 0.893],
+             "room": "room1", "truth": f"{labels[0]}1", "correct": True}
+    parts = [{"label": labels[0], "outcome": "found", "reason": f"{labels[0]} at (1.44, 7.58, "
+              f"0.89) in room1", "objects": [found], "sim_time_s": 58.69, "turns": 1,
+              "instances": 2, "distinct": 1, "correct": True}]
+    if len(labels) > 1:
+        parts.append({"label": labels[1], "outcome": "gave_up", "reason": "no plan reaches "
+                      "the success threshold", "objects": [], "sim_time_s": 208.32,
+                      "turns": 2, "instances": 0, "distinct": 0, "correct": True})
+    parts += [{"label": label, "outcome": "not_needed", "reason": "", "objects": [],
+               "sim_time_s": None, "turns": 0, "instances": 1, "distinct": 0, "correct": True}
+              for label in labels[2:]]
+    task = {"targets": labels, "mode": spec.get("mode", "all"),
+            "count": spec.get("count", "one")}
+    return {"outcome": "gave_up", "reason": "; ".join(f"{p['label']}: {p['outcome']}"
+                                                      for p in parts),
+            "target": " and ".join(labels), "object": found, "correct": True, "task": task,
+            "targets": parts, "sim_time_s": 208.32, "seed": spec.get("seed", 0)}

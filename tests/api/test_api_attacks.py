@@ -156,8 +156,9 @@ _INLINE = "inline text, parsed as text (never opened)"
 _CLOSED = "one of a closed set of values"
 _CHECKED = "refused when it looks like a path (strategy options, qsr)"
 TASK_FIELDS = {
-    "target": _NAMES, "category": _NAMES, "world": _NAMES, "start_room": _NAMES,
-    "strategy": _NAMES, "world_file": _INLINE, "robot": _CLOSED, "generate.style": _CLOSED,
+    "target": _NAMES, "targets[]": _NAMES, "category": _NAMES, "world": _NAMES,
+    "start_room": _NAMES, "strategy": _NAMES, "world_file": _INLINE, "robot": _CLOSED,
+    "mode": _CLOSED, "count": _CLOSED, "generate.style": _CLOSED,
     "strategy_options.*": _CHECKED, "qsr[].*": _CHECKED, "qsr.*": _CHECKED,
 }
 PLAN_FIELDS = {"domain": _INLINE, "problem": _INLINE, "problems[]": _INLINE}
@@ -180,6 +181,9 @@ def test_a_path_in_any_task_field_is_refused(client: TestClient, file_watch: _Fi
     path = f"{file_watch.root}/world.yaml"
     bodies: dict[str, dict[str, Any]] = {
         "target": {"target": path, "world": "office"},
+        "targets[]": {"targets": ["cup", path], "world": "office"},
+        "mode": {"targets": ["cup", "book"], "mode": path, "world": "office"},
+        "count": {**BODY, "count": path},
         "category": {**BODY, "category": path},
         "world": {"target": "quick", "world": path},
         "start_room": {**BODY, "start_room": path},

@@ -85,6 +85,29 @@ def test_an_unknown_label_is_searched_for_unless_strict(client: TestClient) -> N
     assert [d["loc"] for d in still.json()["detail"]] == [["body", "category"]]
 
 
+def test_every_label_of_targets_is_checked(client: TestClient) -> None:
+    """The knowledge check covers each label of a task of several: labels the knowledge
+    base lacks (only with `strict_labels`; one item each, at `targets`), two spellings of one
+    label, and the room category, as for `target`."""
+    body = {**GOOD, "target": None, "targets": ["cerealbox", "unicorn", "griffin"]}
+    strict = client.post("/v1/tasks", json={**body, "strict_labels": True})
+    assert strict.status_code == 422, strict.text
+    detail = strict.json()["detail"]
+    assert [d["loc"] for d in detail] == [["body", "targets"], ["body", "targets"]]
+    assert "'unicorn'" in detail[0]["msg"] and "'griffin'" in detail[1]["msg"]
+    accepted = client.post("/v1/tasks", json={**body, "mode": "any"})
+    assert accepted.status_code == 202, accepted.text
+    assert accepted.json()["request"]["targets"] == ["cerealbox", "unicorn", "griffin"]
+    twice = client.post("/v1/tasks", json={**body, "targets": ["cup", "Cup"]})
+    assert twice.status_code == 422
+    (error,) = twice.json()["detail"]
+    assert error["loc"] == ["body", "targets"] and "spelled differently" in error["msg"]
+    assert ["body", "category"] in _loc(client, target=None, targets=["cup", "stapler"],
+                                        category="attic")
+    assert ["body", "target"] in _loc(client, target="unicorn", count="all",
+                                      strict_labels=True)
+
+
 def test_inline_world_is_checked_too(client: TestClient) -> None:
     body = {"target": "cerealbox", "world_file": "name: x\nsize: [1, 1]\n"}
     response = client.post("/v1/tasks", json=body)

@@ -254,6 +254,45 @@ def test_submit_a_task_and_watch_it_find_the_object(service: Service_, browser: 
         By.CSS_SELECTOR, f"tr[data-id='{task_id}'] .state-succeeded"))
 
 
+def test_submit_two_targets_and_see_each_ones_part(service: Service_,
+                                                   browser: WebDriver) -> None:
+    """Several labels typed into the form (comma-separated) with a mode become `targets`;
+    the task page shows each label's part live and, once ended, the summary's."""
+    browser.get(f"{service.base}/")
+    wait = WebDriverWait(browser, 30)
+    wait.until(lambda d: d.find_elements(By.CSS_SELECTOR, "#f-world option[value=office]"))
+    Select(browser.find_element(By.ID, "f-world")).select_by_value("office")
+    target = browser.find_element(By.ID, "f-target")
+    target.clear()
+    target.send_keys("cup, stapler")
+    Select(browser.find_element(By.ID, "f-mode")).select_by_value("all")
+    for field in ("f-x", "f-y", "f-yaw"):
+        browser.find_element(By.ID, field).clear()
+    if not browser.execute_script("return sessionStorage.getItem('avs-api-key');"):
+        browser.find_element(By.ID, "api-key").send_keys(service.key)
+        browser.find_element(By.ID, "key-save").click()
+    browser.find_element(By.ID, "submit-button").click()
+    wait.until(lambda d: "/tasks/" in d.current_url)
+    WebDriverWait(browser, 180, poll_frequency=0.2).until(
+        lambda d: d.find_element(By.ID, "state").get_attribute("data-state") in TERMINAL)
+    WebDriverWait(browser, 30).until(lambda d: _page(d, "avsPage.complete") is not None)
+    assert browser.find_element(By.ID, "state").get_attribute("data-state") == "succeeded"
+    card = browser.find_element(By.ID, "targets-card")
+    WebDriverWait(browser, 10).until(lambda d: card.find_elements(
+        By.CSS_SELECTOR, "tr[data-label=cup][data-outcome=found]"))
+    assert card.is_displayed() and "cup and stapler" in card.text
+    for label in ("cup", "stapler"):
+        row = card.find_element(By.CSS_SELECTOR, f"tr[data-label={label}]")
+        assert row.get_attribute("data-outcome") == "found" and "found" in row.text
+        assert " at (" in row.text and " s" in row.text  # where and when
+    browser.execute_script("document.getElementById('targets-card').scrollIntoView()")
+    browser.save_screenshot(str(_artifacts() / "6-task-of-two-targets.png"))
+    # the list names the task by its form
+    browser.get(f"{service.base}/")
+    WebDriverWait(browser, 10).until(lambda d: any(
+        "cup and stapler" in row.text for row in d.find_elements(By.CSS_SELECTOR, "#tasks tr")))
+
+
 def test_open_a_finished_400_event_task(service: Service_, browser: WebDriver) -> None:
     times = []
     for _ in range(3):
