@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+import yaml
 
 from avs_planner.experiment import CampaignError, load_campaign
 from avs_planner.experiment import subjects as subjects_module
@@ -418,3 +419,36 @@ def test_the_generators_instance_counts():
     assert sorted(counts) == world.labels_present()
     assert sum(counts.values()) == len(world.data["objects"])
 
+
+def _no_generator(monkeypatch):
+    monkeypatch.setattr(subjects_module, "generated_targets",
+                        lambda seed, style, rooms: [("cup", True)])
+    monkeypatch.setattr(subjects_module, "generated_instances",
+                        lambda seed, style, rooms: {"cup": 3, "book": 2, "stapler": 2})
+
+
+def test_the_task_benchmark_campaign_and_its_held_out_twin(monkeypatch):
+    _no_generator(monkeypatch)
+    dev, held = load_campaign("tasks-dev"), load_campaign("tasks-heldout")
+    for campaign, seeds, noise in ((dev, range(314, 326), 0),
+                                   (held, range(10000, 10008), 100)):
+        runs = campaign.runs()
+        worlds = {r.episode["generate"]["seed"] for r in runs}
+        assert worlds == set(seeds)
+        assert {r.seed for r in runs} == {noise}
+        assert {r.strategy.name for r in runs} == {"switching"}
+        assert {r.robot for r in runs} == {"pioneer"}
+        kinds = [r.subject.kind for r in runs]
+        per_world = 2 * len(seeds)  # office and lab
+        assert kinds.count("all") == kinds.count("any") == kinds.count("count") == per_world
+        assert kinds.count("") == 3 * per_world  # the single searches of the all task
+    strip = {"name", "description", "seeds"}
+
+    def body(name):
+        data = yaml.safe_load((CAMPAIGN_DIR / f"{name}.yaml").read_text(encoding="utf-8"))
+        for world in data["worlds"]:
+            world["generate"].pop("seeds")
+        return {k: v for k, v in data.items() if k not in strip}
+
+    assert body("tasks-dev") == body("tasks-heldout")  # the same content, other seeds
+    assert all(r.episode["generate"]["seed"] >= HELDOUT_WORLD_SEEDS_FROM for r in held.runs())
