@@ -1,7 +1,8 @@
 """Campaign files: which episodes to run, validated with errors that name the entry.
 
 A campaign is worlds (or the active visual search paper's scenarios) × targets × strategies ×
-robots × seeds; the format is in docs/experiments.md. `load_campaign` reads and checks a file
+robots × seeds, where a target is one label or a task of several objects (`subjects.py`); the
+format is in docs/experiments.md. `load_campaign` reads and checks a file
 (or a built-in by name, from `campaigns/`), and `Campaign.runs()` expands it into one `RunSpec`
 per episode, each with a stable run id (the name of its directory in the output).
 """
@@ -56,7 +57,8 @@ class RunSpec:
         s = self.subject
         return {"run_id": self.run_id, "scenario": s.scenario or "", "world": s.world,
                 "group": s.group, "target": s.target, "expected": s.expected or "",
-                "strategy": self.strategy.label, "robot": self.robot or "", "seed": self.seed}
+                "strategy": self.strategy.label, "robot": self.robot or "", "seed": self.seed,
+                "task": s.kind, "task_labels": " ".join(s.labels) if s.task else ""}
 
 
 @dataclass(frozen=True)
@@ -85,7 +87,7 @@ class Campaign:
 
     def _run(self, subject: Subject, strategy: Strategy, robot: str | None, seed: int
              ) -> RunSpec:
-        spec: dict[str, Any] = {**subject.spec, "target": subject.target, "seed": seed}
+        spec: dict[str, Any] = {**subject.spec, **subject.episode_keys(), "seed": seed}
         if strategy.name != DEFAULT_STRATEGY or strategy.options:
             spec["strategy"] = strategy.name
             spec["strategy_options"] = dict(strategy.options)

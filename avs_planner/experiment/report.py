@@ -15,8 +15,9 @@ beside it (`plots.py`) and the runs that failed. The parts live in their own mod
 `report_rows.py` (which runs count, slices and pairs), `report_cells.py` (numbers with their
 intervals, as table cells; the statistics themselves: `stats.py`), `report_header.py` (the
 header and every section's stamp), `report_outcomes.py` (the outcome and comparison tables),
-`report_planner.py` (the DT sub-planner, and beside the paper) and `report_map.py` (map
-quality).
+`report_planner.py` (the DT sub-planner, and beside the paper), `report_map.py` (map
+quality) and `report_tasks.py` (tasks of several objects: in a campaign with tasks, the other
+tables cover its single-label searches and the tasks have sections of their own).
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ from avs_planner.experiment.report_outcomes import (
 )
 from avs_planner.experiment.report_planner import PAPER, PAPER_OUTCOME, beside_the_paper, dt_table
 from avs_planner.experiment.report_rows import Pair, Row, as_expected, comparable, normalised
+from avs_planner.experiment.report_tasks import is_task, task_tables
 from avs_planner.experiment.results import RESULTS_FILE, WALL_CUT, read_results
 
 __all__ = ["PAPER", "PAPER_OUTCOME", "Pair", "Row", "as_expected", "build_report", "comparable",
@@ -65,22 +67,28 @@ def _meta(run_dir: Path) -> dict[str, Any]:
 
 
 def render(rows: list[Row], meta: dict[str, Any], out: Path) -> str:
-    """The report's Markdown for `rows`; its plots are drawn beside `out`."""
-    rows = [normalised(r) for r in rows]
-    strategies = list(dict.fromkeys(r["strategy"] for r in rows))  # the campaign's order
-    groups = sorted({r["group"] for r in rows})
-    stamp = campaign_stamp(rows, meta)
-    lines = header(rows, meta)
-    lines += strategy_table(rows, strategies, stamp)
-    lines += targets_table(rows, strategies, stamp)
-    lines += group_table(rows, groups, strategies, stamp)
-    lines += paired_table(rows, strategies, stamp)
-    lines += dt_table(rows, strategies, groups, stamp)
-    lines += map_table(rows, strategies, stamp)
-    if {r["scenario"] for r in rows} <= set(PAPER_OUTCOME) and rows[0]["scenario"]:
-        lines += beside_the_paper(rows, groups, stamp)
-    lines += _figures(rows, groups, strategies, out)
-    lines += _failures(rows)
+    """The report's Markdown for `rows`; its plots are drawn beside `out`. The tables of
+    single-label searches cover the runs of one label; tasks of several objects have their
+    own sections (`report_tasks.py`)."""
+    every = [normalised(r) for r in rows]
+    stamp = campaign_stamp(every, meta)
+    lines = header(every, meta)
+    rows = [r for r in every if not is_task(r)]
+    if rows:
+        strategies = list(dict.fromkeys(r["strategy"] for r in rows))  # the campaign's order
+        groups = sorted({r["group"] for r in rows})
+        lines += strategy_table(rows, strategies, stamp)
+        lines += targets_table(rows, strategies, stamp)
+        lines += group_table(rows, groups, strategies, stamp)
+        lines += paired_table(rows, strategies, stamp)
+        lines += dt_table(rows, strategies, groups, stamp)
+        lines += map_table(rows, strategies, stamp)
+        if {r["scenario"] for r in rows} <= set(PAPER_OUTCOME) and rows[0]["scenario"]:
+            lines += beside_the_paper(rows, groups, stamp)
+    lines += task_tables(every, stamp)
+    if rows:
+        lines += _figures(rows, groups, strategies, out)
+    lines += _failures(every)
     return "\n".join(lines) + "\n"
 
 

@@ -7,6 +7,13 @@ plan, DT time per decision) become totals, counts and medians; the full lists st
 run's summary.json. Keys a summary may or may not carry (the DT's confirmations and
 rejections, the map-quality scores in `map_score`) leave their cells empty when absent.
 
+A task of several objects (`harness/tasks.py`) fills its row as one search does, for the whole
+task (its outcome, sim time and verdict: `correct` when every report names a true instance of
+its label, `false_report` when one does not), plus the task's own columns (`TASK_COLUMNS`):
+which labels, each label's outcome, and counts of labels found, reports, true instances and
+distinct ones reported; `targets_json` keeps each label's part (outcome, when it ended,
+reports, instances) for the report. A single search leaves them empty.
+
 A run's `status` is the campaign's view of it: `ok`; `wall_cut` when the episode ended
 because its wall-clock budget ran out (a loaded machine, not the strategy: its numbers are not
 comparable, and `--retry-failed` runs it again); `error`, `crashed` or `timeout` (killed past
@@ -16,6 +23,7 @@ its hard deadline) when it failed.
 from __future__ import annotations
 
 import csv
+import json
 import math
 import statistics
 from collections.abc import Iterable, Mapping
@@ -31,19 +39,27 @@ MAP_SCORE_KEYS = ("rooms_true", "rooms_matched", "merges", "splits", "category_a
                   "entered_area_m2", "entered_rooms", "entered_matched")
 KEY_COLUMNS = ["run_id", "scenario", "world", "group", "target", "expected", "strategy",
                "robot", "seed"]
+# a task of several objects: all, any or count, and its labels (space-separated); empty for
+# one label (and absent from tables written before tasks: not required when read)
+TASK_KEY_COLUMNS = ["task", "task_labels"]
+TASK_COLUMNS = ["targets_outcome", "targets_found", "reports", "reports_correct",
+                "instances", "distinct", "targets_json"]
 VALUE_COLUMNS = ["status", "error", "outcome", "reason", "correct", "success",
-                 "correct_give_up", "false_report", "found_label", "sim_time_s", "distance_m",
+                 "correct_give_up", "false_report", "found_label", *TASK_COLUMNS,
+                 "sim_time_s", "distance_m",
                  "plans", "replans", "cp_calls", "cp_time_s", "cp_s_per_plan", "dt_calls",
                  "dt_decisions", "dt_time_s", "dt_s_per_action", "dt_confirmed",
                  "dt_rejected", "views_processed",
                  *(f"map_{k}" for k in MAP_SCORE_KEYS),
                  "episode_s", "wall_s", "overhead_s", "backend", "commit"]
-COLUMNS = KEY_COLUMNS + VALUE_COLUMNS
+COLUMNS = KEY_COLUMNS + TASK_KEY_COLUMNS + VALUE_COLUMNS
 _INTS = {"seed", "plans", "replans", "cp_calls", "dt_calls", "dt_decisions", "dt_confirmed",
-         "dt_rejected", "views_processed"}
+         "dt_rejected", "views_processed", "targets_found", "reports", "reports_correct",
+         "instances", "distinct"}
 _BOOLS = {"correct", "success", "correct_give_up", "false_report"}
 _TEXT = {"run_id", "scenario", "world", "group", "target", "expected", "strategy", "robot",
-         "status", "error", "outcome", "reason", "found_label", "backend", "commit"}
+         "status", "error", "outcome", "reason", "found_label", "backend", "commit", "task",
+         "task_labels", "targets_outcome", "targets_json"}
 
 
 def is_wall_cut(outcome: Any, reason: Any) -> bool:
@@ -65,7 +81,7 @@ def row(record: Mapping[str, Any]) -> dict[str, Any]:
 
     A wall-cut run keeps its episode's numbers (how far it got) but no verdict: `correct`,
     `success`, `correct_give_up` and `false_report` stay empty."""
-    out: dict[str, Any] = {k: record.get(k) for k in KEY_COLUMNS}
+    out: dict[str, Any] = {k: record.get(k) for k in KEY_COLUMNS + TASK_KEY_COLUMNS}
     out.update({k: record.get(k) for k in ("status", "error", "episode_s", "wall_s",
                                            "overhead_s", "backend", "commit")})
     summary = record.get("summary")
@@ -95,7 +111,38 @@ def _summary_columns(s: Mapping[str, Any], expected: str) -> dict[str, Any]:
         "dt_s_per_action": _mean(dt), "dt_confirmed": _count(s.get("dt_confirmed")),
         "dt_rejected": _count(s.get("dt_rejected")), "views_processed": s.get("views_processed"),
         **_map_score(s.get("map_score")),
+        **_task_columns(s.get("targets")),
     }
+
+
+def _task_columns(parts: Any) -> dict[str, Any]:
+    """A task's own columns from its summary's `targets` (each label's part); a wrong report
+    of any label is a false report of the task. Nothing for one label."""
+    if not isinstance(parts, list) or not parts:
+        return {}
+    labels = [_part(p) for p in parts if isinstance(p, Mapping)]
+    reports = sum(p["reports"] for p in labels)
+    correct = sum(p["correct_reports"] for p in labels)
+    return {
+        "targets_outcome": " ".join(f"{p['label']}:{p['outcome']}" for p in labels),
+        "targets_found": sum(p["outcome"] == "found" for p in labels),
+        "reports": reports, "reports_correct": correct,
+        "false_report": reports > correct,
+        "instances": sum(p["instances"] or 0 for p in labels),
+        "distinct": sum(p["distinct"] or 0 for p in labels),
+        "targets_json": json.dumps(labels, separators=(",", ":")),
+    }
+
+
+def _part(part: Mapping[str, Any]) -> dict[str, Any]:
+    """One label's part of a task (`harness/runner.py: _target_part`), as `targets_json`
+    keeps it."""
+    objects = [o for o in part.get("objects") or [] if isinstance(o, Mapping)]
+    return {"label": part.get("label"), "outcome": part.get("outcome"),
+            "sim_time_s": part.get("sim_time_s"), "reports": len(objects),
+            "correct_reports": sum(bool(o.get("correct")) for o in objects),
+            "instances": _count(part.get("instances")),
+            "distinct": _count(part.get("distinct"))}
 
 
 def _count(value: Any) -> int | None:

@@ -1,12 +1,24 @@
 """What a campaign searches: (world, target, start) subjects from scenarios or worlds × targets.
 
-A subject carries the outcome to expect: a scenario's own; for a world file, `found` when
-the world holds an object (or furniture) with the target's label, else `gave_up`; for a
-generated world with `targets: auto`, the generator's (label, present) list.
+A target is one label or a task of several objects (`harness/tasks.py`: all or any of several
+labels, or every instance of one); docs/experiments.md has the forms a campaign file takes. A
+subject carries the outcome to expect: a scenario's own; for a world file, `found` when the
+world holds an object (or furniture) with the target's label, else `gave_up` (a task: `found`
+when it holds every label of an "all" task, some label of an "any" task, an instance of a
+counted label); for a generated world with `targets: auto`, the generator's (label, present)
+list, and for tasks over the building's labels (`{auto: present, ...}`), `found`.
+
+Tasks over a generated building's labels take them from the generator's record of what it
+placed (`harness/worlds.py`: the experimenter's knowledge, never the robot's): the labels
+present, sorted, then shuffled by `random.Random(building seed)`; an `all: N` or `any: N` task
+takes the first N of that order (so `any: 2` takes two of the labels `all: 3` takes), and
+`count: all` every label with at least `MIN_COUNTED` instances, in that order (`pick: N`: the
+first N of them).
 """
 
 from __future__ import annotations
 
+import random
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from functools import cache
@@ -18,22 +30,75 @@ from avs_planner.experiment.errors import CampaignError
 from avs_planner.experiment.values import Where, parse_seeds
 
 AUTO = "auto"
+AUTO_PRESENT = "present"  # tasks over the labels a generated building holds
+MIN_COUNTED = 2  # `{auto: present, count: all}`: labels with at least this many instances
 _WORLD_KEYS = {"world", "generate", "targets", "start_room", "start"}
 _GENERATE_KEYS = {"seeds", "style", "rooms"}
 _TARGET_KEYS = {"label", "expected"}
+_TASK_KEYS = {"targets", "label", "mode", "count", "stop_below", "expected", "singles"}
+_AUTO_KEYS = {"auto", "all", "any", "count", "stop_below", "pick", "singles"}
+FORM_KEYS = {"auto", "label", "targets"}  # a `targets` mapping with one of these is one form
 _EXPECTED = ("found", "gave_up")
+_FORMS = ("a label or {label, expected}, or a task: {targets: [a, b], mode: all|any} or "
+          "{label: a, count: all, stop_below: p}")
 
 
 @dataclass(frozen=True)
 class Subject:
-    """A world, a target label and a start: the part of an episode a campaign varies least."""
+    """A world, a target (a label, or a task of several objects) and a start: the part of an
+    episode a campaign varies least."""
 
     world: str  # display name
     group: str  # scenario name, world name or generator group: a row of the report
-    target: str
+    target: str  # the label; for a task, its name ("cup and book", "every chair")
     expected: str | None  # found / gave_up / None (unknown)
     scenario: str | None
     spec: Mapping[str, Any]  # episode keys: world or generate, start, start_room, ...
+    # a task of several objects: its episode keys (targets, mode, count, and stop_below when
+    # the campaign gives it); None for one label
+    task: Mapping[str, Any] | None = None
+
+    @property
+    def kind(self) -> str:
+        """`all`, `any` or `count` for a task of several objects; "" for one label."""
+        if self.task is None:
+            return ""
+        return "count" if self.task["count"] == "all" else str(self.task["mode"])
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """The labels searched for."""
+        return (self.target,) if self.task is None else tuple(self.task["targets"])
+
+    def episode_keys(self) -> dict[str, Any]:
+        """What the episode spec says of the target: `target`, or a task's keys."""
+        if self.task is None:
+            return {"target": self.target}
+        return {k: list(v) if k == "targets" else v for k, v in self.task.items()}
+
+
+@dataclass(frozen=True)
+class Wanted:
+    """A target entry for one world: a label or a task, the outcome to expect, and whether it
+    is a single search that `singles: true` added (left out when the world's list has it)."""
+
+    name: str
+    expected: str | None = None
+    task: Mapping[str, Any] | None = None
+    added: bool = False
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        return (self.name,) if self.task is None else tuple(self.task["targets"])
+
+    def expected_in(self, present: set[str]) -> str:
+        """The expected outcome in a world holding the labels `present` (unless given)."""
+        if self.expected is not None:
+            return self.expected
+        there = [label in present for label in self.labels]
+        if self.task is not None and self.task["count"] == "one" and self.task["mode"] == "all":
+            return _EXPECTED[not all(there)]
+        return _EXPECTED[not any(there)]
 
 
 def scenario_subjects(value: Any, where: Where, base: Path) -> Iterator[Subject]:
@@ -83,7 +148,7 @@ def _targets_for(entry: dict[str, Any], top: Any, key: str, at: Where, where: Wh
     """The entry's own targets, else the top-level mapping's entry for `key`, else the list."""
     if "targets" in entry:
         return entry["targets"], at.at("targets")
-    if isinstance(top, dict):
+    if isinstance(top, dict) and not set(top) & FORM_KEYS:
         if key not in top:
             raise where.at("targets").error(f"no targets for world {key!r} (keys: "
                                             f"{', '.join(map(str, top))})")
@@ -111,13 +176,12 @@ def _from_file(entry: dict[str, Any], top: Any, at: Where, where: Where, base: P
         raise at.error(str(exc)) from None
     labels = {o.label for o in world.objects} | {f.label for f in world.furniture}
     value, t_at = _targets_for(entry, top, text, at, where)
-    if value == AUTO:
-        raise t_at.error("'auto' targets are for generated worlds; list labels instead")
     spec = {"world": ref, **{k: entry[k] for k in ("start", "start_room") if k in entry}}
     name = Path(text).stem
-    for label, expected in _labels(value, t_at):
-        yield Subject(name, name, label, expected or _EXPECTED[label not in labels], None,
-                      spec)
+    entries = _entries(value, t_at, generated=False)
+    for wanted in _unique([w for e in entries for w in e.resolve(None)]):
+        yield Subject(name, name, wanted.name, wanted.expected_in(labels), None, spec,
+                      wanted.task)
 
 
 def _generated(entry: dict[str, Any], targets: tuple[Any, Where], at: Where
@@ -135,22 +199,44 @@ def _generated(entry: dict[str, Any], targets: tuple[Any, Where], at: Where
         raise g_at.at("rooms").error(f"a positive number of rooms, got {rooms!r}")
     group = f"gen-{style}" + (f"-r{rooms}" if rooms is not None else "")
     value, t_at = targets
+    entries = _entries(value, t_at, generated=True)
     for seed in parse_seeds(gen["seeds"], g_at.at("seeds")):
         spec = {"generate": {"seed": seed, "style": style, "rooms": rooms}}
-        pairs = (_auto(seed, style, rooms, t_at) if value == AUTO
-                 else list(_labels(value, t_at)))
+        building = Building(seed, style, rooms)
         name = generated_name(seed, style, rooms)
-        for label, expected in pairs:
-            yield Subject(name, group, label, expected, None, spec)
+        for wanted in _unique([w for e in entries for w in e.resolve(building)]):
+            yield Subject(name, group, wanted.name, wanted.expected, None, spec, wanted.task)
 
 
-def _auto(seed: int, style: str, rooms: int | None, where: Where
-          ) -> list[tuple[str, str | None]]:
-    try:
-        pairs = generated_targets(seed, style, rooms)
-    except AvsError as exc:
-        raise where.error(f"world seed {seed}: {exc}") from None
-    return [(label, _EXPECTED[not present]) for label, present in pairs]
+@dataclass(frozen=True)
+class Building:
+    """A generated world, as the target entries that depend on it need it."""
+
+    seed: int
+    style: str
+    rooms: int | None
+
+    def targets(self, where: Where) -> list[Wanted]:
+        """The generator's own targets (`targets: auto`)."""
+        try:
+            pairs = generated_targets(self.seed, self.style, self.rooms)
+        except AvsError as exc:
+            raise where.error(f"world seed {self.seed}: {exc}") from None
+        return [Wanted(label, _EXPECTED[not present]) for label, present in pairs]
+
+    def labels(self, where: Where) -> list[tuple[str, int]]:
+        """The labels the building holds with their instance counts, in the building's own
+        order (sorted, then shuffled by `random.Random(seed)`: see the module's doc)."""
+        try:
+            counts = generated_instances(self.seed, self.style, self.rooms)
+        except AvsError as exc:
+            raise where.error(f"world seed {self.seed}: {exc}") from None
+        ordered = sorted(label for label, n in counts.items() if n > 0)
+        random.Random(self.seed).shuffle(ordered)
+        return [(label, counts[label]) for label in ordered]
+
+    def name(self) -> str:
+        return generated_name(self.seed, self.style, self.rooms)
 
 
 def generated_name(seed: int, style: str, rooms: int | None) -> str:
@@ -169,26 +255,242 @@ def generated_targets(seed: int, style: str, rooms: int | None) -> list[tuple[st
         raise CampaignError(f"generated worlds are not available in this build: {exc}") from None
 
 
-def _labels(value: Any, where: Where) -> Iterator[tuple[str, str | None]]:
-    if isinstance(value, str):
-        value = [value]
+def generated_instances(seed: int, style: str, rooms: int | None) -> dict[str, int]:
+    """How many objects of each label one generated world holds (the generator's record)."""
+    return dict(_instances(seed, style, rooms))
+
+
+@cache
+def _instances(seed: int, style: str, rooms: int | None) -> tuple[tuple[str, int], ...]:
+    from avs_planner.harness.worlds import generated_instances as instances
+
+    try:
+        return tuple(instances(seed, style, rooms).items())
+    except ImportError as exc:
+        raise CampaignError(f"generated worlds are not available in this build: {exc}") from None
+
+
+# ---- target entries ----------------------------------------------------------------------
+
+
+class _Entry:
+    """One entry of a `targets` list, checked once; `resolve` gives what it asks of a world
+    (`building`: the generated world, None for a world file)."""
+
+    def resolve(self, building: Building | None) -> list[Wanted]:
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class _Fixed(_Entry):
+    wanted: tuple[Wanted, ...]
+
+    def resolve(self, building: Building | None) -> list[Wanted]:
+        return list(self.wanted)
+
+
+@dataclass(frozen=True)
+class _AutoTargets(_Entry):
+    """`auto`: the generator's own targets (two present, one absent)."""
+
+    where: Where
+
+    def resolve(self, building: Building | None) -> list[Wanted]:
+        assert building is not None
+        return building.targets(self.where)
+
+
+@dataclass(frozen=True)
+class _AutoTask(_Entry):
+    """`{auto: present, all: N}`, `{auto: present, any: N}`, `{auto: present, count: all}`:
+    tasks over the labels each generated building holds (see the module's doc)."""
+
+    where: Where
+    kind: str  # all, any or count
+    size: int | None  # all / any: labels per task; count: `pick` (None: every eligible one)
+    stop_below: float | None
+    singles: bool
+
+    def resolve(self, building: Building | None) -> list[Wanted]:
+        assert building is not None
+        labels = building.labels(self.where)
+        about = f"world seed {building.seed} ({building.name()})"
+        if self.kind == "count":
+            eligible = [label for label, n in labels if n >= MIN_COUNTED]
+            if self.size is not None and len(eligible) < self.size:
+                raise self.where.at("pick").error(
+                    f"{about}: pick {self.size} asks for {self.size} labels with "
+                    f"{MIN_COUNTED} or more instances; the building has {len(eligible)}"
+                    + (f" ({', '.join(eligible)})" if eligible else ""))
+            groups = [[label] for label in eligible[:self.size]]
+        else:
+            if len(labels) < (self.size or 0):
+                raise self.where.at(self.kind).error(
+                    f"{about}: {self.kind}: {self.size} asks for {self.size} labels the "
+                    f"building holds; it holds {len(labels)} "
+                    f"({', '.join(label for label, _ in labels)})")
+            groups = [[label for label, _ in labels[:self.size]]]
+        out: list[Wanted] = []
+        for group in groups:
+            for label in group:
+                _known(label, self.where)
+            spec: dict[str, Any] = {"targets": group}
+            spec.update({"count": "all"} if self.kind == "count" else {"mode": self.kind})
+            if self.stop_below is not None:
+                spec["stop_below"] = self.stop_below
+            out.append(_task_wanted(_form(spec, self.where), "found",
+                                    self.stop_below is not None))
+            if self.singles:
+                out += [Wanted(label, "found", added=True) for label in group]
+        return out
+
+
+def _entries(value: Any, where: Where, generated: bool) -> list[_Entry]:
+    """The entries of a `targets` value (a list, or one entry such as `auto`), each checked
+    and named by where it sits."""
+    if isinstance(value, str) or (isinstance(value, dict) and set(value) & FORM_KEYS):
+        return [_entry(value, where, generated)]
     if not isinstance(value, list) or not value:
-        raise where.error(f"a non-empty list of labels (or 'auto'), got {value!r}")
-    for i, item in enumerate(value):
-        yield _label(item, where.at(i))
+        raise where.error(f"a non-empty list of labels or tasks (or 'auto'), got {value!r}")
+    return [_entry(item, where.at(i), generated) for i, item in enumerate(value)]
 
 
-def _label(item: Any, where: Where) -> tuple[str, str | None]:
-    if isinstance(item, str) and item and item != AUTO:
-        return _known(item, where), None
-    if not isinstance(item, dict) or not isinstance(item.get("label"), str):
-        raise where.error(f"a label or {{label, expected}}, got {item!r}")
+def _entry(item: Any, where: Where, generated: bool) -> _Entry:
+    if item == AUTO or (isinstance(item, dict) and AUTO in item):
+        if not generated:
+            raise where.error("'auto' targets are for generated worlds; list labels instead")
+        return _AutoTargets(where) if item == AUTO else _auto_task(item, where)
+    if isinstance(item, str) and item:
+        return _Fixed((Wanted(_known(item, where)),))
+    if not isinstance(item, dict):
+        raise where.error(f"{_FORMS}; got {item!r}")
+    if set(item) & (_TASK_KEYS - _TARGET_KEYS):
+        return _Fixed(_task(item, where))
+    if not isinstance(item.get("label"), str):
+        raise where.error(f"{_FORMS}; got {item!r}")
     if set(item) - _TARGET_KEYS:
         raise where.error(f"unknown keys {sorted(set(item) - _TARGET_KEYS)}")
+    return _Fixed((Wanted(_known(item["label"], where.at("label")),
+                          _expected(item, where)),))
+
+
+def _expected(item: Mapping[str, Any], where: Where) -> str | None:
     expected = item.get("expected")
     if expected is not None and expected not in _EXPECTED:
         raise where.at("expected").error(f"found or gave_up, got {expected!r}")
-    return _known(item["label"], where.at("label")), expected
+    return expected
+
+
+def _task(item: dict[str, Any], where: Where) -> tuple[Wanted, ...]:
+    """`{targets: [a, b], mode: all|any}` or `{label: a, count: all, stop_below: p}`, checked
+    by the episode's own rules (`TaskForm.from_spec`); with `singles: true`, each label's
+    single search too. A form of one label found once is a plain single search."""
+    unknown = set(item) - _TASK_KEYS
+    if unknown:
+        raise where.error(f"unknown keys {sorted(unknown)}; a task takes "
+                          f"{sorted(_TASK_KEYS)}")
+    if "label" in item and "targets" in item:
+        raise where.error("give 'label' (one label, e.g. with count: all) or 'targets' (a "
+                          "list), not both")
+    if "label" not in item and "targets" not in item:
+        raise where.error(f"a task names its labels: 'targets: [a, b]' or 'label: a'; got "
+                          f"{item!r}")
+    spec = {k: item[k] for k in ("mode", "count", "stop_below") if k in item}
+    if "targets" in item:
+        spec["targets"] = item["targets"]
+    else:
+        spec["target"] = item["label"]
+    form = _form(spec, where)
+    for i, label in enumerate(form.targets):
+        _known(label, where.at("targets").at(i) if "targets" in item else where.at("label"))
+    expected = _expected(item, where)
+    singles = _flag(item, "singles", where)
+    if not form.several:
+        return (Wanted(form.targets[0], expected),)
+    wanted = _task_wanted(form, expected, "stop_below" in item)
+    added = tuple(Wanted(label, None, added=True) for label in form.targets) if singles else ()
+    return (wanted, *added)
+
+
+def _auto_task(item: dict[str, Any], where: Where) -> _AutoTask:
+    unknown = set(item) - _AUTO_KEYS
+    if unknown:
+        raise where.error(f"unknown keys {sorted(unknown)}; a task over the building's labels "
+                          f"takes {sorted(_AUTO_KEYS)}")
+    if item[AUTO] != AUTO_PRESENT:
+        raise where.at(AUTO).error(f"'{AUTO_PRESENT}' (tasks over labels the building "
+                                   f"holds); got {item[AUTO]!r}")
+    kinds = [k for k in ("all", "any", "count") if k in item]
+    if len(kinds) != 1:
+        raise where.error("give one of 'all: N' (one object of each of N labels), 'any: N' "
+                          "(one of any of N labels) or 'count: all' (every instance)")
+    kind = kinds[0]
+    from avs_planner.harness.tasks import MAX_TARGETS
+
+    if kind == "count":
+        if item["count"] != "all":
+            raise where.at("count").error(f"'all' (every instance of a label); got "
+                                          f"{item['count']!r}")
+        size = item.get("pick")
+        if size is not None and (isinstance(size, bool) or not isinstance(size, int)
+                                 or size < 1):
+            raise where.at("pick").error(f"a positive number of labels, got {size!r}")
+        stop = None
+        if "stop_below" in item:
+            stop = _form({"target": "x", "count": "all", "stop_below": item["stop_below"]},
+                         where).stop_below
+    else:
+        size = item[kind]
+        if isinstance(size, bool) or not isinstance(size, int) \
+                or not 2 <= size <= MAX_TARGETS:
+            raise where.at(kind).error(f"a number of labels from 2 to {MAX_TARGETS}, got "
+                                       f"{size!r}")
+        for key in ("pick", "stop_below"):
+            if key in item:
+                raise where.at(key).error(f"'{key}' goes with 'count: all' only")
+        stop = None
+    return _AutoTask(where, kind, size, stop, _flag(item, "singles", where))
+
+
+def _form(spec: Mapping[str, Any], where: Where):  # noqa: ANN202 - harness.tasks.TaskForm
+    """The episode's own check of a task form; its message, named by where it sits."""
+    from avs_planner.harness.tasks import TaskForm
+
+    try:
+        return TaskForm.from_spec(spec)
+    except AvsError as exc:
+        raise where.error(str(exc).removeprefix("episode spec: ")) from None
+
+
+def _task_wanted(form: Any, expected: str | None, stop_given: bool) -> Wanted:
+    """A task (`harness.tasks.TaskForm`) as a target: named as the episode names it ("cup and
+    book", "every chair"), and with its stop level when the campaign gives one (two levels:
+    two targets); its episode keys say `stop_below` only then."""
+    task: dict[str, Any] = {"targets": list(form.targets), "mode": form.mode,
+                            "count": form.count}
+    if stop_given:
+        task["stop_below"] = form.stop_below
+    name = form.name + (f" (stop below {form.stop_below:g})" if stop_given else "")
+    return Wanted(name, expected, task)
+
+
+def _flag(item: Mapping[str, Any], key: str, where: Where) -> bool:
+    value = item.get(key, False)
+    if not isinstance(value, bool):
+        raise where.at(key).error(f"true or false, got {value!r}")
+    return value
+
+
+def _unique(wanted: list[Wanted]) -> list[Wanted]:
+    """The world's targets, leaving out a single search `singles` added when the list holds
+    it already (two tasks over the same labels, or the label listed on its own)."""
+    listed = {w.name for w in wanted if not w.added}
+    out: list[Wanted] = []
+    for w in wanted:
+        if w.added and (w.name in listed or any(o.name == w.name for o in out)):
+            continue
+        out.append(w)
+    return out
 
 
 def _known(label: str, where: Where) -> str:

@@ -5,10 +5,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+import yaml
 
 from avs_planner.experiment import CampaignError, load_campaign
 from avs_planner.experiment import subjects as subjects_module
 from avs_planner.experiment.campaign import (
+    CAMPAIGN_DIR,
     HELDOUT_FIG3_NOISE_SEEDS,
     HELDOUT_WORLD_SEEDS_FROM,
     parse_campaign,
@@ -248,8 +250,205 @@ def test_development_campaigns_stay_off_the_held_out_seeds(name, monkeypatch):
 
 
 def test_built_in_campaigns_name_papers_by_title_not_by_seed_number():
-    from avs_planner.experiment.campaign import CAMPAIGN_DIR
-
     for path in CAMPAIGN_DIR.glob("*.yaml"):
         text = path.read_text(encoding="utf-8").lower()
         assert "seed 003" not in text and "issue 34" not in text, path.name
+
+
+# ---- tasks of several objects ------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("targets", "fragments"), [
+    ([{"targets": ["cup", "cup"]}], ["targets[0]: 'targets' names cup more than once"]),
+    ([{"targets": ["cup", "book"], "mode": "most"}],
+     ["targets[0]: 'mode' must be one of all, any; got 'most'"]),
+    (["cup", {"targets": ["cup", "banana"]}],
+     ["targets[1].targets[1]: unknown target label 'banana'"]),
+    ([{"targets": "cup"}], ["targets[0]: 'targets' must be a non-empty list"]),
+    ([{"targets": ["cup", "book"], "count": "all"}],
+     ["targets[0]: 'count: all' finds every instance of one label"]),
+    ([{"label": "chair", "count": "all", "stop_below": 1.5}],
+     ["targets[0]: 'stop_below' must be a probability"]),
+    ([{"label": "chair", "stop_below": 0.2}],
+     ["targets[0]: 'stop_below' applies to 'count: all' only"]),
+    ([{"label": "chair", "count": "some"}], ["targets[0]: 'count' must be one of one, all"]),
+    ([{"label": "chair", "targets": ["cup"], "count": "all"}],
+     ["targets[0]: give 'label'", "or 'targets'"]),
+    ([{"mode": "any"}], ["targets[0]: a task names its labels"]),
+    ([{"targets": ["cup", "book"], "colour": "red"}], ["targets[0]: unknown keys ['colour']"]),
+    ([{"targets": ["cup", "book"], "expected": "maybe"}],
+     ["targets[0].expected: found or gave_up"]),
+    ([{"targets": ["cup", "book"], "singles": "yes"}], ["targets[0].singles: true or false"]),
+    ([{"label": "bananas", "count": "all"}], ["targets[0].label: unknown target label"]),
+    ([{"auto": "present", "all": 3}], ["targets[0]: 'auto' targets are for generated worlds"]),
+    (["cup", "auto"], ["targets[1]: 'auto' targets are for generated worlds"]),
+])
+def test_a_bad_task_is_refused_naming_its_position(targets, fragments):
+    refused({"worlds": ["office"], "targets": targets}, *fragments)
+
+
+def _labels_of(counts):
+    return lambda seed, style, rooms: dict(counts)
+
+
+BUILDING = {"cup": 3, "book": 1, "stapler": 2, "monitor": 1}
+
+
+@pytest.mark.parametrize(("targets", "fragments"), [
+    ({"auto": "absent", "all": 2}, ["targets.auto: 'present'"]),
+    ({"auto": "present"}, ["targets: give one of 'all: N'"]),
+    ({"auto": "present", "all": 2, "any": 2}, ["targets: give one of 'all: N'"]),
+    ({"auto": "present", "all": 1}, ["targets.all: a number of labels from 2 to 8, got 1"]),
+    ({"auto": "present", "any": True}, ["targets.any: a number of labels from 2 to 8"]),
+    ({"auto": "present", "all": 5}, ["targets.all: world seed 7 (gen-office-7): all: 5 asks "
+                                     "for 5 labels the building holds; it holds 4"]),
+    ({"auto": "present", "count": "one"}, ["targets.count: 'all'"]),
+    ({"auto": "present", "count": "all", "pick": 0}, ["targets.pick: a positive number"]),
+    ({"auto": "present", "count": "all", "pick": 3},
+     ["targets.pick: world seed 7 (gen-office-7): pick 3 asks for 3 labels with 2 or more "
+      "instances; the building has 2"]),
+    ({"auto": "present", "any": 2, "pick": 1}, ["targets.pick: 'pick' goes with 'count: all'"]),
+    ({"auto": "present", "count": "all", "stop_below": 0}, ["targets: 'stop_below' must be"]),
+    ({"auto": "present", "all": 2, "mode": "any"}, ["targets: unknown keys ['mode']"]),
+    (["auto", {"auto": "present", "any": 9}], ["targets[1].any: a number of labels"]),
+])
+def test_a_bad_task_over_a_buildings_labels_is_refused(targets, fragments, monkeypatch):
+    monkeypatch.setattr(subjects_module, "generated_instances", _labels_of(BUILDING))
+    refused({"worlds": [{"generate": {"seeds": 7}}], "targets": targets}, *fragments)
+
+
+def test_tasks_in_a_world_file_expect_what_the_world_holds():
+    """office.yaml holds a cup and a cerealbox, no book and no toilet."""
+    runs = parse({"worlds": ["office"], "targets": [
+        "cup", {"targets": ["cup", "book"], "mode": "any", "singles": True},
+        {"targets": ["cup", "book"]}, {"targets": ["toilet", "book"], "mode": "any"},
+        {"label": "cup", "count": "all", "stop_below": 0.05},
+        {"label": "toilet", "count": "all", "expected": "found"},
+        {"targets": ["cerealbox"]}]}).runs()
+    got = [(r.subject.target, r.subject.kind, r.subject.expected) for r in runs]
+    assert got == [("cup", "", "found"), ("cup or book", "any", "found"),
+                   ("book", "", "gave_up"),  # added by singles; cup is listed already
+                   ("cup and book", "all", "gave_up"), ("toilet or book", "any", "gave_up"),
+                   ("every cup (stop below 0.05)", "count", "found"),
+                   ("every toilet", "count", "found"),  # as the entry says
+                   ("cerealbox", "", "found")]  # a task of one label is one search
+    assert [r.run_id for r in runs][1:6] == [
+        "office-cup-or-book-switching-s0", "office-book-switching-s0",
+        "office-cup-and-book-switching-s0", "office-toilet-or-book-switching-s0",
+        "office-every-cup-stop-below-0.05-switching-s0"]
+
+
+def test_a_task_subject_becomes_an_episode_spec_with_targets_mode_and_count():
+    runs = parse({"worlds": ["office"], "targets": [
+        {"targets": ["cup", "book"], "mode": "any"},
+        {"label": "chair", "count": "all", "stop_below": 0.05}, {"label": "chair",
+                                                                 "count": "all"}],
+        "time_budget_s": 300}).runs()
+    specs = [dict(r.episode) for r in runs]
+    assert specs[0] == {"world": "office", "targets": ["cup", "book"], "mode": "any",
+                        "count": "one", "seed": 0, "time_budget_s": 300.0}
+    assert specs[1] == {"world": "office", "targets": ["chair"], "mode": "all", "count": "all",
+                        "stop_below": 0.05, "seed": 0, "time_budget_s": 300.0}
+    assert "stop_below" not in specs[2] and "target" not in specs[2]
+    assert runs[0].columns() == {
+        "run_id": "office-cup-or-book-switching-s0", "scenario": "", "world": "office",
+        "group": "office", "target": "cup or book", "expected": "found",
+        "strategy": "switching", "robot": "", "seed": 0, "task": "any",
+        "task_labels": "cup book"}
+    assert runs[1].columns()["task"] == "count"
+    from avs_planner.harness.runner import EpisodeSpec
+
+    for spec in specs:  # what the episode reads: the same task
+        episode = EpisodeSpec.from_dict(spec)
+        assert episode.task is not None and episode.target == spec["targets"][0]
+    assert EpisodeSpec.from_dict(specs[0]).task.mode == "any"
+    assert EpisodeSpec.from_dict(specs[1]).task.stop_below == 0.05
+
+
+def test_tasks_over_a_buildings_labels_are_chosen_from_its_seed(monkeypatch):
+    import random
+
+    monkeypatch.setattr(subjects_module, "generated_instances", _labels_of(BUILDING))
+    monkeypatch.setattr(subjects_module, "generated_targets",
+                        lambda seed, style, rooms: [("cup", True), ("book", True),
+                                                    ("keyboard", False)])
+    targets = [{"auto": "present", "all": 3, "singles": True},
+               {"auto": "present", "any": 2, "singles": True},
+               {"auto": "present", "count": "all"}, "auto"]
+    runs = parse({"worlds": [{"generate": {"seeds": "7-8", "style": "lab"}}],
+                  "targets": targets}).runs()
+    for seed in (7, 8):
+        order = sorted(BUILDING)
+        random.Random(seed).shuffle(order)
+        mine = [r.subject for r in runs if r.subject.world == f"gen-lab-{seed}"]
+        tasks = {s.kind: s for s in mine if s.task}
+        assert list(tasks["all"].task["targets"]) == order[:3]
+        assert list(tasks["any"].task["targets"]) == order[:2]  # two of the three
+        counted = [s.labels[0] for s in mine if s.kind == "count"]
+        assert counted == [x for x in order if BUILDING[x] >= 2]  # cup and stapler
+        singles = [s.target for s in mine if not s.task]
+        # the singles of the three labels, then the generator's own targets (cup and book
+        # once each: a single search `singles` adds is left out when the list holds it)
+        assert sorted(singles) == sorted(set(order[:3]) | {"cup", "book", "keyboard"})
+        assert len(singles) == len(set(singles))
+        assert {s.expected for s in mine if s.target != "keyboard"} == {"found"}
+        assert all(s.spec["generate"] == {"seed": seed, "style": "lab", "rooms": None}
+                   for s in mine)
+    again = parse({"worlds": [{"generate": {"seeds": "7-8", "style": "lab"}}],
+                   "targets": targets}).runs()
+    assert [r.run_id for r in again] == [r.run_id for r in runs]  # deterministic
+
+
+def test_count_tasks_pick_the_first_labels_with_several_instances(monkeypatch):
+    monkeypatch.setattr(subjects_module, "generated_instances", _labels_of(BUILDING))
+    runs = parse({"worlds": [{"generate": {"seeds": 7}}], "targets": {
+        "auto": "present", "count": "all", "pick": 1, "stop_below": 0.2}}).runs()
+    assert len(runs) == 1
+    assert runs[0].subject.labels[0] in ("cup", "stapler")
+    assert runs[0].episode["stop_below"] == 0.2 and runs[0].episode["count"] == "all"
+    assert runs[0].subject.target.endswith("(stop below 0.2)")
+
+
+def test_the_generators_instance_counts():
+    pytest.importorskip("sim.generate", reason="the world generator is not in this build")
+    from avs_planner.harness.worlds import generated_instances
+    from sim.generate import generate_world
+
+    counts = generated_instances(314, "office")
+    world = generate_world(314, "office")
+    assert sorted(counts) == world.labels_present()
+    assert sum(counts.values()) == len(world.data["objects"])
+
+
+def _no_generator(monkeypatch):
+    monkeypatch.setattr(subjects_module, "generated_targets",
+                        lambda seed, style, rooms: [("cup", True)])
+    monkeypatch.setattr(subjects_module, "generated_instances",
+                        lambda seed, style, rooms: {"cup": 3, "book": 2, "stapler": 2})
+
+
+def test_the_task_benchmark_campaign_and_its_held_out_twin(monkeypatch):
+    _no_generator(monkeypatch)
+    dev, held = load_campaign("tasks-dev"), load_campaign("tasks-heldout")
+    for campaign, seeds, noise in ((dev, range(314, 326), 0),
+                                   (held, range(10000, 10008), 100)):
+        runs = campaign.runs()
+        worlds = {r.episode["generate"]["seed"] for r in runs}
+        assert worlds == set(seeds)
+        assert {r.seed for r in runs} == {noise}
+        assert {r.strategy.name for r in runs} == {"switching"}
+        assert {r.robot for r in runs} == {"pioneer"}
+        kinds = [r.subject.kind for r in runs]
+        per_world = 2 * len(seeds)  # office and lab
+        assert kinds.count("all") == kinds.count("any") == kinds.count("count") == per_world
+        assert kinds.count("") == 3 * per_world  # the single searches of the all task
+    strip = {"name", "description", "seeds"}
+
+    def body(name):
+        data = yaml.safe_load((CAMPAIGN_DIR / f"{name}.yaml").read_text(encoding="utf-8"))
+        for world in data["worlds"]:
+            world["generate"].pop("seeds")
+        return {k: v for k, v in data.items() if k not in strip}
+
+    assert body("tasks-dev") == body("tasks-heldout")  # the same content, other seeds
+    assert all(r.episode["generate"]["seed"] >= HELDOUT_WORLD_SEEDS_FROM for r in held.runs())

@@ -118,3 +118,24 @@ def test_a_generated_world_with_auto_targets_end_to_end(tmp_path):
     assert {r["world"] for r in rows} == {"gen-office-0-r4"}
     summary = json.loads((tmp_path / "runs" / rows[0]["run_id"] / "summary.json").read_text())
     assert summary["strategy"] == "exhaustive" and summary["target"] == rows[0]["target"]
+
+
+def test_a_real_task_episode_through_the_campaign_runner(tmp_path):
+    """One short task (any of two labels gen-office-314 holds): the episode gets the task's
+    form and its summary's parts reach results.csv."""
+    pytest.importorskip("sim.generate", reason="the world generator is not in this build")
+    data = {"name": "task", "worlds": [{"generate": {"seeds": 314, "style": "office"}}],
+            "targets": {"auto": "present", "any": 2}, "time_budget_s": 120,
+            "wall_budget_s": 120}
+    run_campaign(parse_campaign(data, "task.yaml", Path(".")), RunOptions(tmp_path, workers=1))
+    [row] = read_results(tmp_path / "results.csv")
+    assert (row["status"], row["task"], row["expected"]) == ("ok", "any", "found")
+    labels = row["task_labels"].split()
+    assert len(labels) == 2 and row["target"] == " or ".join(labels)
+    summary = json.loads((tmp_path / "runs" / row["run_id"] / "summary.json").read_text())
+    assert summary["task"] == {"targets": labels, "mode": "any", "count": "one"}
+    assert summary["target"] == row["target"]
+    assert row["targets_outcome"] == " ".join(f"{p['label']}:{p['outcome']}"
+                                              for p in summary["targets"])
+    assert row["reports"] == sum(len(p["objects"]) for p in summary["targets"])
+    assert row["instances"] == sum(p["instances"] for p in summary["targets"]) >= 2

@@ -212,3 +212,32 @@ def test_the_ray_backend_records_crashes_errors_and_timeouts(tmp_path):
     assert status == {f"{s}-switching-s{k}": v for s in "ae" for k, v in
                       enumerate(["ok", "crashed", "error", "timeout"])}
     assert (tmp_path / "runs" / "a-switching-s0" / "summary.json").exists()
+
+
+def test_a_campaign_of_tasks_passes_their_form_and_records_each_labels_part(tmp_path):
+    data = {"name": "tasks", "worlds": ["office"], "seeds": "0-1", "targets": [
+        {"targets": ["cerealbox", "stapler"], "singles": True},
+        {"targets": ["cup", "stapler"], "mode": "any"}]}
+    result = run_campaign(parse_campaign(data, "tasks.yaml", Path(".")),
+                          RunOptions(tmp_path, workers=2, episode_runner=f"{FAKE}:tasks"))
+    rows = {(r["target"], r["seed"]): r for r in read_results(result.results)}
+    assert sorted({t for t, _ in rows}) == ["cerealbox", "cerealbox and stapler",
+                                           "cup or stapler", "stapler"]
+    task = rows[("cerealbox and stapler", 1)]
+    assert (task["task"], task["task_labels"], task["outcome"], task["success"]) == (
+        "all", "cerealbox stapler", "found", True)
+    assert (task["targets_outcome"], task["targets_found"], task["reports"],
+            task["reports_correct"], task["instances"], task["distinct"],
+            task["false_report"]) == ("cerealbox:found stapler:found", 2, 2, 2, 4, 2, False)
+    assert json.loads(task["targets_json"])[1] == {
+        "label": "stapler", "outcome": "found", "sim_time_s": 20.0, "reports": 1,
+        "correct_reports": 1, "instances": 2, "distinct": 1}
+    wrong = rows[("cup or stapler", 0)]  # its cup report names the wrong object
+    assert (wrong["task"], wrong["success"], wrong["false_report"], wrong["reports_correct"]
+            ) == ("any", False, True, 1)
+    single = rows[("stapler", 0)]
+    assert (single["task"], single["task_labels"], single["targets_outcome"],
+            single["reports"]) == ("", "", "", None)
+    record = json.loads((tmp_path / "runs" / task["run_id"] / "record.json").read_text())
+    assert record["spec"]["targets"] == ["cerealbox", "stapler"] and "target" not in record["spec"]
+    assert (record["spec"]["mode"], record["spec"]["count"]) == ("all", "one")
