@@ -53,6 +53,15 @@ NOT_NEEDED = "not_needed"  # a target left open because the task ("any") was don
 STOP_BELOW = 0.1
 
 
+class TaskFormError(EpisodeError):
+    """A task form that cannot be: `key` names the spec key at fault (the service's 422
+    names it as the field)."""
+
+    def __init__(self, key: str, message: str) -> None:
+        super().__init__(f"episode spec: {message}")
+        self.key = key
+
+
 @dataclass(frozen=True)
 class TaskForm:
     """What the task asks for (see the module's doc)."""
@@ -83,45 +92,45 @@ class TaskForm:
         `mode`, `count` and `stop_below`. EpisodeError names the key that is wrong."""
         target, targets = spec.get("target"), spec.get("targets")
         if target is not None and targets is not None:
-            raise EpisodeError("episode spec: give 'target' (one label) or 'targets' (a "
-                               "list), not both")
+            raise TaskFormError("targets", "give 'target' (one label) or 'targets' (a "
+                                "list), not both")
         if targets is None:
             if not isinstance(target, str) or not target.strip():
-                raise EpisodeError("episode spec: 'target' (an object label) is required")
+                raise TaskFormError("target", "'target' (an object label) is required")
             labels = (target.strip(),)
         else:
             if isinstance(targets, str) or not isinstance(targets, list | tuple) or not targets:
-                raise EpisodeError(f"episode spec: 'targets' must be a non-empty list of "
-                                   f"object labels, like [cup, book]; got {targets!r}")
+                raise TaskFormError("targets", f"'targets' must be a non-empty list of "
+                                    f"object labels, like [cup, book]; got {targets!r}")
             if not all(isinstance(t, str) and t.strip() for t in targets):
-                raise EpisodeError(f"episode spec: 'targets' must hold object labels "
-                                   f"(non-empty strings); got {targets!r}")
+                raise TaskFormError("targets", f"'targets' must hold object labels "
+                                    f"(non-empty strings); got {targets!r}")
             labels = tuple(t.strip() for t in targets)
             if len(labels) > MAX_TARGETS:
-                raise EpisodeError(f"episode spec: 'targets' holds {len(labels)} labels; at "
-                                   f"most {MAX_TARGETS}")
+                raise TaskFormError("targets", f"'targets' holds {len(labels)} labels; at "
+                                    f"most {MAX_TARGETS}")
             twice = sorted({t for t in labels if labels.count(t) > 1})
             if twice:
-                raise EpisodeError(f"episode spec: 'targets' names {', '.join(twice)} more "
-                                   f"than once (to find every instance, use count: all)")
+                raise TaskFormError("targets", f"'targets' names {', '.join(twice)} more "
+                                    f"than once (to find every instance, use count: all)")
         mode = spec.get("mode", "all")
         if mode not in MODES:
-            raise EpisodeError(f"episode spec: 'mode' must be one of {', '.join(MODES)}; "
-                               f"got {mode!r}")
+            raise TaskFormError("mode", f"'mode' must be one of {', '.join(MODES)}; "
+                                f"got {mode!r}")
         count = spec.get("count", "one")
         if count not in COUNTS:
-            raise EpisodeError(f"episode spec: 'count' must be one of {', '.join(COUNTS)}; "
-                               f"got {count!r}")
+            raise TaskFormError("count", f"'count' must be one of {', '.join(COUNTS)}; "
+                                f"got {count!r}")
         if count == "all" and len(labels) != 1:
-            raise EpisodeError(f"episode spec: 'count: all' finds every instance of one "
-                               f"label; 'targets' names {len(labels)}")
+            raise TaskFormError("count", f"'count: all' finds every instance of one "
+                                f"label; 'targets' names {len(labels)}")
         stop = spec.get("stop_below", STOP_BELOW)
         if isinstance(stop, bool) or not isinstance(stop, int | float) \
                 or not 0.0 < float(stop) < 1.0:
-            raise EpisodeError(f"episode spec: 'stop_below' must be a probability between 0 "
-                               f"and 1 (exclusive); got {stop!r}")
+            raise TaskFormError("stop_below", f"'stop_below' must be a probability between 0 "
+                                f"and 1 (exclusive); got {stop!r}")
         if "stop_below" in spec and count != "all":
-            raise EpisodeError("episode spec: 'stop_below' applies to 'count: all' only")
+            raise TaskFormError("stop_below", "'stop_below' applies to 'count: all' only")
         return cls(labels, str(mode), str(count), float(stop))
 
     def spelled(self, spell: Callable[[str], str]) -> TaskForm:
@@ -129,8 +138,8 @@ class TaskForm:
         labels = tuple(spell(t) for t in self.targets)
         twice = sorted({t for t in labels if labels.count(t) > 1})
         if twice:
-            raise EpisodeError(f"episode spec: 'targets' names {', '.join(twice)} more than "
-                               f"once (spelled differently)")
+            raise TaskFormError("targets", f"'targets' names {', '.join(twice)} more than "
+                                f"once (spelled differently)")
         return replace(self, targets=labels)
 
 

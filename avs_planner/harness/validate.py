@@ -11,7 +11,6 @@ This is wiring, so it may read the world file through `sim`; it never builds a p
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cache, lru_cache
@@ -22,7 +21,7 @@ from matplotlib.path import Path as MplPath
 
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.harness.sim_robot import check_categories, free_spot, generated_spec
-from avs_planner.harness.tasks import TaskForm
+from avs_planner.harness.tasks import TaskForm, TaskFormError
 from avs_planner.strategies import get_strategy, strategy_names
 from conceptual_map.knowledge.loader import load_knowledge
 from conceptual_map.knowledge.model import Knowledge
@@ -89,9 +88,8 @@ def _check_labels(task: Mapping[str, Any], knowledge: Knowledge) -> list[FieldPr
         problems.append(FieldProblem("strict_labels", f"must be true or false, got {strict!r}"))
     try:
         form = TaskForm.from_spec(task)
-    except EpisodeError as exc:
-        problems.append(FieldProblem(_form_key(str(exc)),
-                                     str(exc).removeprefix("episode spec: ")))
+    except TaskFormError as exc:
+        problems.append(FieldProblem(exc.key, str(exc).removeprefix("episode spec: ")))
     else:
         field = "targets" if task.get("targets") is not None else "target"
         for label in form.targets:
@@ -108,16 +106,6 @@ def _check_labels(task: Mapping[str, Any], knowledge: Knowledge) -> list[FieldPr
         problems.append(FieldProblem("category", f"unknown room category {category!r}; the "
                                      f"knowledge base knows {_listed(knowledge.categories)}"))
     return problems
-
-
-_FORM_KEYS = ("targets", "target", "mode", "count", "stop_below")
-
-
-def _form_key(message: str) -> str:
-    """The task-form key a `TaskForm.from_spec` message names first (its messages quote it,
-    e.g. "'count: all' finds every instance of one label" or "'stop_below' must be ...")."""
-    found = re.search(r"'(" + "|".join(_FORM_KEYS) + r")\b", message)
-    return found.group(1) if found else "target"
 
 
 def _check_qsr(task: Mapping[str, Any]) -> list[FieldProblem]:
