@@ -5,10 +5,10 @@ is exact under the belief; in mode "all", closing a detected label first. The pl
 - "look at cone c k times (k <= LOOKAHEAD), then close every label as well as possible", for
   every cone a label may be in: the single-label greedy's lookahead, with one look serving
   every open label (`label_outlook` is that lookahead's cost split by how the label stops);
-- "look along a route of cones chosen by expected penalty removed per second, each label
-  confirmed at its first convincing detection, stop after the best prefix", from the best
-  few first cones (`best_route`): what one look then stopping cannot see, that several cheap
-  looks on the way are worth more together than any one of them.
+- "look along a route of cones chosen by expected penalty removed per second, settle each
+  label's detections as fixed in advance, stop after the best prefix", from the best few first
+  cones (`avs_planner.dt.multi.route`): what one look then stopping cannot see, that several
+  cheap looks on the way are worth more together than any one of them.
 Given the looks, the labels' outcomes are independent, so both costs are exact without the
 joint: in mode "all" the penalties add up per label (a route's travel is paid while any label
 is open); in mode "any" the first confirm ends the search, which the products over labels of
@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 from avs_planner.dt.domain import ActionKind
 from avs_planner.dt.greedy import LOOKAHEAD, stop_choice
@@ -39,6 +38,7 @@ from avs_planner.dt.multi.domain import (
     reject_label,
 )
 from avs_planner.dt.multi.problem import MultiLabelProblem
+from avs_planner.dt.multi.route import route_cost
 from avs_planner.dt.problem import DTProblem
 
 _EPS = 1e-9
@@ -164,17 +164,20 @@ class MultiLookaheadPolicy:
     `depth` 1: each candidate first action (look here, move to one of the `moves` cones with
     the cheapest plans, stop, close a detected label) is valued by the exact expectation over
     its observations of the plan estimate at the next belief; 0: the estimate's own action.
-    `branches`: first cones whose routes are costed (0: one-step plans only); `lookahead`:
-    most looks at one cone in a one-step plan; `route_looks`: longest route."""
+    `branches`: first cones whose routes are costed (0: one-step plans only), and
+    `child_branches` at the beliefs after the first action; `lookahead`: most looks at one
+    cone in a one-step plan; `route_looks`: longest route."""
 
     name = "lookahead"
 
     def __init__(self, problem: MultiLabelProblem, depth: int = 1, moves: int = 3,
-                 branches: int = 3, lookahead: int = LOOKAHEAD, route_looks: int = 16):
+                 branches: int = 3, child_branches: int = 3, lookahead: int = LOOKAHEAD,
+                 route_looks: int = 16):
         self.problem = problem
         self.depth = depth
         self.moves = moves
         self.branches = branches
+        self.child_branches = child_branches
         self.lookahead = lookahead
         self.route_looks = route_looks
 
@@ -186,8 +189,8 @@ class MultiLookaheadPolicy:
     def observe(self, action: MultiAction, observation: MultiObservation) -> None:
         """Stateless: everything it needs is in the belief."""
 
-    def estimate(self, belief: MultiLabelBelief, steps_left: int,
-                 plan: _Plan | None = None) -> tuple[float, MultiAction]:
+    def estimate(self, belief: MultiLabelBelief, steps_left: int, plan: _Plan | None = None,
+                 branches: int | None = None) -> tuple[float, MultiAction]:
         """(expected cost, first action) of the best of: stopping now, the cheapest plan, and
         in mode "all" closing a detected label first and planning for the others."""
         problem = self.problem
@@ -196,29 +199,29 @@ class MultiLookaheadPolicy:
             return stop_cost, stop_action
         open_labels = belief.open_labels
         if belief.after_move:  # moving on or stopping right after a move is dominated
-            plan = self._best_plan(belief, open_labels, steps_left, forced=belief.robot)
+            plan = self._best_plan(belief, open_labels, steps_left, belief.robot, branches)
             return min(plan.cost, stop_cost), self._step(belief, open_labels, belief.robot)
-        plan = plan or self._best_plan(belief, open_labels, steps_left)
+        plan = plan or self._best_plan(belief, open_labels, steps_left, branches=branches)
         best, action = stop_cost, stop_action
         if plan.cost < best - _EPS:
             best, action = plan.cost, self._step(belief, open_labels, plan.cone)
         if problem.mode is SearchMode.ALL:
-            for i in open_labels:
-                if belief.detected(i) and belief.robot >= 0:
+            for i in open_labels:  # a confirm dearer than rejecting never beats going on
+                if _confirm_cost(problem, belief, i) < _reject_cost(problem, belief, i):
                     cost = self._stop_cost(belief, i) + self._rest(belief, open_labels, i,
-                                                                   steps_left)
+                                                                   steps_left, branches)
                     if cost < best - _EPS:
                         best, action = cost, _claim(problem, belief, i, True)
         return best, action
 
     def _rest(self, belief: MultiLabelBelief, open_labels: tuple[int, ...], closed: int,
-              steps_left: int) -> float:
+              steps_left: int, branches: int | None) -> float:
         """Mode "all": best expected cost for the open labels but `closed`."""
         others = tuple(i for i in open_labels if i != closed)
         if not others:
             return 0.0
         stop = sum(self._stop_cost(belief, i) for i in others)
-        return min(stop, self._best_plan(belief, others, steps_left).cost)
+        return min(stop, self._best_plan(belief, others, steps_left, branches=branches).cost)
 
     def _expectimax(self, belief: MultiLabelBelief, steps_left: int) -> MultiAction:
         """The candidate first action with the lowest expected cost, each valued exactly over
@@ -251,7 +254,7 @@ class MultiLookaheadPolicy:
             cost = problem.travel_cost(belief.robot, cone) + problem.sensing_cost
             start, left = belief.after(move_to(cone), None, problem), steps_left - 2
         for p, after in sorted(start.outcomes(look_at(cone), problem), key=lambda pb: -pb[0]):
-            cost += p * self.estimate(after, left)[0]
+            cost += p * self.estimate(after, left, branches=self.child_branches)[0]
             if cost >= bound:
                 break
         return cost
@@ -262,8 +265,10 @@ class MultiLookaheadPolicy:
         return step(cone, self._motive(belief, open_labels, cone))
 
     def _best_plan(self, belief: MultiLabelBelief, open_labels: tuple[int, ...],
-                   steps_left: int, forced: int | None = None) -> _Plan:
-        """The cheapest one-step plan and route (first look at `forced` if given)."""
+                   steps_left: int, forced: int | None = None,
+                   branches: int | None = None) -> _Plan:
+        """The cheapest one-step plan and route (first look at `forced` if given; routes
+        from `branches` first cones, default `self.branches`)."""
         plan = _Plan()
         robot = belief.robot
         if forced is not None:
@@ -276,8 +281,10 @@ class MultiLookaheadPolicy:
             moving = 0 if cone == robot else 1
             for looks in range(1, min(self.lookahead, steps_left - moving) + 1):
                 plan.offer(self._look_cost(belief, open_labels, cone, looks), cone, looks)
-        if self.branches > 0 and steps_left >= 1:
-            firsts = [forced] if forced is not None else self._first_cones(belief, open_labels)
+        branches = self.branches if branches is None else branches
+        if branches > 0 and steps_left >= 1:
+            firsts = ([forced] if forced is not None
+                      else self._first_cones(belief, open_labels, branches))
             for first in firsts:
                 cost = route_cost(self.problem, belief, open_labels, first, steps_left,
                                   self.route_looks)
@@ -310,12 +317,13 @@ class MultiLookaheadPolicy:
     def _stop_cost(self, belief: MultiLabelBelief, i: int) -> float:
         return min(_reject_cost(self.problem, belief, i), _confirm_cost(self.problem, belief, i))
 
-    def _first_cones(self, belief: MultiLabelBelief, open_labels: tuple[int, ...]) -> list[int]:
+    def _first_cones(self, belief: MultiLabelBelief, open_labels: tuple[int, ...],
+                     branches: int) -> list[int]:
         """The robot's cone (if any) and the `branches` cones with the most expected penalty
         removed per second of travel and sensing."""
         scored = sorted(((self._utility(belief, open_labels, belief.robot, c), -c)
                          for c in self.problem.relevant_cones(open_labels)), reverse=True)
-        firsts = [-neg for u, neg in scored[: self.branches] if u > 0.0]
+        firsts = [-neg for u, neg in scored[:branches] if u > 0.0]
         if belief.robot >= 0 and belief.robot not in firsts:
             firsts.append(belief.robot)
         return firsts
@@ -337,109 +345,3 @@ def _gain(problem: MultiLabelProblem, i: int, p: float) -> float:
     """Miss penalty times P(label `i` is detected in a cone where it is with probability p)."""
     single = problem.single(i)
     return single.rewards.miss_penalty * single.detection_rates[0] * p
-
-
-@dataclass(frozen=True)
-class RoutePlan:
-    """The best prefix of a route: expected cost, cones looked at in order, and per look the
-    open labels (positions in `open_labels`) that a detection there confirms."""
-
-    cost: float
-    cones: tuple[int, ...]
-    confirms: tuple[tuple[int, ...], ...]
-
-
-def route_cost(problem: MultiLabelProblem, belief: MultiLabelBelief,
-               open_labels: Sequence[int], first: int, steps_left: float,
-               max_looks: int = 16) -> float:
-    """Expected cost of `best_route` (infinite if no look fits in `steps_left`)."""
-    return best_route(problem, belief, open_labels, first, steps_left, max_looks).cost
-
-
-def best_route(problem: MultiLabelProblem, belief: MultiLabelBelief,
-               open_labels: Sequence[int], first: int, steps_left: float,
-               max_looks: int = 16) -> RoutePlan:
-    """The best prefix of an open-loop route starting with a look at `first` and continued by
-    expected penalty removed per second: at each look a label is confirmed at a detection when
-    confirming beats rejecting it there, else the detection is ignored; after the prefix every
-    open label is rejected. A MOVE and a look count as two steps against `steps_left`."""
-    route = _Route(problem, belief, open_labels)
-    cones = problem.relevant_cones(open_labels)
-    here, best, looked, confirms = belief.robot, RoutePlan(math.inf, (), ()), [], []
-    for step in range(int(min(steps_left, max_looks or 2 * len(cones) + 2))):
-        cone = first if step == 0 else route.next_cone(cones, here)
-        if cone < 0:
-            break
-        steps_left -= 1 if cone == here else 2
-        if steps_left < 0:
-            break
-        confirms.append(route.look(here, cone))
-        looked.append(cone)
-        if route.end_cost() < best.cost:
-            best = RoutePlan(route.end_cost(), tuple(looked), tuple(confirms))
-        here = cone
-    return best
-
-
-class _Route:
-    """The running expectation along a route. Per label, `mass[j]` is the joint P(label in
-    j, not confirmed yet), stored times `scale` so that a look changes one entry; `alive` is
-    its sum. Looks are paid while the search goes on: in mode "all" until every label is
-    confirmed, in mode "any" until the first confirm."""
-
-    def __init__(self, problem: MultiLabelProblem, belief: MultiLabelBelief,
-                 open_labels: Sequence[int]):
-        singles = [problem.single(i) for i in open_labels]
-        self.problem = problem
-        self.any_mode = problem.mode is SearchMode.ANY
-        self.rates = [s.detection_rates for s in singles]
-        self.miss = [s.rewards.miss_penalty for s in singles]
-        self.wrong = [s.rewards.false_confirm_penalty for s in singles]
-        self.mass = [list(belief.probs(i)) for i in open_labels]
-        self.scale = [1.0] * len(singles)
-        self.alive = [sum(m) for m in self.mass]
-        self.spent = 0.0
-
-    def look(self, here: int, cone: int) -> tuple[int, ...]:
-        """Pay for (moving to and) looking at `cone`; returns the labels it can confirm."""
-        alive = self.alive
-        going = math.prod(alive) if self.any_mode else 1.0 - math.prod(1.0 - a for a in alive)
-        self.spent += going * (self.problem.travel_cost(here, cone) + self.problem.sensing_cost)
-        before = list(alive)
-        confirms = []
-        for j, (a, b) in enumerate(self.rates):
-            m_cone, m_none = self.mass[j][cone] * self.scale[j], self.mass[j][-1] * self.scale[j]
-            found = m_cone * a
-            detect = found + (alive[j] - m_cone) * b
-            penalty = self.wrong[j] * (detect - found)
-            if detect > 0.0 and penalty < self.miss[j] * (detect - m_none * b):
-                confirms.append(j)
-                if self.any_mode:  # it counts if no label confirmed before it
-                    penalty *= math.prod(alive[:j]) * math.prod(before[j + 1:])
-                self.spent += penalty
-                alive[j] -= detect
-                self.mass[j][cone] *= (1.0 - a) / (1.0 - b)
-                self.scale[j] *= 1.0 - b
-        return tuple(confirms)
-
-    def end_cost(self) -> float:
-        """Expected cost if the route ends here and every open label is rejected."""
-        rejects = [m * (a - q[-1] * s) for m, a, q, s in zip(self.miss, self.alive, self.mass,
-                                                             self.scale, strict=True)]
-        if not self.any_mode:
-            return self.spent + sum(rejects)
-        still = math.prod(self.alive)  # P(no label confirmed), times E[penalty | open]
-        return self.spent + sum(still * r / a for r, a in zip(rejects, self.alive, strict=True)
-                                if a > 0.0)
-
-    def next_cone(self, cones: Sequence[int], here: int) -> int:
-        """The cone with the most expected penalty removed per second from `here` (-1: none)."""
-        weights = [(m * r[0] * s, q) for m, r, s, q in zip(self.miss, self.rates, self.scale,
-                                                           self.mass, strict=True)]
-        inverse = self.problem.inverse_look_costs[here]
-        best, best_utility = -1, 0.0
-        for cone in cones:
-            utility = sum(w * q[cone] for w, q in weights) * inverse[cone]
-            if utility > best_utility:
-                best, best_utility = cone, utility
-        return best

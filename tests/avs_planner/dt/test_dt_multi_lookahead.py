@@ -20,12 +20,8 @@ from avs_planner.dt.domain import NOWHERE, START
 from avs_planner.dt.greedy import looks_then_stop_cost
 from avs_planner.dt.multi import MultiLabelBelief, MultiLookaheadPolicy
 from avs_planner.dt.multi.domain import MultiObservation, confirm_label, look_at, move_to
-from avs_planner.dt.multi.lookahead import (
-    any_mode_penalty,
-    best_route,
-    label_outlook,
-    stop_decision,
-)
+from avs_planner.dt.multi.lookahead import any_mode_penalty, label_outlook, stop_decision
+from avs_planner.dt.multi.route import best_route
 
 CONES = (ViewCone("a", (1, 0, 0), 0.0), ViewCone("b", (3, 0, 0), 0.0),
          ViewCone("c", (0, 3, 0), 0.0))
@@ -65,9 +61,9 @@ def test_any_mode_penalty_equals_enumerating_which_labels_confirm():
     assert any_mode_penalty(outlooks) == pytest.approx(expected)
 
 
-def _route_by_enumeration(problem, route):
-    """Expected cost of following `route` from START: enumerate where every label is and
-    every detection the route reacts to."""
+def _route_by_enumeration(problem, route, open_labels=(0, 1)):
+    """Expected cost of following `route` from START for `open_labels`: enumerate where
+    every label is and every detection the route reacts to."""
     locations = [*range(problem.n), NOWHERE]
     total = 0.0
     for targets in product(locations, repeat=problem.k):
@@ -75,44 +71,78 @@ def _route_by_enumeration(problem, route):
         for i, t in enumerate(targets):
             prior *= problem.single(i).prior[t if t != NOWHERE else problem.n]
         if prior > 0.0:
-            total += prior * _follow(problem, route, targets, 0, START, [True] * problem.k)
+            state = {"open": [i in open_labels for i in range(problem.k)], "ended": False,
+                     "labels": open_labels}
+            total += prior * _follow(problem, route, targets, 0, START, state)
     return total
 
 
-def _follow(problem, route, targets, step, here, open_):
-    """Expected cost from look `step` on, with the labels in `open_` still open."""
-    if step == len(route.cones):  # reject what is left
-        return sum(problem.single(i).rewards.miss_penalty
-                   for i in range(problem.k) if open_[i] and targets[i] != NOWHERE)
+def _follow(problem, route, targets, step, here, state):
+    """Expected cost from look `step` on; `state`: which labels are open, search ended?"""
+    all_mode = problem.mode.value == "all"
+    going = any(state["open"]) and not state["ended"]
+    if step == len(route.cones) or not going:  # reject what is left
+        return sum(problem.single(i).rewards.miss_penalty for i in range(problem.k)
+                   if going and state["open"][i] and targets[i] != NOWHERE)
     cone = route.cones[step]
-    cost = problem.travel_cost(here, cone) + problem.sensing_cost
-    reacting = [i for i in route.confirms[step] if open_[i]]
-    expected = 0.0
-    for seen in product([True, False], repeat=len(reacting)):
-        p, after, penalty = 1.0, list(open_), 0.0
-        for i, hit in zip(reacting, seen, strict=True):
-            rate = problem.single(i).detector.p_detect(targets[i] == cone)
-            p *= rate if hit else 1.0 - rate
-            if hit and (problem.mode.value == "all" or all(after)):
-                after[i] = False
-                if targets[i] != cone:
-                    penalty += problem.single(i).rewards.false_confirm_penalty
-        if p == 0.0:
-            continue
-        over = not any(after) if problem.mode.value == "all" else not all(after)
-        rest = 0.0 if over else _follow(problem, route, targets, step + 1, cone, after)
-        expected += p * (penalty + rest)
-    return cost + expected
+    return (problem.travel_cost(here, cone) + problem.sensing_cost
+            + _resolve(problem, route, targets, step, cone, state, 0, all_mode))
+
+
+def _resolve(problem, route, targets, step, cone, state, i, all_mode):
+    """Expected cost of label i's (and the later labels') reactions to look `step`, then the
+    rest of the route."""
+    if i == problem.k or state["ended"]:
+        return _follow(problem, route, targets, step + 1, cone, state)
+    if not state["open"][i]:
+        return _resolve(problem, route, targets, step, cone, state, i + 1, all_mode)
+    single = problem.single(i)
+    rate = single.detector.p_detect(targets[i] == cone)
+    action = route.on_detection[step][state["labels"].index(i)]
+    wrong = single.rewards.false_confirm_penalty if targets[i] != cone else 0.0
+    missed = single.rewards.miss_penalty if targets[i] != NOWHERE else 0.0
+    closed = {**state, "open": [o and j != i for j, o in enumerate(state["open"])]}
+    confirmed = {**closed, "ended": not all_mode}
+    on_miss = _resolve(problem, route, targets, step, cone, state, i + 1, all_mode)
+    if action == "confirm":
+        on_hit = wrong + _resolve(problem, route, targets, step, cone, confirmed, i + 1, all_mode)
+    elif action == "reject":
+        on_hit = missed + _resolve(problem, route, targets, step, cone, closed, i + 1, all_mode)
+    elif action == "ignore":
+        on_hit = on_miss
+    else:  # verify: one more look here, confirm on a second hit
+        on_hit = problem.sensing_cost + rate * (
+            wrong + _resolve(problem, route, targets, step, cone, confirmed, i + 1, all_mode)
+        ) + (1.0 - rate) * on_miss
+    return rate * on_hit + (1.0 - rate) * on_miss
 
 
 @pytest.mark.parametrize("mode", ["all", "any"])
 @pytest.mark.parametrize("first", [0, 1, 2])
-def test_route_cost_equals_enumerating_the_route(mode, first):
-    problem = _problem(mode, sensing=0.5)
-    route = best_route(problem, MultiLabelBelief.initial(problem), (0, 1), first, 8, 4)
+@pytest.mark.parametrize("sensing", [0.5, 20.0])  # cheap looks verify, dear ones stop
+@pytest.mark.parametrize("settle", [True, False])
+def test_route_cost_equals_enumerating_the_route(mode, first, sensing, settle):
+    problem = _problem(mode, sensing=sensing)
+    route = best_route(problem, MultiLabelBelief.initial(problem), (0, 1), first, 12, 4, settle)
     assert route.cones[0] == first and len(route.cones) >= 2
-    assert any(route.confirms)
     assert route.cost == pytest.approx(_route_by_enumeration(problem, route))
+
+
+def test_routes_settle_detections_every_way_or_confirm_and_ignore():
+    problem = _problem("any", sensing=20.0)
+    start = MultiLabelBelief.initial(problem)
+    route = best_route(problem, start, (0, 1), 0, 12, 4)
+    assert {a for look in route.on_detection for a in look} == {"confirm", "reject", "verify"}
+    route = best_route(problem, start, (0, 1), 0, 12, 4, settle=False)
+    assert {a for look in route.on_detection for a in look} == {"confirm", "ignore"}
+
+
+def test_routes_verify_an_unconvincing_detection():
+    # a label spread thinly: one detection leaves it doubtful, a second settles it
+    problem = _problem("all", cup=(0.2, 0.2, 0.2), book=(0.0, 0.0, 0.0), sensing=0.5)
+    route = best_route(problem, MultiLabelBelief.initial(problem), (0,), 0, 8, 4)
+    assert route.on_detection[0] == ("verify",)
+    assert route.cost == pytest.approx(_route_by_enumeration(problem, route, (0,)))
 
 
 def test_first_look_goes_where_both_labels_may_be():
