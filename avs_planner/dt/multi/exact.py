@@ -2,10 +2,10 @@
 the test oracle of the online policy.
 
 As in the single-label solver, a belief is fixed by the robot position, whether it just moved,
-the claims and every label's hit/miss counts, so beliefs are memoised by that key. A look has
-one outcome per combination of the open labels' detections (2 ** open labels), with the
-probability the product of the labels' own P(detection): this is the one place the joint
-observation is enumerated. Feasible for two or three labels over a few cones.
+the claims and every open label's hit/miss counts, so beliefs are memoised by that key. A look
+has one outcome per combination of the open labels' detections (2 ** open labels, see
+`MultiLabelBelief.outcomes`), so the tree grows fast: feasible for two or three labels over a
+few cones and a short horizon (2 labels x 3 cones x 6 steps: about 0.4 s).
 """
 
 from __future__ import annotations
