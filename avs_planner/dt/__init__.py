@@ -2,6 +2,7 @@
 Search in Large Environments"): a POMDP over view cones, solved closed-loop.
 
 Entry point: `DTSession`. Models follow pomdp-py's layout (domain, models, agent, problem).
+Several labels in one search: `MultiLabelSession` (`avs_planner.dt.multi`).
 """
 
 from avs_planner.dt.domain import (
@@ -18,6 +19,17 @@ from avs_planner.dt.domain import (
     ViewCone,
 )
 from avs_planner.dt.errors import DtInputError, DtSessionError
+from avs_planner.dt.multi import (
+    LabelResult,
+    LabelStatus,
+    LabelTarget,
+    MultiAction,
+    MultiLabelProblem,
+    MultiLabelResult,
+    MultiLabelSession,
+    MultiObservation,
+    SearchMode,
+)
 from avs_planner.dt.policies import POLICIES, PolicyConfig, make_policy
 from avs_planner.dt.pouct import SearchBudget
 from avs_planner.dt.problem import DTProblem, DTRewards, TravelCosts
@@ -26,6 +38,8 @@ from avs_planner.dt.session import DTResult, DTSession, DTStatus, DTStep
 __all__ = [
     "DETECTED", "NOT_DETECTED", "NOTHING", "REJECT", "POLICIES", "ActionKind", "DTAction",
     "DTObservation", "DTProblem", "DTResult", "DTRewards", "DTSession", "DTState", "DTStatus",
-    "DTStep", "DetectorModel", "DtInputError", "DtSessionError", "ObservationKind",
-    "PolicyConfig", "SearchBudget", "TravelCosts", "ViewCone", "make_policy",
+    "DTStep", "DetectorModel", "DtInputError", "DtSessionError", "LabelResult", "LabelStatus",
+    "LabelTarget", "MultiAction", "MultiLabelProblem", "MultiLabelResult", "MultiLabelSession",
+    "MultiObservation", "ObservationKind", "PolicyConfig", "SearchBudget", "SearchMode",
+    "TravelCosts", "ViewCone", "make_policy",
 ]
