@@ -29,8 +29,19 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 
-from avs_planner.dt import DTRewards, DTSession, DTStatus, SearchBudget, TravelCosts, ViewCone
+from avs_planner.dt import (
+    DTRewards,
+    DTSession,
+    DTStatus,
+    LabelStatus,
+    LabelTarget,
+    MultiLabelSession,
+    SearchBudget,
+    TravelCosts,
+    ViewCone,
+)
 from avs_planner.dt.domain import REJECT, ActionKind
+from avs_planner.dt.multi.domain import MultiAction
 from avs_planner.dt.session import DTResult
 from avs_planner.episode.cone_sets import ConeSets
 from avs_planner.episode.context import SkillContext
@@ -38,7 +49,12 @@ from avs_planner.episode.driving import TARGET_SEEN, Driver, Point
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import SeenLike, StepOutcome, StepStatus
 from avs_planner.episode.sensing import Sensing
-from avs_planner.episode.viewcones import ConeSet, support_relations, support_spaces
+from avs_planner.episode.viewcones import (
+    ConeSet,
+    p_at_support,
+    support_relations,
+    support_spaces,
+)
 from conceptual_map.errors import MapError
 from conceptual_map.metric import plan_path
 from conceptual_map.metric.path_planning import PathResult
@@ -68,6 +84,9 @@ class ViewConeSearch:
             return StepOutcome(StepStatus.FAILED, "no view cone of this search is reachable")
         ctx.stats.dt_calls += 1
         reward = cfg.miss_penalty  # R, the CP's goal reward (`LoopConfig.reward`)
+        others = self._watched(made)
+        if others:
+            return self._run_several(made, travel, others)
         session = DTSession(made.cones, cfg.detector, robot.pose,
                             travel_costs=travel, policy=cfg.dt_policy,
                             budget=SearchBudget(num_sims=cfg.dt_sims),
@@ -103,6 +122,173 @@ class ViewConeSearch:
                  result=result.status.value, probability=round(result.probability, 4),
                  steps=len(result.trace), cones=len(made.cones))
         return self._conclude(result, label, relation, location, made, interrupted)
+
+    # ---- a task of several objects: one session over this label and the others it wants ----
+
+    def _watched(self, made: ConeSet) -> list[tuple[str, tuple[float, ...]]]:
+        """The labels the task also wants (`SearchTask.watch`) that may be in this search's
+        cones, with P(label in cone i): the map's P(label at the location) spread over the
+        cones as this label's cones share its own (the cones cover the same space for every
+        label; a support only where the knowledge puts the label on or in it). Labels below
+        the planner's threshold are left to the frames' glimpses."""
+        ctx = self.context
+        builder, mind = ctx.builder, ctx.mind
+        if not builder.task.watch or made.probability <= 0.0:
+            return []
+        out = []
+        for label in builder.task.watch:
+            try:
+                if self.relation == "on":
+                    support = mind.objects[self.location]
+                    if not support_relations(mind, label, support.label):
+                        continue
+                    p = p_at_support(mind, label, self.location)
+                else:
+                    p = mind.cmap.p_object_at(label, self.location)
+            except (KeyError, MapError):
+                continue
+            scale = min(1.0, p) / made.probability
+            probs = tuple(min(1.0, c.probability * scale) for c in made.cones)
+            if sum(probs) >= builder.config.min_probability:
+                total = sum(probs)
+                out.append((label, probs if total <= 1.0 else tuple(q / total for q in probs)))
+        return out
+
+    def _run_several(self, made: ConeSet, travel: TravelCosts,
+                     others: list[tuple[str, tuple[float, ...]]]) -> StepOutcome:
+        """One DT session over this search's label and the others the task wants
+        (`avs_planner.dt.multi`: a look serves every label, each is confirmed or rejected on
+        its own): a confirmed other label becomes a known object (the task reports it in its
+        own turn), every label's unseen count is thinned by the looks, and this label's result
+        concludes the step as a one-label session's would."""
+        ctx, robot, cfg = self.context, self.context.robot, self.context.config
+        label = self.label
+        reward = cfg.miss_penalty
+        rewards = DTRewards(reward, reward)
+        mass = sum(c.probability for c in made.cones)
+        own = tuple(c.probability / mass * min(1.0, mass) for c in made.cones) if mass > 0 \
+            else tuple(0.0 for _ in made.cones)
+        targets = [LabelTarget(label, own, cfg.detector, rewards)]
+        targets += [LabelTarget(w, probs, cfg.detector, rewards) for w, probs in others]
+        session = MultiLabelSession(made.cones, targets, robot.pose, travel_costs=travel,
+                                    mode="all")
+        interrupted = False
+        while True:
+            action = session.next_action()
+            if session.finished:
+                break
+            if action.kind is ActionKind.CONFIRM:
+                if action.label != label:
+                    self._keep_other(session, action)
+                continue
+            if action.kind is ActionKind.REJECT:
+                continue
+            cone = session.cone(action)
+            assert cone is not None
+            if action.kind is ActionKind.MOVE:
+                if self.driver.drive_to(cone.pose[:2]).detail == TARGET_SEEN:
+                    interrupted = True  # as a one-label session: the planner reports it
+                    break
+                robot.turn_to(cone.pose[2])
+                ctx.look(*(cone.head or (0.0, 0.0)))
+                self.head = cone.head or (0.0, 0.0)
+                if cone.torso is not None:
+                    robot.set_torso(cone.torso)
+                session.update(action)
+                continue
+            open_ = [lab for lab, r in session.label_results().items()
+                     if r.status is LabelStatus.OPEN]
+            seen, detections = self._look_several(open_)
+            session.update(action, seen, detections)
+        return self._conclude_several(session, made, interrupted)
+
+    def _look_several(self, labels: list[str]) -> tuple[dict[str, bool], dict[str, SeenLike]]:
+        """PROCESSVIEWCONE for several labels: one frame asks for all (and the supports, as
+        a one-label look's first frame does); each label detected in the searched location
+        is looked at again as `_look` does, and counts when a frame agrees."""
+        ctx = self.context
+        ctx.stats.views += 1
+        if self.on_look is not None:
+            self.on_look()
+        also = [a for a in self._also_for(self.label) if a not in labels] \
+            if self.label in labels else []
+        frame = ctx.detect([*labels, *also])
+        if also:  # the session's own labels are its to confirm and thin, not the glimpses'
+            self.sensing.glimpse([s for s in frame if s.label not in labels], also, self.head)
+        seen: dict[str, bool] = {}
+        detections: dict[str, SeenLike] = {}
+        frames = 1 + (1 if ctx.config.dt_tiebreak else 0)
+        for label in labels:
+            match = next((s for s in frame if s.label == label
+                          and self._inside(s, self.relation, self.location)), None)
+            agreed = False
+            if match is not None:
+                agree = ctx.config.agree[0]
+                for _ in range(frames):
+                    again = next((s for s in ctx.detect([label]) if s.label == label), None)
+                    agreed = again is not None and \
+                        math.dist(again.position, match.position) <= agree
+                    if agreed:
+                        break
+            elif label == self.label:
+                self._glimpse_tops(label, self.relation, self.location)
+            ctx.emit("observation", label=label, detected=agreed,
+                     **({"position": [round(v, 2) for v in match.position]}
+                        if match is not None else {}))
+            seen[label] = agreed
+            if agreed:
+                detections[label] = match
+        return seen, detections
+
+    def _keep_other(self, session: MultiLabelSession, action: MultiAction) -> None:
+        """The session confirmed a label the task also wants: a known object now (its turn
+        reports it), unless the mind knows one there already."""
+        result = session.label_results()[action.label]
+        seen = result.detection
+        if seen is None or self.sensing.known_near(seen):
+            return
+        mind = self.context.mind
+        support = self.location if self.relation == "on" else None
+        room = None if support else (mind.room_at(seen.position[:2])
+                                     or mind.nearest_room(seen.position[:2]))
+        if support is None and room is None:
+            return
+        obj = mind.add_object(seen.label, seen.position, support, room=room)
+        self.found_sids[obj.id] = seen.id
+        self.context.emit("observation", label=seen.label, detected=True, object=obj.id,
+                          position=[round(v, 2) for v in seen.position], wanted=True)
+
+    def _conclude_several(self, session: MultiLabelSession, made: ConeSet,
+                          interrupted: bool) -> StepOutcome:
+        """This label's part as a one-label session's result (`_conclude`), and the other
+        labels' unseen counts thinned by the same looks."""
+        ctx = self.context
+        label, relation, location = self.label, self.relation, self.location
+        result = session.result
+        results = result.labels if result is not None else session.label_results()
+        steps = tuple(step for step in (result.trace if result is not None else ())
+                      if step.action.kind in (ActionKind.MOVE, ActionKind.PROCESS_VIEW_CONE))
+        times = result.decision_times_s if result is not None else ()
+        mine = results[label]
+        status = DTStatus.CONFIRMED if mine.status is LabelStatus.CONFIRMED \
+            else DTStatus.REJECTED
+        ctx.stats.dt_decisions.extend(times)
+        ctx.emit("dt", label=label, relation=relation, location=location,
+                 result=status.value, probability=round(mine.probability, 4),
+                 steps=len(steps), cones=len(made.cones),
+                 labels={lab: r.status.value for lab, r in results.items() if lab != label})
+        looks: dict[int, int] = {}
+        for step in steps:
+            if step.action.kind is ActionKind.PROCESS_VIEW_CONE:
+                looks[step.action.cone] = looks.get(step.action.cone, 0) + 1
+        coverage = self._coverage(made, looks, label, relation, location)
+        if coverage > 0.0:
+            for other in results:
+                if other != label:
+                    self._searched(other, relation, location, coverage)
+        single = DTResult(status, mine.probability, result.cost if result else 0.0, steps,
+                          mine.cone_id, mine.detection, None, tuple(times))
+        return self._conclude(single, label, relation, location, made, interrupted)
 
     def _reachable(self, made: ConeSet) -> tuple[ConeSet, TravelCosts]:
         """The cones the robot has a path to, and the DT's travel costs between them: driving

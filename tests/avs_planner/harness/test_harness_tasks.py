@@ -129,3 +129,19 @@ def test_count_every_cup(tmp_path):
     assert len(ids) == len(set(ids)) >= 1  # no object reported twice
     assert part["correct"] and part["distinct"] == len(ids)
     assert "found" in part["reason"]
+
+
+def test_a_dt_search_also_looks_for_the_other_labels(tmp_path):
+    """A DT search during a task of several is one session over the turn's label and the
+    other open labels the searched place may hold (`ViewConeSearch._run_several`): its `dt`
+    event names their results, and a look asks for every one of them. (Generated lab 316, a
+    development building, where the book's turn searches a support the others may be on.)"""
+    run_episode({"targets": ["keyboard", "monitor", "book"],
+                 "generate": {"seed": 316, "style": "lab"}, "output_dir": str(tmp_path)})
+    events = _events(tmp_path)
+    several = [e for e in events if e["type"] == "dt" and e.get("labels")]
+    assert several
+    for event in several:
+        assert event["label"] not in event["labels"]
+        assert set(event["labels"]) <= {"keyboard", "monitor", "book"}
+        assert set(event["labels"].values()) <= {"confirmed", "rejected", "open"}
