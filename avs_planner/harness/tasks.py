@@ -20,9 +20,13 @@ known, so its search is a short one (the robot faces it, looks again and reports
 robot keeps everything it mapped, classified and ruled out, so later turns do not drive the
 same corridors again.
 
+A DT search in a turn is one session over the turn's label and the other open labels the
+searched cones may hold (`ViewConeSearch._run_several`, `avs_planner.dt.multi`).
+
 Which open label a turn serves: one with a known object not reported yet (the nearest
-first), else the one the mapped rooms most likely still hold (P(at least one in their space
-not yet searched), from the conceptual map): search first for what is likeliest near.
+first), else the one whose search is worth most going on from here (`TaskRun.worth`: the
+stopping rule's bound, R x P(found within cost c) - c at best). The robot looks round once
+before the first turn, watching for every label, so the first choice is made on a map.
 
 Every strategy runs the same way: a turn is `Strategy.load()(context)` with the context's
 target and state builder set to the turn's label, and the task's budgets and start clock.
