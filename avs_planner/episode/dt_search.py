@@ -171,7 +171,7 @@ class ViewConeSearch:
         targets = [LabelTarget(label, own, cfg.detector, rewards)]
         targets += [LabelTarget(w, probs, cfg.detector, rewards) for w, probs in others]
         session = MultiLabelSession(made.cones, targets, robot.pose, travel_costs=travel,
-                                    mode="all")
+                                    mode=ctx.builder.task.mode)
         interrupted = False
         while True:
             action = session.next_action()

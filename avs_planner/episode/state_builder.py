@@ -36,12 +36,15 @@ class SearchTask:
     names the others it still wants as `watch`: the detector looks for them too wherever it
     looks for the target, and one it confirms becomes a known object (reported in its own
     turn). `exclude`: known objects of the target already reported (a task that counts every
-    instance): the planner does not see them, so it searches for another one."""
+    instance): the planner does not see them, so it searches for another one. `mode`: whether
+    the task wants all its labels or any one (a DT search over several stops at the first
+    confirmed in "any")."""
 
     target: str
     category: str | None = None
     watch: tuple[str, ...] = ()
     exclude: frozenset[str] = frozenset()
+    mode: str = "all"  # the task wants every label (all) or any one of them (any)
 
 
 @dataclass(frozen=True)

@@ -320,7 +320,7 @@ class TaskRun:
                                    first.config)
             builder.search_times = first.search_times  # the robot's own, shared
             self.builders[label] = builder
-        builder.task = replace(builder.task, watch=watch, exclude=frozenset(
+        builder.task = replace(builder.task, watch=watch, mode=self.form.mode, exclude=frozenset(
             oid for oid in self.reported if self._label_of(oid) == label))
         return builder
 
