@@ -200,13 +200,20 @@ class _TurnTrace:
     """The episode's trace as a turn's strategy sees it: its `done` is the turn's end (a
     `turn` event); the task's own `done` comes once, when the task ends."""
 
-    def __init__(self, trace: Any, label: str) -> None:
-        self._trace, self._label = trace, label
+    def __init__(self, trace: Any, turn: _Turn) -> None:
+        self._trace, self._turn = trace, turn
 
     def emit(self, type_: str, **fields: Any) -> dict[str, Any]:
-        if type_ == "done":
-            return self._trace.emit("turn", target=self._label, status="end", **fields)
-        return self._trace.emit(type_, **fields)
+        if type_ != "done":
+            return self._trace.emit(type_, **fields)
+        turn = self._turn
+        if turn.seen is not None:  # the turn was ended for another label, not by the user
+            fields |= {"outcome": "switched", "reason": f"{turn.seen.label} seen "
+                                                        f"({turn.seen.id}): its turn next"}
+        elif turn.enough is not None:
+            fields |= {"outcome": "enough",
+                       "reason": f"P(another {turn.label} unseen) = {turn.enough:.3g}"}
+        return self._trace.emit("turn", target=turn.label, status="end", **fields)
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._trace, name)
@@ -284,7 +291,7 @@ class TaskRun:
         ctx.trace.emit("turn", target=label, status="start", watch=list(watch),
                        found=len(target.found))
         sub = replace(ctx, target=label, builder=builder, should_stop=turn,
-                      trace=_TurnTrace(ctx.trace, label),
+                      trace=_TurnTrace(ctx.trace, turn),
                       stop_below=self.form.stop_below if self.form.count == "all" else None)
         result = self.search(sub)
         self.result.plans += result.plans

@@ -34,6 +34,8 @@ def document(ledger: Ledger, final: Mapping[str, Any] | None = None) -> dict[str
         "search": _search(ledger),
         "notes": ledger.notes,
     }
+    if ledger.task is not None:
+        out["task"] = {**ledger.task, "turns": ledger.turns, "ends": ledger.targets}
     if final:
         out["final_beliefs"] = dict(final)
     if outcome["outcome"] == "gave_up":

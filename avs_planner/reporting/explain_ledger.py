@@ -43,6 +43,10 @@ class Ledger:
 
     def __init__(self) -> None:
         self.start: dict[str, Any] = {}
+        # a task of several objects: its form, its turns and each target's end (else None/[])
+        self.task: dict[str, Any] | None = None
+        self.turns: list[dict[str, Any]] = []
+        self.targets: list[dict[str, Any]] = []
         self.done: dict[str, Any] | None = None
         self.plans: list[dict[str, Any]] = []
         self.replans: list[dict[str, Any]] = []
@@ -79,6 +83,29 @@ class Ledger:
 
     def _on_start(self, event: Mapping[str, Any]) -> None:
         self.start = {k: event.get(k) for k in ("target", "world", "robot", "seed", "strategy")}
+        task = event.get("task")
+        if isinstance(task, Mapping) and task.get("targets"):
+            self.task = dict(task)
+            self.start["target"] = task_name(task)
+
+    def _on_turn(self, event: Mapping[str, Any]) -> None:
+        """A task of several objects searches in turns, one label each (`harness/tasks.py`);
+        the assumptions a turn's plans made end with it."""
+        if event.get("status") == "start":
+            self.turns.append({"t": event.get("t"), "target": event.get("target"),
+                               "watch": list(event.get("watch") or [])})
+            return
+        if self.turns and "ended" not in self.turns[-1]:
+            self.turns[-1] |= {"ended": event.get("t"), "outcome": event.get("outcome"),
+                               "reason": event.get("reason")}
+        for entry in list(self.open.values()):
+            self._close(entry, "unresolved", event.get("t"),
+                        f"still assumed when the turn for {event.get('target')} ended "
+                        f"({event.get('outcome')})")
+
+    def _on_target(self, event: Mapping[str, Any]) -> None:
+        self.targets.append({k: event.get(k) for k in ("t", "target", "outcome", "reason",
+                                                       "found")})
 
     def _on_map(self, event: Mapping[str, Any]) -> None:
         self.seen.feed(event)
@@ -375,3 +402,15 @@ def build(events: Iterable[Mapping[str, Any]], final: Mapping[str, Any] | None =
     for event in events:
         ledger.feed(event)
     return ledger.explanation(final)
+
+
+def task_name(task: Mapping[str, Any]) -> str:
+    """A task of several objects in a few words ("cup and book", "cup or glass", "every
+    chair"), as its summary names it (`harness.tasks.TaskForm.name`)."""
+    labels = [str(t) for t in task.get("targets") or []]
+    if task.get("count") == "all" and labels:
+        return f"every {labels[0]}"
+    if len(labels) < 2:
+        return labels[0] if labels else "?"
+    joint = " or " if task.get("mode") == "any" else " and "
+    return ", ".join(labels[:-1]) + joint + labels[-1]

@@ -43,6 +43,20 @@ def render(explanation: Mapping[str, Any]) -> str:
     head = (f"Episode: find {e.get('target')} in {e.get('world')} ({e.get('strategy')}, "
             f"{e.get('robot')}, seed {e.get('seed')})")
     out += [head, f"Outcome: {e.get('outcome')} at t={_t(e.get('t'))}: {e.get('reason')}", ""]
+    task = e.get("task")
+    if task:
+        out.append(f"Task: {task.get('mode')} of {', '.join(task.get('targets') or [])}"
+                   + (" (every instance)" if task.get("count") == "all" else "")
+                   + f", in {len(task.get('turns') or [])} turns:")
+        for turn in task.get("turns") or []:
+            watch = f" (also watching {', '.join(turn['watch'])})" if turn.get("watch") else ""
+            out.append(f"  t={_t(turn.get('t'))}-{_t(turn.get('ended'))} {turn.get('target')}"
+                       f"{watch}: {turn.get('outcome', 'unfinished')}"
+                       + (f", {turn['reason']}" if turn.get("reason") else ""))
+        for target in task.get("ends") or []:
+            out.append(f"  {target.get('target')}: {target.get('outcome')} at "
+                       f"t={_t(target.get('t'))}: {target.get('reason')}")
+        out.append("")
     plans = e.get("plans") or []
     if plans:
         out.append(f"Plans ({len(plans)}):")

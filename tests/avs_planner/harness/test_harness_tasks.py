@@ -145,3 +145,15 @@ def test_a_dt_search_also_looks_for_the_other_labels(tmp_path):
         assert event["label"] not in event["labels"]
         assert set(event["labels"]) <= {"keyboard", "monitor", "book"}
         assert set(event["labels"].values()) <= {"confirmed", "rejected", "open"}
+
+
+def test_the_explanation_tells_the_turns(tmp_path):
+    run_episode({"targets": ["cup", "stapler"], "world": "office", "output_dir": str(tmp_path)})
+    explanation = json.loads((tmp_path / "explanation.json").read_text())
+    assert explanation["target"] == "cup and stapler"
+    task = explanation["task"]
+    assert task["targets"] == ["cup", "stapler"] and task["mode"] == "all"
+    assert task["turns"] and all("ended" in turn for turn in task["turns"])
+    assert sorted(end["target"] for end in task["ends"]) == ["cup", "stapler"]
+    assert all(end["outcome"] == "found" for end in task["ends"])
+    assert not [a for a in explanation["assumptions"] if a["status"] == "open"]
