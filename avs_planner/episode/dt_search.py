@@ -101,17 +101,12 @@ class ViewConeSearch:
                 break
             cone = session.cone(action)
             if action.kind is ActionKind.MOVE:
-                if self.driver.drive_to(cone.pose[:2]).detail == TARGET_SEEN:
+                if not self._arrive(cone):
                     # the watch confirmed the target on the way to this cone: stop here
                     # (the looks so far still count) and let the planner report it
                     session.update(REJECT)
                     interrupted = True
                     break
-                robot.turn_to(cone.pose[2])
-                ctx.look(*(cone.head or (0.0, 0.0)))
-                self.head = cone.head or (0.0, 0.0)
-                if cone.torso is not None:
-                    robot.set_torso(cone.torso)
                 session.update(action)
                 continue
             match = self._look(label, relation, location)
@@ -122,6 +117,19 @@ class ViewConeSearch:
                  result=result.status.value, probability=round(result.probability, 4),
                  steps=len(result.trace), cones=len(made.cones))
         return self._conclude(result, label, relation, location, made, interrupted)
+
+    def _arrive(self, cone: ViewCone) -> bool:
+        """MOVE to a cone: drive to its pose, turn, point the head (and set the torso); False
+        when the watch confirmed the target on the way (the robot stops there)."""
+        robot = self.context.robot
+        if self.driver.drive_to(cone.pose[:2]).detail == TARGET_SEEN:
+            return False
+        robot.turn_to(cone.pose[2])
+        self.head = cone.head or (0.0, 0.0)
+        self.context.look(*self.head)
+        if cone.torso is not None:
+            robot.set_torso(cone.torso)
+        return True
 
     # ---- a task of several objects: one session over this label and the others it wants ----
 
@@ -186,14 +194,9 @@ class ViewConeSearch:
             cone = session.cone(action)
             assert cone is not None
             if action.kind is ActionKind.MOVE:
-                if self.driver.drive_to(cone.pose[:2]).detail == TARGET_SEEN:
+                if not self._arrive(cone):
                     interrupted = True  # as a one-label session: the planner reports it
                     break
-                robot.turn_to(cone.pose[2])
-                ctx.look(*(cone.head or (0.0, 0.0)))
-                self.head = cone.head or (0.0, 0.0)
-                if cone.torso is not None:
-                    robot.set_torso(cone.torso)
                 session.update(action)
                 continue
             open_ = [lab for lab, r in session.label_results().items()
