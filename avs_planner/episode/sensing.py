@@ -43,6 +43,7 @@ class Sensing:
         # where a task's next turn began (`harness/tasks.py`): a look around before the
         # robot has left that spot is skipped (`look_around`)
         self.resumed: tuple[float, float] | None = None
+        self.kept = 0  # objects of labels the task also wants, made known (`_kept`)
         self.glimpses: Glimpses | None = None
         self.unplaced: list[SeenLike] = []  # confirmed, waiting for the map to give a room
         self.seen_while_moving: dict[str, set[Atom]] = {}
@@ -75,11 +76,12 @@ class Sensing:
         headings = max(2, ctx.config.look_headings)
         yaw = ctx.robot.pose[2]
         ctx.mind.integrate(ctx.robot.scan())
+        kept = self.kept
         found = self.watch()
         half = headings // 2
         for k in range(1, headings):
-            if found is not None and k > half:  # the target is here: the map is done
-                break
+            if (found is not None or self.kept > kept) and k > half:
+                break  # the target (or a label the task also wants) is here: the map is done
             if self.unplaced and k < half:
                 # the target is confirmed and waits only for the scan behind to give it a
                 # room: turn straight there (a frame at each heading on the way cost a second
@@ -145,8 +147,8 @@ class Sensing:
             if not first or self.known_near(first[0]):
                 return None
         else:  # the first of the wanted labels (the target before the others) not known yet
-            first = [s for lab in wanted for s in frame
-                     if s.label == lab and not self.known_near(s)][:1]
+            first = [s for lab in wanted for s in frame if s.label == lab
+                     and not self.known_near(s) and not self._waiting_near(s)][:1]
             if not first:
                 return None
         seen = first[0]
@@ -183,6 +185,8 @@ class Sensing:
             if seen.label in ctx.builder.task.watch:
                 # a label the task also wants, seen in any frame (the DT's looks too): as
                 # the watch does for the target, with its care (`confirm`'s defaults)
+                if self._waiting_near(seen):
+                    continue  # confirmed already, waiting for the map to give it a room
                 again = self.confirm(seen)
                 ctx.emit("observation", label=seen.label, detected=bool(again),
                          watching=True, position=[round(v, 2) for v in seen.position])
@@ -276,9 +280,17 @@ class Sensing:
     def _kept(self, seen: SeenLike, obj: KnownObject) -> None:
         """A label the task also wants (`SearchTask.watch`) is known now: reported in its
         own turn (the planner's problem of this turn has no such label)."""
+        self.kept += 1
         self.context.emit("observation", label=seen.label, detected=True, watching=True,
                           position=[round(v, 2) for v in seen.position], object=obj.id,
                           wanted=True)
+
+    def _waiting_near(self, seen: SeenLike) -> bool:
+        """A confirmed detection of the same label near `seen` waits for a room (`unplaced`):
+        confirming it again would make one object two."""
+        reach = self.context.config.same_object
+        return any(u.label == seen.label and math.dist(u.position[:2], seen.position[:2])
+                   <= reach for u in self.unplaced)
 
     def known_near(self, seen: SeenLike) -> bool:
         """A detection of an object the mind already knows (same label, within

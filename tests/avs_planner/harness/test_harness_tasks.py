@@ -6,6 +6,7 @@ cup2 on a desk in office2, stapler1 on another desk there, no book) for "all", "
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 
@@ -157,3 +158,19 @@ def test_the_explanation_tells_the_turns(tmp_path):
     assert sorted(end["target"] for end in task["ends"]) == ["cup", "stapler"]
     assert all(end["outcome"] == "found" for end in task["ends"])
     assert not [a for a in explanation["assumptions"] if a["status"] == "open"]
+
+
+def test_a_label_seen_before_the_map_has_rooms_becomes_one_object(tmp_path):
+    """A label the task also wants, confirmed in the very first look (no room yet to put it
+    in), waits for one; the frames after do not confirm it again as a second object. (In
+    generated lab 314, a development building, the keyboard is in view at the start.)"""
+    summary = run_episode({"targets": ["stapler", "keyboard"], "mode": "any",
+                           "generate": {"seed": 314, "style": "lab"},
+                           "output_dir": str(tmp_path)})
+    made = [e for e in _events(tmp_path) if e["type"] == "observation" and e.get("wanted")]
+    assert made
+    for i, first in enumerate(made):
+        for second in made[i + 1:]:
+            assert first["label"] != second["label"] or \
+                math.dist(first["position"][:2], second["position"][:2]) > 0.5
+    assert summary["outcome"] == "found" and summary["correct"]
