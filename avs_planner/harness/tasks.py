@@ -45,7 +45,7 @@ from avs_planner.episode.mind import KnownObject
 from avs_planner.episode.outcome import Outcome, SearchResult
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.strategies import SearchContext
-from avs_planner.strategies.switching.stopping import look_cost, remaining
+from avs_planner.strategies.switching.stopping import Remaining, look_cost, remaining
 
 MODES = ("all", "any")
 COUNTS = ("one", "all")
@@ -228,11 +228,10 @@ class TaskRun:
         self.form, self.ctx, self.search = form, ctx, search
         self.user_stop = ctx.should_stop
         self.outcomes = {label: TargetOutcome(label) for label in form.targets}
-        self.reported: set[str] = set()
         self.builders: dict[str, StateBuilder] = {ctx.builder.task.target: ctx.builder}
         self.result = SearchResult(Outcome.GAVE_UP, "")
         self.turns = 0
-        self.turns_look: tuple[float, float] | None = None  # where the task looked round first
+        self.looked_first = False  # the task looked round before its first turn
 
     # ---- the turns ---------------------------------------------------------------------
 
@@ -247,7 +246,7 @@ class TaskRun:
             ctx.executor.context.builder = self._builder(self.form.targets[0],
                                                          self.form.targets[1:])
             ctx.executor.look_around()
-            self.turns_look = tuple(ctx.robot.pose[:2])
+            self.looked_first = True
         while not self._over():
             stop = ctx.budget_spent()
             if stop:
@@ -286,7 +285,7 @@ class TaskRun:
         # a turn after the first goes on from where the robot stands: the strategy's first
         # look around is skipped (`Sensing.resumed`)
         ctx.executor.sensing.resumed = tuple(ctx.robot.pose[:2]) \
-            if self.turns or self.turns_look else None
+            if self.turns or self.looked_first else None
         self.turns += 1
         ctx.trace.emit("turn", target=label, status="start", watch=list(watch),
                        found=len(target.found))
@@ -299,7 +298,6 @@ class TaskRun:
         self.result.cp_times.extend(result.cp_times)
         if result.outcome is Outcome.FOUND and result.found is not None:
             target.found.append(result.found)
-            self.reported.add(result.found.id)
             if self.form.count == "one":
                 self._close(label, Outcome.FOUND, result.reason)
             return
@@ -317,25 +315,27 @@ class TaskRun:
             self._close(label, Outcome.GAVE_UP, result.reason)
 
     def _builder(self, label: str, watch: tuple[str, ...]) -> StateBuilder:
-        """The turn's state builder: one per label, kept across its turns (the searches it
-        saw fail, the search times it measured), told what else to watch for and which of
-        its objects were reported."""
-        first = self.ctx.builder
+        """The turn's state builder (`_builder_of`), told what else to watch for and which of
+        its label's objects were reported."""
+        builder = self._builder_of(label)
+        builder.task = replace(builder.task, watch=watch, mode=self.form.mode,
+                               exclude=frozenset(obj.id for obj in self.outcomes[label].found))
+        return builder
+
+    def _builder_of(self, label: str) -> StateBuilder:
+        """The label's state builder: one per label, kept across its turns (the searches it
+        saw fail, the search times it measured)."""
         builder = self.builders.get(label)
         if builder is None:
+            first = self.ctx.builder
             builder = StateBuilder(self.ctx.mind, SearchTask(label, first.task.category),
                                    first.config)
             builder.search_times = first.search_times  # the robot's own, shared
             self.builders[label] = builder
-        builder.task = replace(builder.task, watch=watch, mode=self.form.mode, exclude=frozenset(
-            oid for oid in self.reported if self._label_of(oid) == label))
         return builder
 
-    def _label_of(self, oid: str) -> str | None:
-        for t in self.outcomes.values():
-            if any(obj.id == oid for obj in t.found):
-                return t.label
-        return None
+    def _reported(self) -> set[str]:
+        return {obj.id for t in self.outcomes.values() for obj in t.found}
 
     def next_label(self) -> str:
         """The open label a known, unreported object has (the nearest), else the one whose
@@ -343,9 +343,10 @@ class TaskRun:
         open_ = self._open()
         ctx = self.ctx
         here = ctx.robot.pose[:2]
+        reported = self._reported()
         known = [(math.dist(obj.position[:2], here), i, obj.label)
                  for i, obj in enumerate(ctx.mind.objects.values())
-                 if obj.label in open_ and obj.id not in self.reported]
+                 if obj.label in open_ and obj.id not in reported]
         if known:
             return min(known)[2]
         if len(open_) == 1 or not ctx.mind.place_map.rooms:
@@ -358,26 +359,25 @@ class TaskRun:
         lead to: `stopping.remaining`), the largest R x P(found within c) - c, R the reward
         the strategy plans with (the switching planner's objective; the stopping rule's
         bound on any continuation)."""
-        ctx = self.ctx
-        reward = float(ctx.options.get("reward", DEFAULT_REWARD))
-        self._builder(label, ())
-        belief = remaining(ctx.mind, self.builders[label], ctx.robot.pose[:2],
-                           look_cost(ctx.mind.body, ctx.executor.config.look_headings))
-        return max((reward * p - cost for cost, p in belief.within), default=-math.inf)
+        reward = float(self.ctx.options.get("reward", DEFAULT_REWARD))
+        return max((reward * p - cost for cost, p in self._remaining(label).within),
+                   default=-math.inf)
 
     def p_another(self, label: str) -> float:
         """P(another `label` in space not yet searched, mapped or beyond the frontiers)."""
+        return self._remaining(label).p
+
+    def _remaining(self, label: str) -> Remaining:
+        """The conceptual map's building-level belief for `label` from where the robot is."""
         ctx = self.ctx
-        builder = self.builders[label]
-        return remaining(ctx.mind, builder, ctx.robot.pose[:2],
-                         look_cost(ctx.mind.body, ctx.executor.config.look_headings)).p
+        return remaining(ctx.mind, self._builder_of(label), ctx.robot.pose[:2],
+                         look_cost(ctx.mind.body, ctx.executor.config.look_headings))
 
     def _enough(self, label: str) -> bool:
         """Counting every instance: P(another) is below the task's level already."""
         target = self.outcomes[label]
         if self.form.count != "all" or not target.found or label not in self.builders:
             return False
-        self._builder(label, ())
         p = self.p_another(label)
         if p >= self.form.stop_below:
             return False
