@@ -62,3 +62,19 @@ def test_room_beliefs_reach_neighbours_through_phi_rc():
     cmap.observe_object("counter", "room")
     assert cmap.room_category("other")["kitchen"] < before
     assert cmap.update().status is BPStatus.CONVERGED
+
+
+def test_one_more_ignores_the_instances_already_found():
+    """`another=True` (a task counting every instance) asks for one more: a found cup makes
+    P(a cup in the room) 1, but P(another one) is the Poisson count still unseen there, which
+    a search through the room lowers."""
+    cmap = _room()
+    cmap.observe_object("cup", "room")
+    assert cmap.p_object_at("cup", "room") == 1.0
+    assert list(cmap.p_object_at_per_category("cup", "room")) == [1.0] * len(
+        cmap.knowledge.categories)
+    before = cmap.p_object_at("cup", "room", another=True)
+    assert 0.0 < before < 1.0
+    cmap.observe_search("cup", "room", 0.9, 1.0)
+    assert cmap.p_object_at("cup", "room", another=True) < before
+    assert cmap.p_object_at("cup", "room") == 1.0
