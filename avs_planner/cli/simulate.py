@@ -66,6 +66,13 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--pre-explore", action="store_true", help="map the building before "
                         "the clock starts (the strategy's own survey where it has one, e.g. "
                         "flap's with depth frames)")
+    parser.add_argument("--memory", metavar="DIR", help="the building's memory: start from "
+                        "what the robot learned in DIR in earlier tasks (map, furniture, "
+                        "sightings to check again) and keep this task's there; created when "
+                        "missing (docs/memory.md)")
+    parser.add_argument("--since", type=float, metavar="S", help="with --memory: simulated "
+                        "seconds since the building's last task (default 3600); sightings "
+                        "fade with it")
     parser.add_argument("--out", default=None,
                         help="output directory (default: a new one under runs/ named after "
                         "the world and target, e.g. runs/office-cerealbox-2: a run never "
@@ -93,6 +100,10 @@ def run(args: argparse.Namespace) -> int:
         _check_label(checked)  # before the run, as a label refused with --strict-labels
         _check_start(checked)  # a pose outside the building is refused, as the API does
         _check_out(Path(args.out))
+        if checked.memory is not None:
+            from avs_planner.episode import memory
+
+            memory.load(checked.memory)  # a memory that cannot be read: exit 1, named
     except (EpisodeError, ValueError) as exc:
         print(f"avs: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -182,6 +193,13 @@ def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
         spec["strategy_options"] = dict(_option(text) for text in args.option)
     if args.qsr:
         spec["qsr"] = _qsr_file(args.qsr)
+    if args.since is not None and args.memory is None:
+        raise ValueError("--since S is the time since the building's last task: use it with "
+                         "--memory DIR")
+    if args.memory is not None:
+        spec["memory"] = args.memory
+    if args.since is not None:
+        spec["since_s"] = args.since
     if args.record:
         spec["record"] = True
     if args.view:
@@ -316,6 +334,12 @@ def _print_summary(summary: dict[str, Any], out: Path) -> None:
           f"({summary.get('dt_confirmed', 0)} confirmed, {summary.get('dt_rejected', 0)} "
           f"rejected), "
           f"{summary['views_processed']} views, wall {summary['wall_time_s']:.1f} s")
+    mem = summary.get("memory")
+    if mem:
+        start = (f"after {mem['tasks_before']} earlier task(s): {mem['furniture']} furniture, "
+                 f"{mem['sightings']} sighting(s), {mem['checked']} checked, "
+                 f"{mem['confirmed']} seen again" if mem["tasks_before"] else "nothing yet")
+        print(f"  memory: {start}; kept this task's")
     files = [out / name for name in ("trace.jsonl", "summary.json", "explanation.json",
                                       "trajectory.png", "recording.rrd")
              if (out / name).exists()]

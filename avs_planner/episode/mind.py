@@ -74,6 +74,11 @@ class Mind:
     failed_moves: dict[tuple[str, str], frozenset[str]] = field(default_factory=dict)
     blocked_retries: int = 0  # times the blocked spots were forgotten (`retry_blocked`)
     clock: float = 0.0  # s: the time of the last scan sensed
+    # object id -> the clock when it was confirmed (what the building memory keeps with it)
+    seen_at: dict[str, float] = field(default_factory=dict)
+    # sightings from the building memory not checked yet (`episode/memory.py`): never
+    # known objects, so nothing is reported from memory alone
+    remembered: list = field(default_factory=list)
     # (grid and rooms key, `viewcones.candidate_cells`' result): recomputed when either changes
     cell_cache: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
@@ -230,12 +235,14 @@ class Mind:
         self.cmap.observe_object(label, room, on=support, object_id=oid)
         known = KnownObject(oid, label, position, room, support)
         self.objects[oid] = known
+        self.seen_at[oid] = self.clock
         return known
 
     def forget_object(self, oid: str) -> None:
         """A known object proved a false detection: the mind and the map drop it."""
         self.cmap.forget_object(oid)
         self.objects.pop(oid, None)
+        self.seen_at.pop(oid, None)
 
     def searched(self, label: str, relation: str, location: str, coverage: float,
                  p_detect: float) -> None:

@@ -15,10 +15,12 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from avs_planner.episode import memory
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.executor import Executor, ExecutorConfig
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import SearchResult
+from avs_planner.episode.recall import check_remembered
 from avs_planner.episode.robot_api import fence
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.trace import Trace, write_summary
@@ -45,7 +47,8 @@ REPORT_TOLERANCE = 0.5
 _KEYS = {"target", "targets", "mode", "count", "stop_below", "category", "world", "world_file",
          "robot", "start_room", "start", "seed", "time_budget_s", "wall_budget_s", "task_id",
          "output_dir", "pre_explore", "dt_policy",
-         "strategy", "strategy_options", "generate", "qsr", "record", "view", "strict_labels"}
+         "strategy", "strategy_options", "generate", "qsr", "record", "view", "strict_labels",
+         "memory", "since_s"}
 
 
 @dataclass(frozen=True)
@@ -77,6 +80,9 @@ class EpisodeSpec:
     # knowledge's uninformed prior, `Knowledge.with_label`, and a `warning` event)
     strict_labels: bool = False
     task: TaskForm | None = None
+    # the building's memory (a directory: `episode/memory.py`); None: start from nothing
+    memory: str | None = None
+    since_s: float = 3600.0  # simulated seconds since the building's previous task
 
     @property
     def form(self) -> TaskForm:
@@ -115,8 +121,19 @@ class EpisodeSpec:
             dt_policy=str(spec.get("dt_policy") or "pouct"), strategy=strategy.name,
             strategy_options=options, generate=generate, world_text=spec.get("world_file"),
             qsr=qsr_descriptions(spec.get("qsr")), strict_labels=_flag(spec, "strict_labels"),
-            **_recording(spec),
+            **_recording(spec), **_memory(spec),
         )
+
+
+def _memory(spec: Mapping[str, Any]) -> dict[str, Any]:
+    """`memory` (a directory) and `since_s` (seconds since the building's last task)."""
+    memory = spec.get("memory")
+    if memory is not None and (not isinstance(memory, str | Path) or not str(memory)):
+        raise EpisodeError(f"episode spec: 'memory' must be a directory, got {memory!r}")
+    since = _number(spec.get("since_s", 3600.0), "since_s")
+    if since < 0:
+        raise EpisodeError(f"episode spec: 'since_s' must be 0 or more, got {since!r}")
+    return {"memory": None if memory is None else str(memory), "since_s": since}
 
 
 def _flag(spec: Mapping[str, Any], key: str) -> bool:
@@ -212,6 +229,18 @@ def run_episode(spec: Mapping[str, Any], emit: Emit | None = None,
     return Episode(episode, emit, should_stop).run()
 
 
+@dataclass
+class _Memory:
+    """The building memory of an episode: as loaded, the building time its task began,
+    what was put into the mind, and what the check of its sightings found."""
+
+    kept: memory.BuildingMemory | None
+    start: float
+    recalled: dict[str, Any] | None
+    checked: int = 0
+    confirmed: int = 0
+
+
 class Episode:
     """One episode's objects, built from a spec; `run` returns the summary."""
 
@@ -233,6 +262,7 @@ class Episode:
         check_categories(self.world_spec, knowledge.categories)
         self.robot: SimRobot = open_world(self.world_spec, spec.seed, knowledge.categories)
         self.mind = Mind.for_body(self.robot.body(), knowledge)  # its own body, not the world
+        self.memory = self._recall_memory()
         if self.out is not None:
             self.out.mkdir(parents=True, exist_ok=True)
         self.trace = Trace(lambda: self.robot.clock, self.out / "trace.jsonl" if self.out
@@ -307,7 +337,10 @@ class Episode:
                             seed=self.spec.seed, strategy=self.spec.strategy)
             for warning in self.warnings:
                 self.trace.emit("warning", **warning)
+            if self.memory is not None and self.memory.recalled is not None:
+                self.trace.emit("memory", recalled=True, **self.memory.recalled)
             start_clock, start_distance = self._pre_explore()
+            self._check_memory()
             search = self._strategy().load()
             targets = None
             if self.spec.task is not None:
@@ -316,6 +349,7 @@ class Episode:
             else:
                 result = search(self.context)
             summary = self.summary(result, start_clock, start_distance, targets)
+            self._keep_memory(summary)
             if self.out is not None:
                 write_summary(self.out / "summary.json", summary)
                 self._explanation()
@@ -326,6 +360,49 @@ class Episode:
                 self.recorder.close()
             self.trace.close()
             self.robot.world.close()
+
+    def _recall_memory(self) -> _Memory | None:
+        """The building's memory, put into the fresh mind (`episode/memory.py`)."""
+        if self.spec.memory is None:
+            return None
+        try:
+            kept = memory.load(self.spec.memory)
+            start = (kept.clock if kept is not None else 0.0) + self.spec.since_s
+            recalled = memory.recall(self.mind, kept, start) if kept is not None else None
+        except memory.BuildingMemoryError:
+            self.robot.world.close()
+            raise
+        return _Memory(kept, start, recalled)
+
+    def _check_memory(self) -> None:
+        """Look where the memory saw a wanted object (`episode/recall.py`); every strategy's
+        task starts so."""
+        if self.memory is None or not self.mind.remembered:
+            return
+        found = check_remembered(self.executor, self.spec.form.targets, self._emit,
+                                 lambda: not self.context.budget_spent())
+        self.memory.checked = sum(1 for e in self.trace.events
+                                  if e["type"] == "memory" and "checked" in e)
+        self.memory.confirmed = len(found)
+        if any(obj.label in self.spec.form.targets for obj in found):
+            # a wanted object is in view now: the strategy's first look round would add
+            # nothing the remembered map and the check's frames do not hold
+            self.executor.sensing.resumed = tuple(self.robot.pose[:2])
+
+    def _keep_memory(self, summary: dict[str, Any]) -> None:
+        """Write what the robot knows now to the building's memory; the summary says so."""
+        if self.memory is None or self.spec.memory is None:
+            return
+        kept = memory.remember(self.mind, self.memory.kept, self.memory.start)
+        memory.save(kept, self.spec.memory)
+        recalled = self.memory.recalled or {}
+        summary["memory"] = {
+            "tasks_before": self.memory.kept.tasks if self.memory.kept is not None else 0,
+            "building_clock_s": round(self.memory.start, 1),
+            "furniture": recalled.get("furniture", 0),
+            "sightings": len(recalled.get("sightings", ())),
+            "checked": self.memory.checked, "confirmed": self.memory.confirmed,
+            "saved": True}
 
     def _pre_explore(self) -> tuple[float, float]:
         """Fig. 3f: build the maps first (frontier exploration), then start the clock."""

@@ -171,6 +171,17 @@ class ChainGraph:
             )
         self._touch(room)
 
+    def place_evidence(self) -> dict[str, dict[str, dict[str, float]]]:
+        """Each place's property evidence as soft weights per value (`observe_property`
+        takes them back): what a later run keeps of what the place classifier said."""
+        out: dict[str, dict[str, dict[str, float]]] = {}
+        for place, kinds in self._evidence.items():
+            for kind, weights in kinds.items():
+                values = self.knowledge.properties[kind].values
+                out.setdefault(place, {})[kind] = {
+                    v: float(w) for v, w in zip(values, weights, strict=True) if w > 0}
+        return out
+
     def observe_room_property(self, room: str, kind: str, value: PropertyValue) -> None:
         """Evidence on a property of a whole room (e.g. its area from the place map).
 

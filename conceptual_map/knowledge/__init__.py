@@ -4,6 +4,7 @@ from conceptual_map.knowledge.loader import DEFAULT_KNOWLEDGE_PATH, load_knowled
 from conceptual_map.knowledge.model import (
     RELATIONS,
     Knowledge,
+    MobilityModel,
     PlaceholderModel,
     PropertyModel,
     UnknownLabelModel,
@@ -13,6 +14,7 @@ __all__ = [
     "DEFAULT_KNOWLEDGE_PATH",
     "RELATIONS",
     "Knowledge",
+    "MobilityModel",
     "PlaceholderModel",
     "PropertyModel",
     "UnknownLabelModel",

@@ -19,6 +19,7 @@ from conceptual_map.errors import KnowledgeError
 from conceptual_map.knowledge.model import (
     RELATIONS,
     Knowledge,
+    MobilityModel,
     PlaceholderModel,
     PropertyModel,
     UnknownLabelModel,
@@ -117,7 +118,7 @@ def parse_knowledge(data: Any, source: str = "<knowledge>") -> Knowledge:
     root = reader.mapping(data, "top level")
     _check_keys(reader, root, "top level", required={"categories", "properties", "connectivity",
                                                     "objects", "relations", "placeholders"},
-                optional={"version", "unknown_labels"})
+                optional={"version", "unknown_labels", "mobility"})
     categories, prior = _categories(reader, root["categories"])
     object_lambda, default_object, rate_shape = _objects(reader, root["objects"], categories)
     relation_lambda, default_relation = _relations(
@@ -135,6 +136,7 @@ def parse_knowledge(data: Any, source: str = "<knowledge>") -> Knowledge:
         default_relation_lambda=default_relation,
         placeholder=_placeholder(reader, root["placeholders"]),
         unknown=_unknown_labels(reader, root.get("unknown_labels"), frozenset(object_lambda)),
+        mobility=_mobility(reader, root.get("mobility"), frozenset(object_lambda)),
         rate_shape=rate_shape,
     )
 
@@ -280,6 +282,30 @@ def _placeholder(reader: _Reader, value: Any) -> PlaceholderModel:
             spec["p_room_leads_on"], "placeholders.p_room_leads_on", 0.0, 1.0
         ),
     )
+
+
+def _mobility(reader: _Reader, value: Any, labels: frozenset[str]) -> MobilityModel:
+    """How often each label is moved (per day); `MobilityModel`'s defaults where the section
+    (or a key of it) is left out."""
+    if value is None:
+        return MobilityModel()
+    spec = reader.mapping(value, "mobility")
+    _check_keys(reader, spec, "mobility", set(), {"default", "fixed_below", "rate"})
+    default = MobilityModel()
+    rates: dict[str, float] = {}
+    if "rate" in spec:
+        table = reader.mapping(spec["rate"], "mobility.rate")
+        for name, rate in table.items():
+            where = f"mobility.rate.{name}"
+            if name not in labels:
+                raise reader.fail(where, f"{name!r} has no entry under objects.lambda")
+            rates[str(name)] = reader.number(rate, where, 0.0, 1e6)
+    return MobilityModel(
+        default=reader.number(spec.get("default", default.default), "mobility.default",
+                              0.0, 1e6),
+        fixed_below=reader.number(spec.get("fixed_below", default.fixed_below),
+                                  "mobility.fixed_below", 0.0, 1e6),
+        rates=MappingProxyType(rates))
 
 
 def _unknown_labels(reader: _Reader, value: Any, labels: frozenset[str]) -> UnknownLabelModel:

@@ -50,6 +50,29 @@ class UnknownLabelModel:
 
 
 @dataclass(frozen=True)
+class MobilityModel:
+    """How often objects of a label are moved, per day: a sighting `days` old still holds
+    with P = exp(-rate x days) (the robot's building memory, `avs_planner/episode/memory.py`).
+    Labels moved less often than `fixed_below` per day are the building's furniture: the
+    memory keeps them as known objects; the others are sightings to be checked again."""
+
+    default: float = 0.2
+    fixed_below: float = 0.05
+    rates: MappingProxyType[str, float] = field(
+        default_factory=lambda: MappingProxyType({}))
+
+    def rate(self, label: str) -> float:
+        return self.rates.get(label, self.default)
+
+    def still_there(self, label: str, days: float) -> float:
+        """P(an object of `label` seen `days` ago has not been moved since)."""
+        return float(np.exp(-self.rate(label) * max(days, 0.0)))
+
+    def fixed(self, label: str) -> bool:
+        return self.rate(label) < self.fixed_below
+
+
+@dataclass(frozen=True)
 class Knowledge:
     """Category priors, property likelihoods, phi_rc and Poisson lambdas for the chain graph."""
 
@@ -64,6 +87,7 @@ class Knowledge:
     default_relation_lambda: float
     placeholder: PlaceholderModel
     unknown: UnknownLabelModel = field(default_factory=UnknownLabelModel)
+    mobility: MobilityModel = field(default_factory=MobilityModel)
     rate_shape: float | None = None
     """Shape a of the Gamma(a, a) prior on a building's rate multiplier (mean 1): each
     label's counts in one building are Poisson(s x lambda) with s shared by its rooms, so

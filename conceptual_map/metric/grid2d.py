@@ -31,6 +31,22 @@ class OccupancyGrid(LogOddsGrid):
         # where its own motion was blocked by something the scans do not show
         self.keep_out: tuple[tuple[float, float, float], ...] = ()
 
+    @classmethod
+    def restored(cls, origin: Sequence[float], logodds: np.ndarray, resolution: float,
+                 model: SensorModel | None = None) -> OccupancyGrid:
+        """A grid holding log-odds kept from an earlier run (`origin`: world corner of cell
+        0). New scans update it as any grid: a wall or door that changed since is re-mapped
+        by the laser's hits and misses, within the sensor model's clamp."""
+        values = np.asarray(logodds)
+        if values.ndim != 2 or values.dtype != np.int8:
+            raise ValueError(f"a 2D int8 log-odds array is needed, got {values.dtype} "
+                             f"with shape {values.shape}")
+        grid = cls(origin=(float(origin[0]), float(origin[1])), size=(1.0, 1.0),
+                   resolution=resolution, model=model)
+        grid.logodds = values.copy()
+        grid._touch()
+        return grid
+
     def set_keep_out(self, discs: Sequence[tuple[float, float, float]]) -> None:
         """Replace the keep-out discs (derived grids are recomputed if they changed)."""
         discs = tuple((float(x), float(y), float(r)) for x, y, r in discs)

@@ -8,7 +8,8 @@ and returns what changed as `MapEvent`s. It only reads the robot's own grid and 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import networkx as nx
 import numpy as np
@@ -87,6 +88,76 @@ class PlaceMap:
         events += self._refresh_placeholders(grid, poses[-1][:2], time)
         events += self._refresh_rooms(grid, time)  # marks the door edges first
         return events
+
+    def relocate(self) -> None:
+        """The robot's next pose does not continue its last path (a new task in a building
+        mapped before starts where the robot now stands): no straight leg is drawn from the
+        last pose, and no place is current until the next `follow` reaches one."""
+        self._path = []
+        self._since_current = []
+        self.current_place = None
+
+    def export(self) -> dict[str, Any]:
+        """What a later run needs to go on from this map, as plain data (JSON-safe): places,
+        the edges between places (with the path driven along them), door openings and the
+        sides the robot saw of each, rooms and the id counters. Placeholders are left out:
+        the next `follow` (or `refresh`) derives them again from the grid."""
+        edges = []
+        for u, v, data in self.graph.edges(data=True):
+            if u in self.places and v in self.places:
+                trace = data.get("trace")
+                edges.append([u, v, bool(data.get("traversed")),
+                              None if trace is None else np.round(trace, 3).tolist()])
+        return {
+            "places": {k: [p.position[0], p.position[1], p.time]
+                       for k, p in self.places.items()},
+            "edges": edges,
+            "openings": {k: [float(o.centre[0]), float(o.centre[1]), float(o.width),
+                             float(o.angle), sorted(self._sides.get(k, ()))]
+                         for k, o in self._openings.items()},
+            "rooms": {k: {"places": sorted(r.places), "doors": sorted(r.doors),
+                          "area": r.area, "elongation": r.elongation}
+                      for k, r in self.rooms.items()},
+            "counters": dict(self._counters),
+        }
+
+    @classmethod
+    def restored(cls, data: Mapping[str, Any], config: PlaceMapConfig | None = None
+                 ) -> tuple[PlaceMap, list[MapEvent]]:
+        """A map rebuilt from `export`'s data, and the events that bring a fresh conceptual
+        map up to it (every room appears). The robot is at no place until its next `follow`
+        (`relocate`). A `MapError` names what is wrong with malformed data."""
+        pm = cls(config)
+        try:
+            for pid, (x, y, t) in data["places"].items():
+                pm.places[pid] = Place(str(pid), (float(x), float(y)), float(t))
+                pm.graph.add_node(pid, kind="place", pos=pm.places[pid].position)
+            for u, v, traversed, trace in data["edges"]:
+                if u not in pm.places or v not in pm.places:
+                    raise MapError(f"edge {u}-{v} names a place the map does not hold")
+                length = math.dist(pm.places[u].position, pm.places[v].position)
+                pm.graph.add_edge(u, v, length=length, traversed=bool(traversed), door=None,
+                                  trace=None if trace is None else np.asarray(trace, float))
+            for did, (cx, cy, width, angle, sides) in data["openings"].items():
+                pm._openings[did] = Opening(np.array([cx, cy], dtype=float), float(width),
+                                            float(angle))
+                pm._sides[did] = {int(s) for s in sides}
+                pm.doors[did] = pm._door_from(did)
+            for rid, room in data["rooms"].items():
+                places = frozenset(room["places"])
+                if not places <= set(pm.places):
+                    raise MapError(f"room {rid} lists places the map does not hold")
+                pm.rooms[rid] = Room(str(rid), places, frozenset(room["doors"]),
+                                     float(room["area"]), float(room["elongation"]))
+            pm._counters = {str(k): int(v) for k, v in data["counters"].items()}
+        except MapError:
+            raise
+        except (KeyError, TypeError, ValueError) as exc:
+            raise MapError(f"a kept place map is malformed: {type(exc).__name__}: {exc}"
+                           ) from None
+        events = [MapEvent(EntityKind.ROOM, Change.APPEARED, rid, room)
+                  for rid, room in pm.rooms.items()]
+        return pm, events
 
     def refresh(self, grid: OccupancyGrid, time: float = 0.0) -> list[MapEvent]:
         """Re-derive placeholders and rooms from the grid where the robot last was (e.g. after

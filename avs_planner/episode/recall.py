@@ -1,0 +1,165 @@
+"""Checking what the building memory says: go and look where a wanted object was seen.
+
+A sighting from an earlier task (`episode/memory.py`) is never reported as it stands: the
+object may have been moved since. Before a task's search begins, the robot checks the
+sightings of the labels it wants that are more likely still there than not (weight at least
+`CHECK_WEIGHT`, P = exp(-rate x days) from the knowledge's `mobility` section), most likely
+first and, among equals, nearest first: it drives to a standpoint that sees the spot (within
+the camera distance a report's verification uses, with a free line of sight in its map),
+faces it and looks. An object confirmed there, by the frames a new detection needs, becomes a
+known object of this task (the strategy reports it after its own verification); one not seen
+is dropped, with a `memory` trace event. Sightings it could not reach stay for a later task.
+Every strategy's task starts with the same check (the harness runs it before the strategy).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Collection
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from avs_planner.episode.executor import Executor
+from avs_planner.episode.memory import Sighting
+from avs_planner.episode.mind import KnownObject
+from avs_planner.episode.outcome import StepStatus
+from avs_planner.episode.verifying import verify_distance
+from conceptual_map.metric import PathQueryError, distance_field
+from conceptual_map.metric.logodds import CellState
+
+CHECK_WEIGHT = 0.5  # a sighting more likely moved than not is not worth a detour of its own
+STANDPOINT_TURNS = 12  # directions around the spot tried for a standpoint
+STANDPOINT_RANGES = (1.0, 0.7, 1.3)  # x the verification distance, tried in this order
+SHORT_OF = 0.6  # m: the line of sight is tested up to this short of the spot: the laser
+# maps the furniture it stands on, which the camera looks over (a wall that close is ruled
+# out by standing in the spot's own room)
+
+
+@dataclass(frozen=True)
+class _Seen:
+    """The remembered spot as the detector's `confirm` takes it."""
+
+    label: str
+    position: tuple[float, float, float]
+    id: int = -1
+
+
+def check_remembered(executor: Executor, labels: Collection[str],
+                     emit: Callable[..., Any], budget_left: Callable[[], bool] = lambda: True
+                     ) -> list[KnownObject]:
+    """Check the sightings of `labels` (see the module's doc); the objects confirmed."""
+    mind = executor.mind
+    found: list[KnownObject] = []
+    skipped: list[Sighting] = []
+    while budget_left():
+        todo = [s for s in mind.remembered if s.label in labels and s.weight >= CHECK_WEIGHT
+                and s not in skipped]
+        if not todo:
+            break
+        plan = _standpoints(executor, todo)
+        for s in todo:
+            if all(s is not p for p, _ in plan):
+                emit("memory", unreachable=s.label, position=list(s.position))
+                skipped.append(s)
+        if not plan:
+            break
+        sighting, stand = plan[0]
+        known, looked = _check(executor, sighting, stand)
+        if not looked:  # the way there failed: kept for a later task, not dropped
+            emit("memory", unreachable=sighting.label, position=list(sighting.position))
+            skipped.append(sighting)
+            continue
+        mind.remembered.remove(sighting)
+        emit("memory", checked=sighting.label, position=[round(v, 2) for v in
+                                                         sighting.position],
+             weight=round(sighting.weight, 3), seen=known is not None,
+             **({"object": known.id} if known is not None else {"dropped": True}))
+        if known is not None:
+            found.append(known)
+    return found
+
+
+def _standpoints(executor: Executor, todo: list[Sighting]
+                 ) -> list[tuple[Sighting, tuple[float, float]]]:
+    """Each sighting's nearest reachable standpoint, most likely and then nearest first."""
+    mind, robot = executor.mind, executor.robot
+    body = mind.body
+    grid = mind.grid
+    try:
+        reach = distance_field(grid, robot.pose[:2], mind.config.robot_radius)
+    except PathQueryError:
+        return []
+    camera = executor.camera
+    far = verify_distance(executor.config.agree[0], camera.hfov, camera.vfov)
+    occupied = grid.state_grid() == CellState.OCCUPIED
+    out = []
+    for s in todo:
+        best: tuple[float, tuple[float, float]] | None = None
+        room = mind.room_at(s.position[:2], floor_only=True)
+        for scale in STANDPOINT_RANGES:
+            distance = scale * far if body is None else min(scale * far,
+                                                            0.9 * body.detect_range)
+            flat = math.sqrt(max(distance**2 - (camera.height - s.position[2]) ** 2, 0.25))
+            for k in range(STANDPOINT_TURNS):
+                a = 2 * math.pi * k / STANDPOINT_TURNS
+                goal = (s.position[0] + flat * math.cos(a), s.position[1] + flat * math.sin(a))
+                cell = grid.cell_of(goal)
+                if not grid.contains(cell) or not np.isfinite(reach[cell]):
+                    continue
+                if not _in_sight(grid, occupied, goal, s.position[:2]):
+                    continue
+                if room is not None and mind.room_at(goal, floor_only=True) != room:
+                    continue
+                if best is None or reach[cell] < best[0]:
+                    best = (float(reach[cell]), goal)
+            if best is not None:
+                break
+        if best is not None:
+            out.append((s, best[1], best[0]))
+    out.sort(key=lambda e: (-e[0].weight, e[2]))
+    return [(s, stand) for s, stand, _ in out]
+
+
+def _in_sight(grid, occupied: np.ndarray, a: tuple[float, float],  # noqa: ANN001 - a grid
+              b: tuple[float, float]) -> bool:
+    """No occupied cell on the line from `a` to `SHORT_OF` m before `b`."""
+    length = math.dist(a, b)
+    if length <= SHORT_OF:
+        return True
+    t = 1.0 - SHORT_OF / length
+    end = (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]))
+    return grid.segment_clear(a, end, ~occupied)
+
+
+def _check(executor: Executor, sighting: Sighting, stand: tuple[float, float]
+           ) -> tuple[KnownObject | None, bool]:
+    """Drive to `stand` and look at the spot: the known object confirmed there (or None),
+    and whether the robot got to look."""
+    mind = executor.mind
+    reach = executor.config.same_object
+    outcome = executor.drive_to(stand)
+    near = _known_near(mind.objects.values(), sighting, reach)
+    if near is not None:  # the watch confirmed it on the way
+        return near, True
+    if outcome.status is not StepStatus.DONE:
+        return None, False
+    seen = _Seen(sighting.label, sighting.position)
+    x, y, _ = executor.robot.pose
+    dx, dy = sighting.position[0] - x, sighting.position[1] - y
+    executor.robot.turn_to(math.atan2(dy, dx))
+    executor.context.look(0.0, -math.atan2(executor.camera.height - sighting.position[2],
+                                           max(math.hypot(dx, dy), 0.1)))
+    if not executor.confirm(seen):
+        return None, True
+    room = mind.room_at(sighting.position[:2]) or mind.nearest_room(sighting.position[:2])
+    if room is None:
+        return None, True
+    return mind.add_object(sighting.label, sighting.position, room=room), True
+
+
+def _known_near(objects, sighting: Sighting, reach: float  # noqa: ANN001 - known objects
+                ) -> KnownObject | None:
+    return next((o for o in objects if o.label == sighting.label
+                 and math.dist(o.position[:2], sighting.position[:2]) <= reach), None)
