@@ -45,7 +45,8 @@ REPORT_TOLERANCE = 0.5
 _KEYS = {"target", "targets", "mode", "count", "stop_below", "category", "world", "world_file",
          "robot", "start_room", "start", "seed", "time_budget_s", "wall_budget_s", "task_id",
          "output_dir", "pre_explore", "dt_policy",
-         "strategy", "strategy_options", "generate", "qsr", "record", "view", "strict_labels"}
+         "strategy", "strategy_options", "generate", "qsr", "record", "view", "strict_labels",
+         "memory", "since_s"}
 
 
 @dataclass(frozen=True)
@@ -77,6 +78,8 @@ class EpisodeSpec:
     # knowledge's uninformed prior, `Knowledge.with_label`, and a `warning` event)
     strict_labels: bool = False
     task: TaskForm | None = None
+    memory: str | None = None  # the building's memory directory (read at start, written at end)
+    since_s: float = 3600.0  # simulated seconds since the building's previous task
 
     @property
     def form(self) -> TaskForm:
@@ -115,8 +118,24 @@ class EpisodeSpec:
             dt_policy=str(spec.get("dt_policy") or "pouct"), strategy=strategy.name,
             strategy_options=options, generate=generate, world_text=spec.get("world_file"),
             qsr=qsr_descriptions(spec.get("qsr")), strict_labels=_flag(spec, "strict_labels"),
-            **_recording(spec),
+            memory=_memory(spec), since_s=_since(spec), **_recording(spec),
         )
+
+
+def _memory(spec: Mapping[str, Any]) -> str | None:
+    value = spec.get("memory")
+    if value is not None and (not isinstance(value, str) or not value):
+        raise EpisodeError(f"episode spec: 'memory' must be a directory path, got {value!r}")
+    return value
+
+
+def _since(spec: Mapping[str, Any]) -> float:
+    value = spec.get("since_s", 3600.0)
+    if isinstance(value, bool) or not isinstance(value, int | float) \
+            or not math.isfinite(value) or value < 0:
+        raise EpisodeError(f"episode spec: 'since_s' must be a number >= 0 (simulated seconds "
+                           f"since the building's previous task), got {value!r}")
+    return float(value)
 
 
 def _flag(spec: Mapping[str, Any], key: str) -> bool:
