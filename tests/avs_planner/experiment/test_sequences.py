@@ -199,3 +199,17 @@ def test_the_memory_campaigns_keep_to_their_seed_ranges():
     assert len(dev.runs()) == 200 and len(heldout.runs()) == 200
     header = Path(heldout.source).read_text(encoding="utf-8").split("\nname:")[0]
     assert "NOTHING may be tuned" in header and "10000 and up" in header
+
+
+@pytest.mark.slow
+def test_the_ray_backend_runs_a_sequence_in_order_with_its_memory(tmp_path):
+    pytest.importorskip("ray", reason="Ray is not installed (pip install '.[ray]')")
+    run(tmp_path, backend="ray")
+    runs = parse(SEQ).runs()
+    log = executions(tmp_path)
+    for arm in ("on", "off"):
+        ids = [r.run_id for r in runs if r.memory == arm]
+        assert [x for x in log if x in ids] == ids
+    got = seen(tmp_path)
+    assert all(got[r.run_id] == [f"day{d}" for d in range(r.task_index)]
+               for r in runs if r.memory == "on")
