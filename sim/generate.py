@@ -9,6 +9,10 @@ where the conceptual map's knowledge rates them unlikely. See sim/README.md ("Ge
     world = generate_world(seed=7, style="office", rooms=6)
     spec = world.spec()                 # through sim's own loader and checks
     targets = world.targets(rng_seed=0)  # two labels present, one absent
+    later = generate_world(seed=7, style="office", rooms=6, day=3, move=0.2, doors=0.1)
+
+Day k > 0 of a building is day k-1 with some small objects moved and some doors toggled
+(`sim/generation/days.py`); day 0 is the building as generated.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from sim.errors import GenerationError
+from sim.generation.days import day_streams, next_doors, next_objects
 from sim.generation.freespace import approach_point, free_space
 from sim.generation.furnish import Piece, furnish
 from sim.generation.layout import Layout, plan_layout
@@ -35,6 +40,8 @@ WITHHELD_LABELS = 2  # small-object labels kept out of every world, so some are 
 MIN_PRESENT_LABELS = 2  # different small-object labels a world should hold (benchmark targets)
 PLACEMENT_ATTEMPTS = 10
 WALL_HEIGHT = 2.0
+DEFAULT_MOVE = 0.2  # per day, the probability each small object moves (days after day 0)
+DEFAULT_DOORS = 0.0  # per day, the probability each door toggles open / closed
 
 
 @dataclass(frozen=True)
@@ -46,12 +53,17 @@ class GeneratedWorld:
     style: str
     surprises: tuple[str, ...] = ()  # names of objects placed where the knowledge says unlikely
     surprise: float = 0.25  # the share asked for
+    day: int = 0  # days after the building was generated (objects moved, doors toggled)
+    move: float = DEFAULT_MOVE  # per day, the probability each small object moves
+    doors: float = DEFAULT_DOORS  # per day, the probability each door toggles
 
     def yaml(self) -> str:
         """The world file as YAML text (docs/architecture.md's format), headed by its command."""
         command = (f"avs world generate --seed {self.seed} --style {self.style} --rooms "
                    f"{len(self.data['rooms']) - 1} --surprise {self.surprise!r} --robot "
                    f"{self.data['robot']['model']}")
+        if self.day:
+            command += f" --day {self.day} --move {self.move!r} --doors {self.doors!r}"
         return world_yaml(self.data, command)
 
     def spec(self) -> WorldSpec:
@@ -77,20 +89,33 @@ class GeneratedWorld:
 
 
 def generate_world(seed: int, style: str = "office", rooms: int | None = None,
-                   surprise: float = 0.25, robot: str = "pioneer") -> GeneratedWorld:
-    """A world for `seed` (same arguments, same world); `rooms` counts the rooms off the spine."""
+                   surprise: float = 0.25, robot: str = "pioneer", day: int = 0,
+                   move: float = DEFAULT_MOVE, doors: float = DEFAULT_DOORS) -> GeneratedWorld:
+    """A world for `seed` (same arguments, same world); `rooms` counts the rooms off the spine.
+
+    `day` k > 0 is the same building k days later: each day every small object moves with
+    probability `move` and every door toggles with probability `doors` (`generation/days.py`);
+    day 0 is the building as generated, whatever `move` and `doors` say."""
     table = placement_table()
     rule = _check_arguments(table, seed, style, rooms, surprise, robot)
-    rng = np.random.default_rng([seed, zlib.crc32(style.encode())])
+    _check_days(day, move, doors)
+    code = zlib.crc32(style.encode())
+    rng = np.random.default_rng([seed, code])
     drawn = int(rng.integers(rule.default_rooms[0], rule.default_rooms[1] + 1))
     count = drawn if rooms is None else rooms  # drawn either way: --rooms K of a drawn K agrees
     layout = plan_layout(rng, table, rule, count)
     pieces = furnish(rng, layout, table)
     objects = _small_objects(rng, table, layout, pieces, surprise)
     start = _start(rng, layout, pieces)
+    for k in range(1, day + 1):
+        objects_rng, doors_rng = day_streams(seed, code, k)
+        objects = next_objects(objects_rng, table, layout, pieces, objects, surprise, move)
+        layout = next_doors(doors_rng, layout, doors)
     data = world_data(f"{style}_{seed}", layout, pieces, objects, robot, start)
+    if not day:
+        move, doors = DEFAULT_MOVE, DEFAULT_DOORS  # day 0 is the same world whatever they say
     return GeneratedWorld(data, seed, style, tuple(o.name for o in objects if o.unusual),
-                          float(surprise))
+                          float(surprise), day, float(move), float(doors))
 
 
 def _small_objects(rng: np.random.Generator, table: PlacementTable, layout: Layout,
@@ -125,6 +150,16 @@ def _check_arguments(table: PlacementTable, seed: int, style: str, rooms: int | 
     if robot not in ROBOT_MODELS:
         raise GenerationError(f"robot: unknown model {robot!r} (known: {', '.join(ROBOT_MODELS)})")
     return rule
+
+
+def _check_days(day: int, move: float, doors: float) -> None:
+    """`GenerationError` naming the bad argument of a day's world."""
+    if isinstance(day, bool) or not isinstance(day, int) or day < 0:
+        raise GenerationError(f"day: expected a non-negative integer, got {day!r}")
+    for name, value in (("move", move), ("doors", doors)):
+        if isinstance(value, bool) or not isinstance(value, int | float) or not (
+                math.isfinite(value) and 0.0 <= value <= 1.0):
+            raise GenerationError(f"{name}: expected a probability in [0, 1], got {value!r}")
 
 
 def _start(rng: np.random.Generator, layout: Layout,

@@ -33,6 +33,15 @@ def register(subparsers: Any) -> None:
                                "(default: 0.25)")
     generate.add_argument("--robot", default="pioneer", choices=("pioneer", "pr2"),
                           help="robot model written to the file (default: pioneer)")
+    generate.add_argument("--day", type=int, default=0,
+                          help="the building this many days later: small objects moved, doors "
+                               "toggled (default: 0, the building as generated)")
+    generate.add_argument("--move", type=float, default=0.2,
+                          help="per day, the probability each small object moves to another "
+                               "placement (default: 0.2)")
+    generate.add_argument("--doors", type=float, default=0.0,
+                          help="per day, the probability each door toggles open/closed; every "
+                               "room stays reachable (default: 0)")
     generate.add_argument("--out", help="YAML file to write (default: standard output)")
     generate.set_defaults(func=run_generate)
 
@@ -42,7 +51,8 @@ def run_generate(args: argparse.Namespace) -> int:
     from sim.generate import generate_world
 
     try:
-        world = generate_world(args.seed, args.style, args.rooms, args.surprise, args.robot)
+        world = generate_world(args.seed, args.style, args.rooms, args.surprise, args.robot,
+                               args.day, args.move, args.doors)
         world.spec()  # every generated world passes sim's own checks; say so if one does not
     except SimError as exc:
         print(f"avs: error: {exc}", file=sys.stderr)

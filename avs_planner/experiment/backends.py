@@ -5,10 +5,16 @@ episode stack once, so a new process costs milliseconds, not the 2 s of imports,
 state survives from one episode to the next. A slot thread per worker starts the process,
 waits for its record or its deadline (then kills it), and hands the record back. The Ray
 backend (`ray_backend.py`) keeps the same contract.
+
+A job may carry the episodes that must follow it (`Job.then`: the later tasks of a campaign
+sequence, which read the memory the earlier ones wrote): a backend runs them one after another,
+each handed back on its own as it finishes, the next started only after the one before was
+handed back; different jobs still run side by side.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import multiprocessing
 import os
 import shutil
@@ -35,6 +41,45 @@ class Job:
     run: RunSpec
     out_dir: Path
     deadline_s: float
+    then: tuple[Job, ...] = ()  # episodes to run after this one, in order, in the same slot
+    # the campaign sequence's memory directory (memory on), and the snapshot of it to start
+    # from (the one the episode before left; None: start with no memory)
+    memory: Path | None = None
+    memory_from: Path | None = None
+
+    def steps(self) -> list[Job]:
+        """This episode and those that follow it, in order (each without followers)."""
+        return [dataclasses.replace(job, then=()) for job in (self, *self.then)]
+
+
+MEMORY_SNAPSHOT = "memory"  # in a run's directory: its sequence's memory as the episode left it
+
+
+def start_dir(job: Job) -> None:
+    """A fresh run directory, and a sequence's memory as the episode before left it."""
+    fresh_dir(job.out_dir)
+    if job.memory is None:
+        return
+    if job.memory.exists():
+        shutil.rmtree(job.memory)
+    if job.memory_from is not None and job.memory_from.is_dir():
+        shutil.copytree(job.memory_from, job.memory)
+    else:
+        job.memory.mkdir(parents=True)
+
+
+def keep_memory(job: Job) -> None:
+    """Keep what the episode left in its sequence's memory beside its record (the next
+    episode starts from it, also when it runs again after a stop)."""
+    if job.memory is None:
+        return
+    snapshot = job.out_dir / MEMORY_SNAPSHOT
+    if snapshot.exists():
+        shutil.rmtree(snapshot)
+    if job.memory.is_dir():
+        shutil.copytree(job.memory, snapshot)
+    else:
+        snapshot.mkdir(parents=True)
 
 
 OnDone = Callable[[Job, Record], None]
@@ -133,17 +178,18 @@ class LocalBackend:
             self._stopping.set()
 
     def _serve(self, queue: Iterable[Job], on_done: OnDone) -> None:
-        for job in _locked(queue, self._lock):
-            if self._stopping.is_set():
-                return
-            record = self._one(job)
-            if self._stopping.is_set():
-                return  # interrupted: leave the run for the next attempt
-            with self._lock:
-                on_done(job, record)
+        for unit in _locked(queue, self._lock):
+            for job in unit.steps():  # a sequence's episodes one after another
+                if self._stopping.is_set():
+                    return
+                record = self._one(job)
+                if self._stopping.is_set():
+                    return  # interrupted: leave the run for the next attempt
+                with self._lock:
+                    on_done(job, record)
 
     def _one(self, job: Job) -> Record:
-        fresh_dir(job.out_dir)
+        start_dir(job)
         start = time.perf_counter()
         reader, writer = self._ctx.Pipe(duplex=False)
         process = self._ctx.Process(target=_child, daemon=True, name=f"avs-{job.run.run_id}",

@@ -4,11 +4,14 @@ A campaign is worlds (or the active visual search paper's scenarios) × targets 
 robots × seeds, where a target is one label or a task of several objects (`subjects.py`); the
 format is in docs/experiments.md. `load_campaign` reads and checks a file
 (or a built-in by name, from `campaigns/`), and `Campaign.runs()` expands it into one `RunSpec`
-per episode, each with a stable run id (the name of its directory in the output).
+per episode, each with a stable run id (the name of its directory in the output). A campaign
+with `sequence` (`sequences.py`) runs each generated building's tasks day after day, with and
+without the robot's memory; its runs carry their sequence, task index and memory arm.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -19,7 +22,13 @@ import yaml
 
 from avs_planner.errors import AvsError
 from avs_planner.experiment.errors import CampaignError
-from avs_planner.experiment.subjects import Subject, scenario_subjects, world_subjects
+from avs_planner.experiment.sequences import Arm, Sequence, parse_sequence
+from avs_planner.experiment.subjects import (
+    Subject,
+    scenario_subjects,
+    sequence_subjects,
+    world_subjects,
+)
 from avs_planner.experiment.values import Where, parse_seeds, positive_number
 
 CAMPAIGN_DIR = Path(__file__).parent / "campaigns"
@@ -28,7 +37,7 @@ DEFAULT_STRATEGY = "switching"
 HELDOUT_WORLD_SEEDS_FROM = 10000  # generated building seeds from here on
 HELDOUT_FIG3_NOISE_SEEDS = range(100, 120)  # sensor-noise seeds of Fig. 3 a-f
 _TOP_KEYS = {"name", "description", "worlds", "scenarios", "targets", "strategies", "robots",
-             "seeds", "time_budget_s", "wall_budget_s"}
+             "seeds", "time_budget_s", "wall_budget_s", "sequence"}
 _STRATEGY_KEYS = {"name", "label", "options"}
 
 
@@ -51,6 +60,11 @@ class RunSpec:
     robot: str | None
     seed: int
     episode: Mapping[str, Any]
+    # a task of a campaign sequence: the sequence's id, the task's index in it (its day) and
+    # the memory arm (on / off); "" / None otherwise
+    sequence: str = ""
+    task_index: int | None = None
+    memory: str = ""
 
     def columns(self) -> dict[str, Any]:
         """The run's coordinates as results-table columns."""
@@ -58,7 +72,9 @@ class RunSpec:
         return {"run_id": self.run_id, "scenario": s.scenario or "", "world": s.world,
                 "group": s.group, "target": s.target, "expected": s.expected or "",
                 "strategy": self.strategy.label, "robot": self.robot or "", "seed": self.seed,
-                "task": s.kind, "task_labels": " ".join(s.labels) if s.task else ""}
+                "task": s.kind, "task_labels": " ".join(s.labels) if s.task else "",
+                "sequence": self.sequence, "task_index": self.task_index,
+                "memory": self.memory}
 
 
 @dataclass(frozen=True)
@@ -74,9 +90,14 @@ class Campaign:
     seeds: tuple[int, ...]
     time_budget_s: float | None = None
     wall_budget_s: float | None = None
+    sequence: Sequence | None = None
 
     def runs(self) -> list[RunSpec]:
         runs: list[RunSpec] = []
+        if self.sequence is not None:
+            runs = self._sequence_runs(self.sequence)
+            _check_unique(runs, self.source)
+            return runs
         for seed in self.seeds:
             for subject in self.subjects:
                 for robot in self.robots:
@@ -102,6 +123,37 @@ class Campaign:
         parts += [strategy.label, robot or "", f"s{seed}"]
         return RunSpec(_slug("-".join(p for p in parts if p)), subject, strategy, robot, seed,
                        spec)
+
+    def _sequence_runs(self, sequence: Sequence) -> list[RunSpec]:
+        """Per building, noise seed, robot, strategy and memory arm, one sequence: its tasks
+        in order (task i on day i), each run carrying the sequence's id, its index and the
+        arm; with memory on, the episode spec names the sequence's memory directory."""
+        buildings: dict[str, list[Subject]] = {}
+        for subject in self.subjects:
+            buildings.setdefault(subject.world, []).append(subject)
+        runs: list[RunSpec] = []
+        for seed in self.seeds:
+            for building, tasks in buildings.items():
+                for robot in self.robots:
+                    for strategy in self.strategies:
+                        for memory in sequence.memory:
+                            arm = Arm(building, robot, strategy.label, seed, memory)
+                            runs += [self._task_run(s, strategy, robot, seed, arm, sequence)
+                                     for s in sorted(tasks, key=lambda s: s.day or 0)]
+        return runs
+
+    def _task_run(self, subject: Subject, strategy: Strategy, robot: str | None, seed: int,
+                  arm: Arm, sequence: Sequence) -> RunSpec:
+        run = self._run(subject, strategy, robot, seed)
+        episode = dict(run.episode)
+        if arm.memory_dir is not None:
+            episode.update(memory=arm.memory_dir, since_s=sequence.since_s)
+        index = subject.day or 0
+        parts = [subject.world, f"t{index:02d}", subject.target, strategy.label, robot or "",
+                 f"s{seed}", f"memory-{arm.memory}"]
+        return dataclasses.replace(run, run_id=_slug("-".join(p for p in parts if p)),
+                                   episode=episode, sequence=_slug(arm.sequence_id),
+                                   task_index=index, memory=arm.memory)
 
 
 def builtin_campaigns() -> list[str]:
@@ -131,20 +183,35 @@ def parse_campaign(data: Any, source: str, base: Path) -> Campaign:
     unknown = set(data) - _TOP_KEYS
     if unknown:
         raise where.error(f"unknown keys {sorted(unknown)}; allowed: {sorted(_TOP_KEYS)}")
+    sequence = None
+    if "sequence" in data:
+        sequence = parse_sequence(data["sequence"], where.at("sequence"))
     return Campaign(
         name=str(data.get("name") or Path(source).stem),
         description=str(data.get("description") or ""), source=source,
-        subjects=_subjects(data, where, base),
+        subjects=_subjects(data, where, base, sequence),
         strategies=_strategies(data.get("strategies", [DEFAULT_STRATEGY]), where.at("strategies")),
         robots=_robots(data.get("robots"), where.at("robots")),
         seeds=tuple(parse_seeds(data.get("seeds", 0), where.at("seeds"))),
         time_budget_s=_budget(data, "time_budget_s", where),
         wall_budget_s=_budget(data, "wall_budget_s", where),
+        sequence=sequence,
     )
 
 
-def _subjects(data: dict[str, Any], where: Where, base: Path) -> tuple[Subject, ...]:
+def _subjects(data: dict[str, Any], where: Where, base: Path, sequence: Sequence | None
+              ) -> tuple[Subject, ...]:
     has_worlds, has_scenarios = "worlds" in data, "scenarios" in data
+    if sequence is not None:
+        if has_scenarios or not has_worlds:
+            raise where.at("sequence").error("a sequence runs on generated buildings: give "
+                                             "'worlds' with {generate: {seeds, style}} "
+                                             "entries, not 'scenarios'")
+        if "targets" in data:
+            raise where.at("targets").error("a sequence draws each task's target from the "
+                                            "labels its building holds that day; drop "
+                                            "'targets'")
+        return tuple(sequence_subjects(data["worlds"], sequence, where))
     if has_worlds == has_scenarios:
         raise where.error("give either 'worlds' (with 'targets') or 'scenarios', not both")
     if has_scenarios:

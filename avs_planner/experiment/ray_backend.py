@@ -4,11 +4,15 @@
 needs this package installed, as on the driver). At most `slots` tasks are in flight (default:
 the cluster's CPUs), so a task starts when it is submitted and its wall-clock deadline counts
 from then; results stream back as tasks finish. A task returns its files (summary, trace,
-picture) with its record, so nodes need no shared file system.
+picture) with its record, so nodes need no shared file system. A job with followers
+(`Job.then`, a campaign sequence) submits each follower when the one before has finished; a
+sequence with memory needs the output directory at the same path on every node (a shared file
+system), since its episodes read and write their memory there.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from collections import deque
@@ -16,7 +20,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from avs_planner.experiment.backends import Job, OnDone, Record, fresh_dir, timeout_record
+from avs_planner.experiment.backends import Job, OnDone, Record, start_dir, timeout_record
 from avs_planner.experiment.errors import CampaignError
 from avs_planner.experiment.worker import DEFAULT_RUNNER, execute_collect, preload
 
@@ -54,7 +58,8 @@ class RayBackend:
             while pending or self._flying:
                 while pending and len(self._flying) < self.slots:
                     self._submit(pending.popleft())
-                self._collect(on_done)
+                for job in self._collect(on_done):  # a sequence's next episode goes first
+                    pending.appendleft(dataclasses.replace(job.then[0], then=job.then[1:]))
         finally:
             for ref in list(self._flying):
                 self._ray.cancel(ref, force=True)
@@ -74,11 +79,14 @@ class RayBackend:
             raise CampaignError(f"Ray workers cannot import the episode runner: {exc}") from None
 
     def _submit(self, job: Job) -> None:
-        fresh_dir(job.out_dir)
+        start_dir(job)
         ref = self._remote.remote(dict(job.run.episode), self.runner)
         self._flying[ref] = (job, time.perf_counter())
 
-    def _collect(self, on_done: OnDone) -> None:
+    def _collect(self, on_done: OnDone) -> list[Job]:
+        """Hand back the episodes that finished or passed their deadline; those among them
+        that have followers."""
+        ended: list[Job] = []
         now = time.perf_counter()
         soonest = min(start + job.deadline_s for job, start in self._flying.values())
         ready, _ = self._ray.wait(list(self._flying), num_returns=1,
@@ -87,13 +95,16 @@ class RayBackend:
             job, start = self._flying.pop(ref)
             record = self._result(ref, job)
             record["wall_s"] = time.perf_counter() - start
-            on_done(job, record)
+            on_done(dataclasses.replace(job, then=()), record)
+            ended.append(job)
         for ref, (job, start) in list(self._flying.items()):
             if time.perf_counter() - start > job.deadline_s:
                 self._ray.cancel(ref, force=True)
                 del self._flying[ref]
-                on_done(job, {**timeout_record(job.deadline_s),
-                              "wall_s": time.perf_counter() - start})
+                on_done(dataclasses.replace(job, then=()),
+                        {**timeout_record(job.deadline_s), "wall_s": time.perf_counter() - start})
+                ended.append(job)
+        return [job for job in ended if job.then]
 
     def _result(self, ref: Any, job: Job) -> Record:
         try:

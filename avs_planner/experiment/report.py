@@ -16,8 +16,9 @@ beside it (`plots.py`) and the runs that failed. The parts live in their own mod
 intervals, as table cells; the statistics themselves: `stats.py`), `report_header.py` (the
 header and every section's stamp), `report_outcomes.py` (the outcome and comparison tables),
 `report_planner.py` (the DT sub-planner, and beside the paper), `report_map.py` (map
-quality) and `report_tasks.py` (tasks of several objects: in a campaign with tasks, the other
-tables cover its single-label searches and the tasks have sections of their own).
+quality), `report_tasks.py` (tasks of several objects: in a campaign with tasks, the other
+tables cover its single-label searches and the tasks have sections of their own) and
+`report_sequences.py` (campaign sequences: memory on against memory off).
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ from avs_planner.experiment.report_outcomes import (
 )
 from avs_planner.experiment.report_planner import PAPER, PAPER_OUTCOME, beside_the_paper, dt_table
 from avs_planner.experiment.report_rows import Pair, Row, as_expected, comparable, normalised
+from avs_planner.experiment.report_sequences import sequence_tables
 from avs_planner.experiment.report_tasks import is_task, task_tables
 from avs_planner.experiment.results import RESULTS_FILE, WALL_CUT, read_results
 
@@ -86,6 +88,7 @@ def render(rows: list[Row], meta: dict[str, Any], out: Path) -> str:
         if {r["scenario"] for r in rows} <= set(PAPER_OUTCOME) and rows[0]["scenario"]:
             lines += beside_the_paper(rows, groups, stamp)
     lines += task_tables(every, stamp)
+    lines += sequence_tables(every, stamp)
     if rows:
         lines += _figures(rows, groups, strategies, out)
     lines += _failures(every)

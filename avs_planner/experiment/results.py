@@ -42,6 +42,10 @@ KEY_COLUMNS = ["run_id", "scenario", "world", "group", "target", "expected", "st
 # a task of several objects: all, any or count, and its labels (space-separated); empty for
 # one label (and absent from tables written before tasks: not required when read)
 TASK_KEY_COLUMNS = ["task", "task_labels"]
+# a task of a campaign sequence (`sequences.py`): the sequence's id, the task's index in it
+# (the building's day) and the memory arm, on or off; empty otherwise (and absent from tables
+# written before sequences: not required when read)
+SEQUENCE_COLUMNS = ["sequence", "task_index", "memory"]
 TASK_COLUMNS = ["targets_outcome", "targets_found", "reports", "reports_correct",
                 "instances", "distinct", "targets_json"]
 VALUE_COLUMNS = ["status", "error", "outcome", "reason", "correct", "success",
@@ -52,14 +56,14 @@ VALUE_COLUMNS = ["status", "error", "outcome", "reason", "correct", "success",
                  "dt_rejected", "views_processed",
                  *(f"map_{k}" for k in MAP_SCORE_KEYS),
                  "episode_s", "wall_s", "overhead_s", "backend", "commit"]
-COLUMNS = KEY_COLUMNS + TASK_KEY_COLUMNS + VALUE_COLUMNS
+COLUMNS = KEY_COLUMNS + TASK_KEY_COLUMNS + SEQUENCE_COLUMNS + VALUE_COLUMNS
 _INTS = {"seed", "plans", "replans", "cp_calls", "dt_calls", "dt_decisions", "dt_confirmed",
          "dt_rejected", "views_processed", "targets_found", "reports", "reports_correct",
-         "instances", "distinct"}
+         "instances", "distinct", "task_index"}
 _BOOLS = {"correct", "success", "correct_give_up", "false_report"}
 _TEXT = {"run_id", "scenario", "world", "group", "target", "expected", "strategy", "robot",
          "status", "error", "outcome", "reason", "found_label", "backend", "commit", "task",
-         "task_labels", "targets_outcome", "targets_json"}
+         "task_labels", "targets_outcome", "targets_json", "sequence", "memory"}
 
 
 def is_wall_cut(outcome: Any, reason: Any) -> bool:
@@ -81,7 +85,8 @@ def row(record: Mapping[str, Any]) -> dict[str, Any]:
 
     A wall-cut run keeps its episode's numbers (how far it got) but no verdict: `correct`,
     `success`, `correct_give_up` and `false_report` stay empty."""
-    out: dict[str, Any] = {k: record.get(k) for k in KEY_COLUMNS + TASK_KEY_COLUMNS}
+    out: dict[str, Any] = {k: record.get(k)
+                           for k in KEY_COLUMNS + TASK_KEY_COLUMNS + SEQUENCE_COLUMNS}
     out.update({k: record.get(k) for k in ("status", "error", "episode_s", "wall_s",
                                            "overhead_s", "backend", "commit")})
     summary = record.get("summary")

@@ -7,10 +7,18 @@ its record exists for the same episode spec; crashed, timed-out, failed and wall
 episode whose wall-clock budget ran out: see results.py) are done too (recorded with their
 error) unless `retry_failed` asks for them again. Each invocation notes in campaign.json when
 it ran and at which git commit (provenance.py); each record carries the commit too.
+
+The tasks of a campaign sequence (`sequences.py`) run in order, one sequence per worker slot at
+a time (`Job.then`). With memory on, each episode's run directory keeps a copy of the memory as
+it left it (`runs/<run-id>/memory/`), and an episode starts from the copy of the one before
+(none for the first), so a stopped sequence resumes from the right memory; when an episode of
+such a sequence runs again (its directory deleted, `--retry-failed`), the episodes after it run
+again too, since they read what it wrote.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import socket
 import time
@@ -19,11 +27,19 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from avs_planner.experiment.backends import Backend, Job, Record, make_backend
+from avs_planner.experiment.backends import (
+    MEMORY_SNAPSHOT,
+    Backend,
+    Job,
+    Record,
+    keep_memory,
+    make_backend,
+)
 from avs_planner.experiment.campaign import Campaign, RunSpec
 from avs_planner.experiment.errors import CampaignError
 from avs_planner.experiment.provenance import describe, git_state
 from avs_planner.experiment.results import RESULTS_FILE, run_status, write_results
+from avs_planner.experiment.sequences import ordered, placed
 from avs_planner.experiment.worker import DEFAULT_RUNNER
 
 RECORD_FILE = "record.json"
@@ -82,7 +98,8 @@ class CampaignResult:
 
 def run_campaign(campaign: Campaign, options: RunOptions,
                  on_progress: Callable[[Progress], None] | None = None) -> CampaignResult:
-    runs = campaign.runs()
+    runs = [dataclasses.replace(run, episode=placed(dict(run.episode), options.out))
+            for run in campaign.runs()]
     backend = make_backend(options.backend, options.workers, options.address,
                            options.episode_runner)
     try:
@@ -97,17 +114,18 @@ def _run(campaign: Campaign, runs: list[RunSpec], options: RunOptions, backend: 
     git = git_state()
     meta = _claim(options.out, campaign, len(runs))
     records = load_records(options.out, runs)
-    todo = [run for run in runs if not _done(records.get(run.run_id), options.retry_failed)]
+    todo = _todo(runs, records, options.retry_failed)
     skipped = len(runs) - len(todo)
     if options.limit is not None:
         todo = todo[:options.limit]
     pending = {run.run_id for run in todo}
     failed = sum(r["status"] != "ok" for k, r in records.items() if k not in pending)
     progress = Progress(len(runs), skipped, failed, skipped, backend.slots)
-    jobs = [Job(run, run_dir(options.out, run), _deadline(run, options)) for run in todo]
+    jobs = _jobs(runs, todo, options)
     table = _Table(options.out, runs, records)
 
     def on_done(job: Job, record: Record) -> None:
+        keep_memory(job)  # before the sequence's next episode starts from it
         record = _write_record(job, record, backend.name, describe(git))
         table.add(record)
         progress.done += 1
@@ -161,6 +179,45 @@ def load_records(out: Path, runs: list[RunSpec]) -> dict[str, Record]:
             record["status"] = run_status(record["status"], record.get("summary"))
             records[run.run_id] = record
     return records
+
+
+def _todo(runs: list[RunSpec], records: dict[str, Record], retry_failed: bool
+          ) -> list[RunSpec]:
+    """The runs to run now: those not done; in a sequence with memory, also every run after
+    the first one to run (it reads the memory the ones before it wrote)."""
+    todo = []
+    again: set[str] = set()  # sequences with memory in which an earlier episode runs
+    for run in runs:
+        if (run.sequence in again
+                or not _done(records.get(run.run_id), retry_failed)):
+            todo.append(run)
+            if run.sequence and "memory" in run.episode:
+                again.add(run.sequence)
+    return todo
+
+
+def _jobs(runs: list[RunSpec], todo: list[RunSpec], options: RunOptions) -> list[Job]:
+    """One job per run, the runs of a sequence chained in order into one job (`Job.then`);
+    with memory, each starts from the memory the run before it in the sequence left."""
+    before: dict[str, RunSpec] = {}
+    previous: dict[str, RunSpec] = {}
+    for run in runs:
+        if run.sequence:
+            if run.sequence in previous:
+                before[run.run_id] = previous[run.sequence]
+            previous[run.sequence] = run
+    jobs = []
+    for run in todo:
+        memory = run.episode.get("memory")
+        prior = before.get(run.run_id)
+        jobs.append(Job(run, run_dir(options.out, run), _deadline(run, options),
+                        memory=Path(memory) if memory else None,
+                        memory_from=(run_dir(options.out, prior) / MEMORY_SNAPSHOT
+                                     if memory and prior is not None else None)))
+    units = []
+    for group in ordered(jobs, lambda job: job.run.sequence or None):
+        units.append(dataclasses.replace(group[0], then=tuple(group[1:])))
+    return units
 
 
 def _done(record: Record | None, retry_failed: bool) -> bool:

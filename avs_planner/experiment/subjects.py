@@ -27,6 +27,7 @@ from typing import Any
 
 from avs_planner.errors import AvsError
 from avs_planner.experiment.errors import CampaignError
+from avs_planner.experiment.sequences import Sequence, task_label
 from avs_planner.experiment.values import Where, parse_seeds
 
 AUTO = "auto"
@@ -57,6 +58,9 @@ class Subject:
     # a task of several objects: its episode keys (targets, mode, count, and stop_below when
     # the campaign gives it); None for one label
     task: Mapping[str, Any] | None = None
+    # a task of a campaign sequence: the day of the building (and the task's index in the
+    # sequence); None otherwise
+    day: int | None = None
 
     @property
     def kind(self) -> str:
@@ -186,6 +190,20 @@ def _from_file(entry: dict[str, Any], top: Any, at: Where, where: Where, base: P
 
 def _generated(entry: dict[str, Any], targets: tuple[Any, Where], at: Where
                ) -> Iterator[Subject]:
+    style, rooms, group, seeds = _generate_entry(entry, at)
+    value, t_at = targets
+    entries = _entries(value, t_at, generated=True)
+    for seed in seeds:
+        spec = {"generate": {"seed": seed, "style": style, "rooms": rooms}}
+        building = Building(seed, style, rooms)
+        name = generated_name(seed, style, rooms)
+        for wanted in _unique([w for e in entries for w in e.resolve(building)]):
+            yield Subject(name, group, wanted.name, wanted.expected, None, spec, wanted.task)
+
+
+def _generate_entry(entry: dict[str, Any], at: Where
+                    ) -> tuple[str, int | None, str, list[int]]:
+    """A `{generate: {seeds, style, rooms}}` entry: style, rooms, group and building seeds."""
     gen = entry["generate"]
     g_at = at.at("generate")
     if not isinstance(gen, dict) or "seeds" not in gen or set(gen) - _GENERATE_KEYS:
@@ -198,14 +216,40 @@ def _generated(entry: dict[str, Any], targets: tuple[Any, Where], at: Where
                               or rooms < 1):
         raise g_at.at("rooms").error(f"a positive number of rooms, got {rooms!r}")
     group = f"gen-{style}" + (f"-r{rooms}" if rooms is not None else "")
-    value, t_at = targets
-    entries = _entries(value, t_at, generated=True)
-    for seed in parse_seeds(gen["seeds"], g_at.at("seeds")):
-        spec = {"generate": {"seed": seed, "style": style, "rooms": rooms}}
-        building = Building(seed, style, rooms)
-        name = generated_name(seed, style, rooms)
-        for wanted in _unique([w for e in entries for w in e.resolve(building)]):
-            yield Subject(name, group, wanted.name, wanted.expected, None, spec, wanted.task)
+    return style, rooms, group, parse_seeds(gen["seeds"], g_at.at("seeds"))
+
+
+def sequence_subjects(worlds: Any, sequence: Sequence, where: Where) -> Iterator[Subject]:
+    """The tasks of a campaign sequence (`sequences.py`): per generated building, task i on
+    day i, its target a label the building holds that day (expected: found)."""
+    if not isinstance(worlds, list) or not worlds:
+        raise where.at("worlds").error("a non-empty list of {generate: {seeds, style, rooms}} "
+                                       "entries (a sequence runs on generated buildings)")
+    for i, entry in enumerate(worlds):
+        at = where.at("worlds").at(i)
+        if not isinstance(entry, dict) or "generate" not in entry:
+            raise at.error("a sequence runs on generated buildings: give {generate: {seeds, "
+                           "style, rooms}}")
+        if set(entry) - {"generate"}:
+            raise at.error(f"unknown keys {sorted(set(entry) - {'generate'})}: with "
+                           f"'sequence', an entry is {{generate: {{seeds, style, rooms}}}} "
+                           f"(targets are drawn per task)")
+        style, rooms, group, seeds = _generate_entry(entry, at)
+        for seed in seeds:
+            name = generated_name(seed, style, rooms)
+            for day in range(sequence.tasks):
+                days = sequence.generate(day)
+                try:
+                    counts = generated_instances(seed, style, rooms, **days)
+                except AvsError as exc:
+                    raise at.error(f"world seed {seed}: {exc}") from None
+                labels = [label for label, n in counts.items() if n > 0]
+                if not labels:
+                    raise at.error(f"world seed {seed} ({name}) holds no small objects on "
+                                   f"day {day}")
+                label = _known(task_label(seed, day, labels), at)
+                spec = {"generate": {"seed": seed, "style": style, "rooms": rooms, **days}}
+                yield Subject(name, group, label, "found", None, spec, None, day)
 
 
 @dataclass(frozen=True)
@@ -255,17 +299,20 @@ def generated_targets(seed: int, style: str, rooms: int | None) -> list[tuple[st
         raise CampaignError(f"generated worlds are not available in this build: {exc}") from None
 
 
-def generated_instances(seed: int, style: str, rooms: int | None) -> dict[str, int]:
-    """How many objects of each label one generated world holds (the generator's record)."""
-    return dict(_instances(seed, style, rooms))
+def generated_instances(seed: int, style: str, rooms: int | None, **days: Any
+                        ) -> dict[str, int]:
+    """How many objects of each label one generated world holds (the generator's record); of
+    a later day of it when `days` (day, move, doors) say so."""
+    return dict(_instances(seed, style, rooms, tuple(sorted(days.items()))))
 
 
 @cache
-def _instances(seed: int, style: str, rooms: int | None) -> tuple[tuple[str, int], ...]:
+def _instances(seed: int, style: str, rooms: int | None, days: tuple[tuple[str, Any], ...]
+               ) -> tuple[tuple[str, int], ...]:
     from avs_planner.harness.worlds import generated_instances as instances
 
     try:
-        return tuple(instances(seed, style, rooms).items())
+        return tuple(instances(seed, style, rooms, **dict(days)).items())
     except ImportError as exc:
         raise CampaignError(f"generated worlds are not available in this build: {exc}") from None
 

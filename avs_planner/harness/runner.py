@@ -130,10 +130,12 @@ def _memory(spec: Mapping[str, Any]) -> dict[str, Any]:
     memory = spec.get("memory")
     if memory is not None and (not isinstance(memory, str | Path) or not str(memory)):
         raise EpisodeError(f"episode spec: 'memory' must be a directory, got {memory!r}")
-    since = _number(spec.get("since_s", 3600.0), "since_s")
-    if since < 0:
-        raise EpisodeError(f"episode spec: 'since_s' must be 0 or more, got {since!r}")
-    return {"memory": None if memory is None else str(memory), "since_s": since}
+    since = spec.get("since_s", 3600.0)
+    if isinstance(since, bool) or not isinstance(since, int | float) \
+            or not math.isfinite(since) or since < 0:
+        raise EpisodeError(f"episode spec: 'since_s' must be a number >= 0 (simulated seconds "
+                           f"since the building's previous task), got {since!r}")
+    return {"memory": None if memory is None else str(memory), "since_s": float(since)}
 
 
 def _flag(spec: Mapping[str, Any], key: str) -> bool:

@@ -148,23 +148,51 @@ def load_spec(world: str | Path, robot: str | None = None, start: Sequence[float
     return _with_robot(spec, robot, start, start_room, closed_doors)
 
 
+GENERATE_KEYS = ("seed", "style", "rooms", "surprise", "day", "move", "doors")
+
+
 def generated_spec(generate: Mapping[str, Any], robot: str | None = None,
                    start: Sequence[float] | None = None,
                    start_room: str | None = None) -> WorldSpec:
-    """A generated world (`{seed, style, rooms, surprise}`, see `sim.generate`)."""
-    from sim.generate import generate_world
-
-    unknown = set(generate) - {"seed", "style", "rooms", "surprise"}
-    if unknown or "seed" not in generate:
-        raise EpisodeError(f"generate: expected keys seed (required), style, rooms, surprise; "
-                           f"got {sorted(generate)}")
+    """A generated world (`{seed, style, rooms, surprise, day, move, doors}`, see
+    `sim.generate`): `day` k > 0 is the building k days on, objects moved with probability
+    `move` and doors toggled with probability `doors` each day."""
     try:
-        world = generate_world(int(generate["seed"]), str(generate.get("style", "office")),
-                               generate.get("rooms"), float(generate.get("surprise", 0.25)))
+        world = generate_world_of(generate)
         spec = world.spec()
-    except (SimError, TypeError, ValueError) as exc:
+    except SimError as exc:
         raise EpisodeError(f"generate: {exc}") from exc
     return _with_robot(spec, robot, start, start_room, ())
+
+
+def generate_world_of(generate: Mapping[str, Any]) -> Any:
+    """`sim.generate.generate_world` of an episode's `generate` mapping (a `GeneratedWorld`);
+    EpisodeError naming the key when a key is unknown or a value is not of its kind."""
+    from sim.generate import DEFAULT_DOORS, DEFAULT_MOVE, generate_world
+
+    if not isinstance(generate, Mapping):
+        raise EpisodeError(f"generate: expected a mapping of {', '.join(GENERATE_KEYS)}; "
+                           f"got {generate!r}")
+    unknown = set(generate) - set(GENERATE_KEYS)
+    if unknown or "seed" not in generate:
+        raise EpisodeError(f"generate: expected keys seed (required), style, rooms, surprise, "
+                           f"day, move, doors; got {sorted(generate)}")
+    day = generate.get("day", 0)
+    if isinstance(day, bool) or not isinstance(day, int) or day < 0:
+        raise EpisodeError(f"generate.day: expected an integer >= 0, got {day!r}")
+    for key in ("move", "doors"):
+        value = generate.get(key, 0.0)
+        if isinstance(value, bool) or not isinstance(value, int | float) \
+                or not 0.0 <= value <= 1.0:
+            raise EpisodeError(f"generate.{key}: expected a probability in [0, 1], got "
+                               f"{value!r}")
+    try:
+        return generate_world(int(generate["seed"]), str(generate.get("style", "office")),
+                              generate.get("rooms"), float(generate.get("surprise", 0.25)),
+                              day=day, move=float(generate.get("move", DEFAULT_MOVE)),
+                              doors=float(generate.get("doors", DEFAULT_DOORS)))
+    except (TypeError, ValueError) as exc:
+        raise EpisodeError(f"generate: {exc}") from exc
 
 
 def _with_robot(spec: WorldSpec, robot: str | None, start: Sequence[float] | None,

@@ -57,9 +57,9 @@ def place_objects(rng: np.random.Generator, table: PlacementTable, layout: Layou
         placement = options[int(rng.choice(len(options), p=weights / weights.sum()))]
         size = table.object_sizes[placement.label]
         supports = [p for p in pieces if p.room == slot.room.name
-                    and p.label == placement.support and _fits(p, size)]
+                    and p.label == placement.support and fits(p, size)]
         support = supports[int(rng.integers(len(supports)))]
-        offset = _offset(rng, support, size, taken.setdefault(support.name, []))
+        offset = free_offset(rng, support, size, taken.setdefault(support.name, []))
         if offset is None:
             continue
         counters[placement.label] = counters.get(placement.label, 0) + 1
@@ -88,7 +88,7 @@ def _possible(table: PlacementTable, category: str, unusual: bool, here: list[Pi
               withheld: frozenset[str]) -> list[Placement]:
     """Placements of a category whose label is allowed and whose support is in the room."""
     return [p for p in table.placements_in(category, unusual) if p.label not in withheld
-            and any(f.label == p.support and _fits(f, table.object_sizes[p.label]) for f in here)]
+            and any(f.label == p.support and fits(f, table.object_sizes[p.label]) for f in here)]
 
 
 def _choose_surprises(rng: np.random.Generator, slots: list[_Slot],
@@ -116,11 +116,11 @@ def _choose_surprises(rng: np.random.Generator, slots: list[_Slot],
     return [(slots[i], i in chosen) for i in kept]
 
 
-def _fits(support: Piece, size: tuple[float, float, float]) -> bool:
+def fits(support: Piece, size: tuple[float, float, float]) -> bool:
     return (support.size[0] - 2 * EDGE >= size[0] and support.size[1] - 2 * EDGE >= size[1])
 
 
-def _offset(rng: np.random.Generator, support: Piece, size: tuple[float, float, float],
+def free_offset(rng: np.random.Generator, support: Piece, size: tuple[float, float, float],
             taken: list[Rect]) -> tuple[float, float] | None:
     """An offset on the support's top (its own frame) clear of the objects already there."""
     limit_x = _floor_cm(support.size[0] / 2 - size[0] / 2 - EDGE)

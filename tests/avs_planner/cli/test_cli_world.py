@@ -36,6 +36,9 @@ def test_generate_writes_a_file_that_sim_loads(
     (["--surprise", "-0.1"], "surprise: expected a share in [0, 1], got -0.1"),
     (["--seed", "-3"], "seed: expected a non-negative integer, got -3"),
     (["--style", "castle"], "invalid choice: 'castle'"),
+    (["--day", "-1"], "day: expected a non-negative integer, got -1"),
+    (["--day", "2", "--move", "1.5"], "move: expected a probability in [0, 1], got 1.5"),
+    (["--day", "2", "--doors", "-0.5"], "doors: expected a probability in [0, 1], got -0.5"),
 ])
 def test_bad_input_exits_1_with_a_clear_message(
         args: list[str], message: str, capsys: pytest.CaptureFixture[str]) -> None:
@@ -62,3 +65,14 @@ def test_an_unwritable_output_is_bad_input(
 
 def test_the_style_choices_are_the_generators() -> None:
     assert _STYLES == STYLES
+
+
+def test_generate_writes_a_later_day_of_the_building(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["world", "generate", "--seed", "5", "--day", "3", "--move", "0.5",
+                 "--doors", "0.2"]) == 0
+    out = capsys.readouterr().out
+    assert out == generate_world(5, "office", day=3, move=0.5, doors=0.2).yaml()
+    assert out != generate_world(5, "office").yaml()
+    assert out.splitlines()[0].endswith("--day 3 --move 0.5 --doors 0.2")
+    assert main(["world", "generate", "--seed", "5", "--day", "0", "--move", "0.9"]) == 0
+    assert capsys.readouterr().out == generate_world(5, "office").yaml()

@@ -102,3 +102,18 @@ def tasks(spec: dict[str, Any], emit: Any = None, should_stop: Any = None) -> di
                            for i, label in enumerate(labels)])
     Path(spec["output_dir"], "summary.json").write_text(json.dumps(result), encoding="utf-8")
     return result
+
+
+def remembering(spec: dict[str, Any], emit: Any = None, should_stop: Any = None
+                ) -> dict[str, Any]:
+    """A stand-in for an episode with the building memory: it notes which days' files its
+    memory held at the start (`memory_seen` in the summary) and adds its own day's."""
+    seen: list[str] = []
+    if spec.get("memory"):
+        memory = Path(spec["memory"])
+        seen = sorted(p.name for p in memory.iterdir()) if memory.is_dir() else []
+        memory.mkdir(parents=True, exist_ok=True)
+        (memory / f"day{spec['generate']['day']}").write_text("seen\n", encoding="utf-8")
+    result = {**summary(spec), "memory_seen": seen, "since_s": spec.get("since_s")}
+    (Path(spec["output_dir"]) / "summary.json").write_text(json.dumps(result), encoding="utf-8")
+    return result
