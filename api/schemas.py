@@ -151,8 +151,8 @@ class TaskCreate(BaseModel):
                           description="search strategy (GET /v1/strategies lists them)")
     strategy_options: dict[OptionName, OptionValue] = Field(
         default_factory=dict, max_length=50, description="the strategy's options by name; "
-        "options naming files (e.g. qsr's learn_file) and values that look like file paths "
-        "are refused (422): the service reads and writes no file a request names")
+        "options naming files (any `*_file`, `*_path`, `*_dir`) and values that look like "
+        "file paths are refused (422): the service reads and writes no file a request names")
     qsr: list[dict[str, Any]] | dict[str, Any] | None = Field(
         None, description="QSR descriptions of where the target is (strategies qsr, "
         "supporting-planes, random and the switching planner's cones): a list in the format of "

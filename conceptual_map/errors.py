@@ -7,3 +7,8 @@ class MapError(Exception):
 
 class KnowledgeError(MapError):
     """Invalid commonsense-knowledge data (names the file and the offending entry)."""
+
+
+class ExperienceError(MapError):
+    """An experience store that cannot be used: missing, not such a store, or of a newer
+    schema (names the file)."""

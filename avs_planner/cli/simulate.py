@@ -58,6 +58,12 @@ def register(subparsers: Any) -> None:
                         help="QSR descriptions for the qsr strategy: a YAML list (or a mapping "
                              "with a 'descriptions' list) in the format of "
                              "conceptual_map/qsr/README.md; default: the built-in knowledge")
+    parser.add_argument("--experience", metavar="PATH", help="an experience store (SQLite; "
+                        "made when missing): the episode searches with the priors it learned "
+                        "and adds what it saw when it ends (docs/learning.md; see "
+                        "`avs knowledge show`)")
+    parser.add_argument("--building", metavar="ID", help="with --experience: the building's "
+                        "id, whose own counts refine the all-buildings ones")
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--start-room", help="start at the centre of this room")
     where.add_argument("--start", help="start pose x,y,yaw (metres, radians)")
@@ -104,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
             from avs_planner.episode import memory
 
             memory.load(checked.memory)  # a memory that cannot be read: exit 1, named
+        _check_experience(checked)
     except (EpisodeError, ValueError) as exc:
         print(f"avs: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -116,6 +123,19 @@ def run(args: argparse.Namespace) -> int:
     else:
         _print_summary(summary, Path(args.out))
     return _EXIT.get(summary["outcome"], EXIT_TIMEOUT)
+
+
+def _check_experience(spec: Any) -> None:
+    """An --experience file that exists must be an experience store (before the run)."""
+    if spec.experience is None or not Path(spec.experience).exists():
+        return
+    from conceptual_map.errors import ExperienceError
+    from conceptual_map.knowledge.experience import ExperienceStore
+
+    try:
+        ExperienceStore(spec.experience, create=False).close()
+    except ExperienceError as exc:
+        raise ValueError(f"--experience: {exc}") from None
 
 
 def _check_label(spec: Any) -> None:
@@ -160,6 +180,9 @@ def _check_flags(args: argparse.Namespace) -> None:
     """Flags that would be silently ignored together are an error."""
     if args.generated is not None and args.world:
         raise ValueError("--generated SEED and --world name two different worlds: give one")
+    if args.building is not None and args.experience is None:
+        raise ValueError("--building names a scope of the experience store: use it with "
+                         "--experience PATH")
     if args.generated is None and (args.style is not None or args.rooms is not None):
         raise ValueError("--style and --rooms shape a generated world: use them with "
                          "--generated SEED")
@@ -200,6 +223,10 @@ def _spec(args: argparse.Namespace, base: dict[str, Any]) -> dict[str, Any]:
         spec["memory"] = args.memory
     if args.since is not None:
         spec["since_s"] = args.since
+    if args.experience is not None:
+        spec["experience"] = args.experience
+    if args.building is not None:
+        spec["building"] = args.building
     if args.record:
         spec["record"] = True
     if args.view:

@@ -48,7 +48,7 @@ _KEYS = {"target", "targets", "mode", "count", "stop_below", "category", "world"
          "robot", "start_room", "start", "seed", "time_budget_s", "wall_budget_s", "task_id",
          "output_dir", "pre_explore", "dt_policy",
          "strategy", "strategy_options", "generate", "qsr", "record", "view", "strict_labels",
-         "memory", "since_s"}
+         "memory", "since_s", "experience", "building"}
 
 
 @dataclass(frozen=True)
@@ -83,6 +83,8 @@ class EpisodeSpec:
     # the building's memory (a directory: `episode/memory.py`); None: start from nothing
     memory: str | None = None
     since_s: float = 3600.0  # simulated seconds since the building's previous task
+    experience: str | None = None  # path of the experience store (learned priors), if any
+    building: str | None = None  # the building's id: its scope in the experience store
 
     @property
     def form(self) -> TaskForm:
@@ -121,7 +123,7 @@ class EpisodeSpec:
             dt_policy=str(spec.get("dt_policy") or "pouct"), strategy=strategy.name,
             strategy_options=options, generate=generate, world_text=spec.get("world_file"),
             qsr=qsr_descriptions(spec.get("qsr")), strict_labels=_flag(spec, "strict_labels"),
-            **_recording(spec), **_memory(spec),
+            **_recording(spec), **_memory(spec), **_experience(spec),
         )
 
 
@@ -143,6 +145,23 @@ def _flag(spec: Mapping[str, Any], key: str) -> bool:
     if not isinstance(value, bool):
         raise EpisodeError(f"episode spec: {key!r} must be true or false, got {value!r}")
     return value
+
+
+def _experience(spec: Mapping[str, Any]) -> dict[str, str | None]:
+    """`experience`: the store's path (a non-empty string); `building`: an id of at most 64
+    letters, digits, `_`, `.`, `-`, starting with a letter or digit."""
+    from conceptual_map.knowledge.experience import BUILDING_ID
+
+    path, building = spec.get("experience"), spec.get("building")
+    if path is not None and (not isinstance(path, str) or not path):
+        raise EpisodeError(f"episode spec: 'experience' must be the path of an experience "
+                           f"store file, got {reprlib.repr(path)}")
+    if building is not None and (not isinstance(building, str)
+                                 or not BUILDING_ID.match(building)):
+        raise EpisodeError(f"episode spec: 'building' must be an id of 1-64 letters, digits, "
+                           f"'_', '.' or '-' starting with a letter or digit, got "
+                           f"{reprlib.repr(building)}")
+    return {"experience": path, "building": building}
 
 
 def _recording(spec: Mapping[str, Any]) -> dict[str, bool]:
@@ -251,7 +270,7 @@ class Episode:
         self.spec = spec
         self.out = Path(spec.output_dir) if spec.output_dir else None
         self.world_spec = self._world_spec()
-        knowledge = load_knowledge()
+        knowledge = self._knowledge()
         # labels and categories as the knowledge spells them: "CerealBox" is the cerealbox
         task = spec.task.spelled(knowledge.spelled) if spec.task is not None else None
         spec = self.spec = replace(spec, target=knowledge.spelled(spec.target), task=task,
@@ -289,8 +308,45 @@ class Episode:
             category=spec.category, time_budget_s=spec.time_budget_s,
             wall_budget_s=spec.wall_budget_s, options=spec.strategy_options,
             should_stop=should_stop or (lambda: False), dump_dir=spec.output_dir,
-            qsr=spec.qsr)
+            qsr=spec.qsr, experience=self.experience)
         self.recorder = self._recorder()
+
+    def _knowledge(self) -> Knowledge:
+        """The file's knowledge; with an experience store, its posterior for the spec's
+        building (`ExperienceStore.knowledge_for`), the store kept open for the update."""
+        from conceptual_map.errors import ExperienceError
+        from conceptual_map.knowledge.experience import ExperienceSession, ExperienceStore
+
+        self.experience: ExperienceSession | None = None
+        if self.spec.experience is None:
+            return load_knowledge()
+        try:
+            store = ExperienceStore(self.spec.experience)
+            knowledge = store.knowledge_for(load_knowledge(), self.spec.building)
+        except ExperienceError as exc:
+            raise EpisodeError(f"episode spec: 'experience': {exc}") from None
+        self.experience = ExperienceSession(store, self.spec.building)
+        return knowledge
+
+    def _learn(self, result: SearchResult) -> dict[str, Any]:
+        """{"experience": ...}: the episode's evidence (`episode_evidence`, from the mind
+        alone) added to the store, unless the search was stopped on request; nothing
+        without a store."""
+        if self.experience is None:
+            return {}
+        from avs_planner.episode.experience import episode_evidence
+        from conceptual_map.errors import ExperienceError
+
+        part: dict[str, Any] = {"store": self.experience.store.path.name,
+                                "building": self.spec.building,
+                                "updated": result.reason != "stopped on request"}
+        if part["updated"]:
+            evidence = self.experience.with_learned(episode_evidence(self.mind))
+            try:
+                self.experience.store.update(self.spec.building, evidence)
+            except ExperienceError as exc:  # the search's result stands; say why not kept
+                part.update(updated=False, error=str(exc))
+        return {"experience": part}
 
     def _recorder(self):  # noqa: ANN202 - a viewer.Recorder, or None
         """The Rerun recorder, subscribed to the trace, when the spec asks for one."""
@@ -352,12 +408,15 @@ class Episode:
                 result = search(self.context)
             summary = self.summary(result, start_clock, start_distance, targets)
             self._keep_memory(summary)
+            summary.update(self._learn(result))
             if self.out is not None:
                 write_summary(self.out / "summary.json", summary)
                 self._explanation()
                 self._picture()
             return summary
         finally:
+            if self.experience is not None:
+                self.experience.store.close()
             if self.recorder is not None:
                 self.recorder.close()
             self.trace.close()

@@ -40,6 +40,9 @@ class SearchContext:
     # not yet searched) falls below this level, the task's own; a strategy with a give-up rule
     # of its own (weighing the reward against costs) leaves the stop to that level
     stop_below: float | None = None
+    # the episode's use of an experience store (`conceptual_map.knowledge.experience.
+    # ExperienceSession`): learned QSR counts are read from it and added to it; None: none
+    experience: Any = None
 
     def budget_spent(self) -> str | None:
         """Why the search must stop now (a request, the simulated or wall budget), or None."""

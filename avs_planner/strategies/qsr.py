@@ -23,16 +23,18 @@ when the survey ends (the QSR paper's time is search time with known maps); summ
 times.
 
 After a found object, the knowledge learns from it (`learn_from_observation` with the surveyed
-landmarks), written to `learn_file` when that option names a file; the next search reads it from
-there. Nothing is kept in the process: an episode's result depends only on its inputs (a
-service worker or a campaign process runs many episodes, in any order).
+landmarks) for the rest of the episode. With an experience store in the search context
+(`SearchContext.experience`, an episode's `experience` file), the search starts from the
+descriptions earlier episodes learned, and what it learns goes back there when the episode
+ends well (`conceptual_map/knowledge/experience.py`). Nothing is kept in the process: an
+episode's result depends only on its inputs (a service worker or a campaign process runs many
+episodes, in any order).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -64,7 +66,6 @@ from conceptual_map.qsr import (
     QsrKnowledge,
     SupportingPlanes,
     build_mixture,
-    dump_qsr,
     extract_supporting_planes,
     learn_from_observation,
     load_qsr,
@@ -115,14 +116,13 @@ class QsrSearch:
     # -- knowledge --
 
     def _knowledge(self) -> tuple[QsrKnowledge, str]:
-        """The task's descriptions; else `learn_file` when it exists; else the default
-        knowledge."""
+        """The task's descriptions; else the default knowledge with what the experience
+        store learned, when the episode has one; else the default knowledge."""
         ctx = self.ctx
         if ctx.qsr is not None:
             return ctx.qsr, "task"
-        path = str(self.opt.get("learn_file") or "")
-        if path and Path(path).exists():
-            return load_qsr(path), path
+        if ctx.experience is not None:
+            return ctx.experience.qsr_knowledge(load_qsr()), "experience"
         return load_qsr(), "default"
 
     # -- the loop --
@@ -437,9 +437,5 @@ class QsrSearch:
         if not update.credited:
             return
         self.knowledge = update.knowledge
-        path = str(self.opt.get("learn_file") or "")
-        if path:
-            import yaml
-
-            Path(path).write_text(yaml.safe_dump(dump_qsr(update.knowledge), sort_keys=False),
-                                  encoding="utf-8")
+        if self.ctx.experience is not None:
+            self.ctx.experience.learn_qsr(update.credited)

@@ -33,9 +33,16 @@ OPTIONS: dict[str, Any] = {
     "depth_columns": 64,  # depth frame size (columns x rows)
     "depth_rows": 48,
     "watch": False,  # the detector watches for the target while driving to a view pose
-    "learn": True,  # after a found object, update the knowledge (written to learn_file)
-    "learn_file": "",  # QSR YAML read at start (when it exists) and written after learning
+    "learn": True,  # after a found object, update the knowledge for the rest of the episode
+    # (and the experience store's QSR counts, when the episode has a store)
 }
+
+REMOVED = {
+    "learn_file": "the QSR counts a search learns are kept in the experience store: give "
+                  "one with `avs simulate --experience PATH` (the episode spec's "
+                  "`experience`); see docs/learning.md",
+}
+"""Options the QSR strategies no longer take -> what to use instead."""
 
 UTILITIES = ("rate", "eq2")
 

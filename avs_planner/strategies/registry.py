@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 from avs_planner.episode.errors import EpisodeError
@@ -12,6 +12,7 @@ from avs_planner.episode.outcome import SearchResult
 from avs_planner.errors import AvsError
 from avs_planner.strategies.context import SearchContext
 from avs_planner.strategies.qsr_options import OPTIONS as _QSR_OPTIONS
+from avs_planner.strategies.qsr_options import REMOVED as _QSR_REMOVED
 from avs_planner.strategies.switching.loop import LoopConfig
 
 _QSR_CHECK = "avs_planner.strategies.qsr_options:check_options"
@@ -38,6 +39,8 @@ class Strategy:
     # (raises an AvsError naming the option)
     configure: str | None = None  # "module:function": checked options -> (ExecutorConfig,
     # BuilderConfig) the episode builds its executor and state builder with (None: defaults)
+    removed: Mapping[str, str] = field(default_factory=dict)  # options it no longer takes ->
+    # what to use instead (refused with that message)
 
     def load(self) -> Run:
         return _load(self.entry)
@@ -52,6 +55,9 @@ class Strategy:
     def check_options(self, given: Mapping[str, Any] | None) -> dict[str, Any]:
         """The defaults overridden by `given`, each converted to its default's type."""
         given = dict(given or {})
+        for key in sorted(set(given) & set(self.removed)):
+            raise StrategyError(f"strategy {self.name!r}: option {key!r} was removed: "
+                                f"{self.removed[key]}")
         unknown = sorted(set(given) - set(self.options))
         if unknown:
             known = ", ".join(sorted(self.options)) or "none"
@@ -144,14 +150,14 @@ STRATEGIES: dict[str, Strategy] = {s.name: s for s in (
              "then views where the QSR mixture (target relative to landmarks) is densest; "
              "abort after 120 s of search",
              "avs_planner.strategies.qsr:run_qsr", _QSR_OPTIONS,
-             check=_QSR_CHECK),
+             check=_QSR_CHECK, removed=_QSR_REMOVED),
     Strategy("supporting-planes", "QSR baseline: as qsr, views scored by a uniform density "
              "over the supporting planes",
              "avs_planner.strategies.qsr:run_supporting_planes", _QSR_OPTIONS,
-             check=_QSR_CHECK),
+             check=_QSR_CHECK, removed=_QSR_REMOVED),
     Strategy("random", "QSR baseline: as qsr, but a random one of the 20 sampled view poses",
              "avs_planner.strategies.qsr:run_random", _QSR_OPTIONS,
-             check=_QSR_CHECK),
+             check=_QSR_CHECK, removed=_QSR_REMOVED),
     Strategy("flap", "FLAP (Gedicke et al.): frontier view sampling in the 3D map and "
              "expected-time view sequencing over the target's known supports (greedy: true is "
              "its baseline)",

@@ -51,23 +51,37 @@ def test_the_search_monitor_gives_up_on_an_absent_object():
     assert summary["views_processed"] >= summary["details"]["poses"] >= 1
 
 
-def test_a_found_cup_teaches_the_knowledge_the_next_search_reads_from_its_file(tmp_path):
-    path = tmp_path / "learnt.yaml"
+def test_a_found_cup_teaches_the_experience_store_the_next_search_reads(tmp_path):
+    """The one episode test of the experience store: a QSR search that finds its cup adds
+    what it learned (QSR counts, and the rooms it searched) to the store; the next episode
+    on the store starts from it; one without a store starts from the default knowledge."""
+    from conceptual_map.knowledge.experience import ExperienceStore
+
+    store = tmp_path / "experience.sqlite"
     before = {d.key: d.count for d in load_qsr().descriptions_for("cup")}
-    summary = run_episode(_spec("qsr", options={"learn": True, "learn_file": str(path)}))
-    assert summary["outcome"] == "found" and summary["details"]["knowledge"] == "default"
-    learnt = load_qsr(path)  # written after the find, in the format load_qsr reads
-    after = {d.key: d.count for d in learnt.descriptions_for("cup")}
-    gained = {k: after[k] - before.get(k, 0.0) for k in after if after[k] != before.get(k)}
+    summary = run_episode(_spec("qsr", options={"learn": True}, experience=str(store),
+                                building="desks-1"))
+    assert summary["outcome"] == "found" and summary["details"]["knowledge"] == "experience"
+    assert summary["experience"] == {"store": "experience.sqlite", "building": "desks-1",
+                                     "updated": True}
+    with ExperienceStore(store, create=False) as kept:
+        learnt = {d.key: d.count for d in kept.qsr_for(load_qsr()).descriptions_for("cup")}
+        scopes = kept.export()["scopes"]
+    gained = {k: learnt[k] - before.get(k, 0.0) for k in learnt if learnt[k] != before.get(k)}
     assert gained and all(v == 1.0 for v in gained.values())
+    assert scopes["all"]["episodes"] == scopes["building:desks-1"]["episodes"] == 1
+    assert scopes["all"]["qsr"] == scopes["building:desks-1"]["qsr"]
     short = {"survey_stops": 0, "abort_s": 1.0}
-    # the next search that names the file starts from what was learnt
-    again = run_episode(_spec("qsr", options={"learn": True, "learn_file": str(path), **short}))
-    assert again["details"]["knowledge"] == str(path)
+    # the next search on the store starts from what was learnt, and adds its own episode
+    again = run_episode(_spec("qsr", options={"learn": True, **short}, experience=str(store),
+                              building="desks-1"))
+    assert again["details"]["knowledge"] == "experience" and again["experience"]["updated"]
+    with ExperienceStore(store, create=False) as kept:
+        assert kept.export()["scopes"]["all"]["episodes"] == 2
     # one that names none starts from the default knowledge: nothing is kept in the process
     # (a service worker or a campaign process runs many episodes in any order)
     fresh = run_episode(_spec("qsr", options={"learn": True, **short}))
-    assert fresh["details"]["knowledge"] == "default"
+    assert fresh["details"]["knowledge"] == "default" and "experience" not in fresh
 
 
 def test_task_descriptions_are_validated_with_clear_errors():
