@@ -53,6 +53,10 @@ def check_remembered(executor: Executor, labels: Collection[str],
     mind = executor.mind
     found: list[KnownObject] = []
     skipped: list[Sighting] = []
+    if mind.place_map.current_place is None:
+        # a scan where the robot stands places it in the remembered map (a standpoint it
+        # already stands at is reached without driving, and so without a scan)
+        executor.sense([tuple(executor.robot.pose)])
     while budget_left():
         todo = [s for s in mind.remembered if s.label in labels and s.weight >= CHECK_WEIGHT
                 and s not in skipped]
