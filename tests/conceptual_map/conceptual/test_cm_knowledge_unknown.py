@@ -58,3 +58,25 @@ def test_support_relations_list_in_as_well_as_on():
     assert knowledge.support_lambda("cup", "shelf")[kitchen] == pytest.approx(1.5)
     assert knowledge.support_lambda("cerealbox", "shelf")[kitchen] == pytest.approx(0.6)
     assert not knowledge.support_lambda("cup", "sofa").any()
+
+
+def test_the_knowledge_file_says_how_often_labels_are_moved(tmp_path):
+    """`mobility`: a sighting's chance to hold after `days` is exp(-rate x days); labels
+    moved less often than `fixed_below` are furniture (the building memory keeps them)."""
+    mobility = load_knowledge().mobility
+    assert mobility.fixed("desk") and mobility.fixed("fridge")
+    assert not mobility.fixed("cup") and not mobility.fixed("chair")
+    assert mobility.rate("cup") == mobility.default  # not listed: the default rate
+    assert mobility.still_there("cup", 2.0) == pytest.approx(np.exp(-2.0 * mobility.default))
+    assert mobility.still_there("shelf", 100.0) == 1.0
+    data = yaml.load(DEFAULT_KNOWLEDGE_PATH.read_text(), Loader=KnowledgeYamlLoader)
+    path = tmp_path / "mine.yaml"
+    for bad, where in (({"rate": {"unicorn": 0.1}}, "mobility.rate.unicorn"),
+                       ({"rate": {"cup": -1}}, "mobility.rate.cup"),
+                       ({"default": "often"}, "mobility.default"),
+                       ({"speed": 1}, "mobility")):
+        path.write_text(yaml.safe_dump({**data, "mobility": bad}))
+        with pytest.raises(KnowledgeError, match=where.replace(".", r"\.")):
+            load_knowledge(path)
+    path.write_text(yaml.safe_dump({k: v for k, v in data.items() if k != "mobility"}))
+    assert load_knowledge(path).mobility.rate("desk") == load_knowledge(path).mobility.default

@@ -6,6 +6,7 @@ import networkx as nx
 import numpy as np
 import pytest
 
+from conceptual_map.errors import MapError
 from conceptual_map.metric import CellState, OccupancyGrid
 from conceptual_map.metric.synthetic import BoxWorld, rooms_world
 from conceptual_map.places import Change, EntityKind, MapEvent, PlaceMap
@@ -181,3 +182,33 @@ def test_room_links_join_the_corridor_to_each_room_through_its_door(run: Run) ->
     }
     joined = sorted(tuple(sorted((rect[a], rect[b]))) for a, b in links.values())
     assert joined == [(0, 1), (0, 2)]
+
+
+def test_an_exported_map_is_restored_and_goes_on_from_a_new_pose(run: Run) -> None:
+    """What a later task keeps (`export`) gives the same places, doors and rooms back, the
+    conceptual map's events for every room, and the robot at no place until it moves: a
+    new pose does not continue the old path with a straight leg through the walls."""
+    import json
+
+    data = json.loads(json.dumps(run.place_map.export()))  # plain data, as it is stored
+    assert "placeholders" not in data  # derived from the grid again
+    restored, events = PlaceMap.restored(data)
+    old = run.place_map
+    assert restored.places == old.places and restored.doors == old.doors
+    assert restored.rooms == old.rooms
+    assert {e.id for e in events} == set(old.rooms)
+    assert all(e.kind is EntityKind.ROOM and e.change is Change.APPEARED for e in events)
+    assert restored.current_place is None
+    grid = OccupancyGrid.restored(run.grid.origin, run.grid.logodds, run.grid.resolution)
+    assert np.array_equal(grid.state_grid(), run.grid.state_grid())
+    start = next(iter(old.places.values())).position
+    restored.update(grid, (*start, 0.0), time=1000.0)
+    assert set(restored.places) == set(old.places)  # it stands at a place it knew
+    assert set(restored.rooms) == set(old.rooms) and restored.doors == old.doors
+    assert restored.current_place is not None
+    with pytest.raises(MapError, match="nowhere"):
+        PlaceMap.restored({**data, "edges": [["place1", "nowhere", True, None]]})
+    with pytest.raises(MapError, match="malformed"):
+        PlaceMap.restored({**data, "places": {"place1": [1.0]}})
+    with pytest.raises(ValueError, match="int8"):
+        OccupancyGrid.restored((0.0, 0.0), np.zeros((3, 3)), 0.05)
