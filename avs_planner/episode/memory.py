@@ -16,8 +16,10 @@ task in that building starts from it (`recall`):
   checks it by looking again (`episode/recall.py`), and one not seen where it was is dropped.
 
 Stored as two files in the building's directory: `memory.json` (the map's entities, the
-evidence and the objects, plain JSON) and `grid.npz` (the grid's arrays, read without
-pickle). The directory is given by whoever runs the task (the CLI's `--memory DIR`, a
+evidence and the objects, plain JSON) and the grid it names, `grid-<tasks>.npz` (the grid's
+arrays, read without pickle). The grid is written first under a new name, then
+`memory.json` is replaced: a task stopped in between leaves the memory as it was. The
+directory is given by whoever runs the task (the CLI's `--memory DIR`, a
 campaign's own output directory, the service's data directory); nothing here builds a path
 from a request.
 """
@@ -27,6 +29,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import tempfile
 from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field
@@ -44,7 +47,7 @@ from conceptual_map.places import PlaceMap
 
 FORMAT = 1
 MEMORY_FILE = "memory.json"
-GRID_FILE = "grid.npz"
+GRID_FILE = re.compile(r"grid-[0-9]{1,9}\.npz")  # the grid files memory.json may name
 DAY_S = 86400.0
 KEEP_FURNITURE = 0.5  # furniture more likely moved than not is not a known object any more
 FORGET_BELOW = 0.01  # a sighting this unlikely to hold is not kept
@@ -206,14 +209,17 @@ def load(directory: str | os.PathLike[str]) -> BuildingMemory | None:
         found = data.get("format") if isinstance(data, Mapping) else type(data).__name__
         raise BuildingMemoryError(f"{path}: building memory format {found!r}; this version reads "
                            f"format {FORMAT} (forget the building to start afresh)")
+    grid_file = data.get("grid")
+    if not isinstance(grid_file, str) or not GRID_FILE.fullmatch(grid_file):
+        raise BuildingMemoryError(f"{path}: names no grid file (grid-<n>.npz): {grid_file!r}")
     try:
-        with np.load(root / GRID_FILE, allow_pickle=False) as arrays:
+        with np.load(root / grid_file, allow_pickle=False) as arrays:
             logodds = np.asarray(arrays["logodds"], dtype=np.int8)
             origin = tuple(float(v) for v in arrays["origin"])
             resolution = float(arrays["resolution"])
     except (OSError, KeyError, ValueError) as exc:
         raise BuildingMemoryError(
-            f"{root / GRID_FILE}: cannot read the kept grid ({exc})") from None
+            f"{root / grid_file}: cannot read the kept grid ({exc})") from None
     try:
         return BuildingMemory(
             tasks=int(data["tasks"]), clock=float(data["clock"]), grid_origin=origin,
@@ -233,14 +239,18 @@ def save(memory: BuildingMemory, directory: str | os.PathLike[str]) -> None:
     root.mkdir(parents=True, exist_ok=True)
     if memory.grid_logodds is None:
         raise BuildingMemoryError("a building memory without a grid cannot be saved")
+    grid_file = f"grid-{memory.tasks}.npz"
     data = {"format": FORMAT, "tasks": memory.tasks, "clock": round(memory.clock, 3),
-            "saved": memory.saved, "place_map": memory.place_map,
+            "saved": memory.saved, "grid": grid_file, "place_map": memory.place_map,
             "evidence": memory.evidence, "objects": memory.objects,
             "sightings": memory.sightings}
-    _replace(root / GRID_FILE, lambda f: np.savez_compressed(
+    _replace(root / grid_file, lambda f: np.savez_compressed(
         f, logodds=memory.grid_logodds, origin=np.asarray(memory.grid_origin),
         resolution=np.asarray(memory.grid_resolution)))
     _replace(root / MEMORY_FILE, lambda f: f.write(json.dumps(data).encode("utf-8")))
+    for old in root.glob("grid-*.npz"):  # the grids no memory.json names any more
+        if old.name != grid_file and GRID_FILE.fullmatch(old.name):
+            old.unlink(missing_ok=True)
 
 
 def _replace(path: Path, write) -> None:  # noqa: ANN001 - a callable taking a binary file

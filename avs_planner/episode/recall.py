@@ -25,6 +25,7 @@ from avs_planner.episode.executor import Executor
 from avs_planner.episode.memory import Sighting
 from avs_planner.episode.mind import KnownObject
 from avs_planner.episode.outcome import StepStatus
+from avs_planner.episode.sensing import SAME_SPOT
 from avs_planner.episode.verifying import verify_distance
 from conceptual_map.metric import PathQueryError, distance_field
 from conceptual_map.metric.logodds import CellState
@@ -49,14 +50,22 @@ class _Seen:
 def check_remembered(executor: Executor, labels: Collection[str],
                      emit: Callable[..., Any], budget_left: Callable[[], bool] = lambda: True
                      ) -> list[KnownObject]:
-    """Check the sightings of `labels` (see the module's doc); the objects confirmed."""
+    """Check the sightings of `labels` (see the module's doc); the objects confirmed. With
+    any to check, the robot first looks round where it stands, as every strategy begins: a
+    wanted object in view there is found without driving to a spot remembered elsewhere
+    (the look round found targets near the start in about 10 s, and a check that drove to
+    another room first cost more). The strategy's own first look round is then skipped
+    while the robot stands where it looked (`Sensing.resumed`)."""
     mind = executor.mind
     found: list[KnownObject] = []
     skipped: list[Sighting] = []
-    if mind.place_map.current_place is None:
-        # a scan where the robot stands places it in the remembered map (a standpoint it
-        # already stands at is reached without driving, and so without a scan)
-        executor.sense([tuple(executor.robot.pose)])
+    if not any(s.label in labels and s.weight >= CHECK_WEIGHT for s in mind.remembered):
+        return found
+    executor.look_around()
+    here = tuple(executor.robot.pose[:2])
+    if any(obj.label in labels for obj in mind.objects.values()):
+        executor.sensing.resumed = here  # a wanted object in view: nothing to check first
+        return found
     while budget_left():
         todo = [s for s in mind.remembered if s.label in labels and s.weight >= CHECK_WEIGHT
                 and s not in skipped]
@@ -82,6 +91,11 @@ def check_remembered(executor: Executor, labels: Collection[str],
              **({"object": known.id} if known is not None else {"dropped": True}))
         if known is not None:
             found.append(known)
+    # where the robot stands now, the look round or the check's frames have looked: the
+    # strategy's first look round would add nothing while a wanted object is known, or while
+    # the robot has not moved from where it looked round
+    if found or math.dist(here, executor.robot.pose[:2]) <= SAME_SPOT:
+        executor.sensing.resumed = tuple(executor.robot.pose[:2])
     return found
 
 

@@ -445,10 +445,6 @@ class Episode:
         self.memory.checked = sum(1 for e in self.trace.events
                                   if e["type"] == "memory" and "checked" in e)
         self.memory.confirmed = len(found)
-        if any(obj.label in self.spec.form.targets for obj in found):
-            # a wanted object is in view now: the strategy's first look round would add
-            # nothing the remembered map and the check's frames do not hold
-            self.executor.sensing.resumed = tuple(self.robot.pose[:2])
 
     def _keep_memory(self, summary: dict[str, Any]) -> None:
         """Write what the robot knows now to the building's memory; the summary says so."""

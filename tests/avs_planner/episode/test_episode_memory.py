@@ -98,6 +98,10 @@ def test_files_round_trip(kept, tmp_path):
     assert back.objects == mem.objects and back.tasks == mem.tasks
     assert back.summary()["labels"] == {"book": 1, "cup": 1, "table": 1}
     assert not list(tmp_path.glob(".*.tmp"))  # written whole, nothing left over
+    mem.tasks += 1  # the next task's memory replaces the grid; the old one is deleted
+    memory.save(mem, tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["grid-2.npz", "memory.json"]
+    assert memory.load(tmp_path).tasks == 2
 
 
 def test_bad_files_are_named(kept, tmp_path):
@@ -113,8 +117,12 @@ def test_bad_files_are_named(kept, tmp_path):
     with pytest.raises(BuildingMemoryError, match="malformed building memory"):
         memory.load(tmp_path)
     (tmp_path / "memory.json").write_text(json.dumps(data), encoding="utf-8")
-    (tmp_path / "grid.npz").write_bytes(b"not an archive")
-    with pytest.raises(BuildingMemoryError, match="grid.npz"):
+    (tmp_path / data["grid"]).write_bytes(b"not an archive")
+    with pytest.raises(BuildingMemoryError, match=r"grid-1\.npz: cannot read"):
+        memory.load(tmp_path)
+    (tmp_path / "memory.json").write_text(json.dumps({**data, "grid": "../../etc/passwd"}),
+                                          encoding="utf-8")
+    with pytest.raises(BuildingMemoryError, match="names no grid file"):
         memory.load(tmp_path)
 
 

@@ -50,7 +50,7 @@ def test_first_task_starts_from_nothing_and_keeps_what_it_learned(first_task):
     assert len(kept["place_map"]["places"]) >= 5 and kept["place_map"]["rooms"]
     labels = [o["label"] for o in kept["objects"]]
     assert "cerealbox" in labels  # the reported object is remembered with its time
-    assert (memory / "grid.npz").exists()
+    assert (memory / kept["grid"]).exists() and kept["grid"] == "grid-1.npz"
 
 
 def test_second_task_starts_from_the_memory_and_checks_the_sighting(first_task, tmp_path):
