@@ -92,6 +92,16 @@ class Settings(BaseSettings):
     def tasks_dir(self) -> Path:
         return self.data_dir / "tasks"
 
+    @property
+    def buildings_dir(self) -> Path:
+        """`buildings/ID/memory/`: each building's memory (docs/memory.md)."""
+        return self.data_dir / "buildings"
+
+    @property
+    def experience_path(self) -> Path:
+        """The experience store every building's tasks learn into (docs/learning.md)."""
+        return self.data_dir / "experience.sqlite3"
+
     def records(self) -> bool:
         """Whether episodes write recording.rrd (AVS_RECORD, else: the viewer extra is
         installed here and episodes run here, not on a Ray cluster that may lack it)."""

@@ -23,7 +23,7 @@ from api.manager import TaskManager
 from api.middleware import BodyLimitMiddleware
 from api.pages import add_pages
 from api.plan_jobs import PlanJobs
-from api.routes import domains, misc, plans, tasks
+from api.routes import buildings, domains, misc, plans, tasks
 from api.security import KeyRing, RateLimiter
 from api.store import StorageError, TaskStore
 from api.worlds import default_worlds_dir
@@ -72,7 +72,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.keys = keys
     app.state.draining = threading.Event()
     app.state.rate_limiter = RateLimiter(settings.rate_limit_per_minute, settings.rate_limit_burst)
-    for module in (tasks, plans, domains, misc):
+    for module in (tasks, buildings, plans, domains, misc):
         app.include_router(module.router, prefix=API_PREFIX)
     add_docs(app)
     add_pages(app)

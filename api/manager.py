@@ -13,7 +13,11 @@ restarts any worker slot thread that died.
 from __future__ import annotations
 
 import asyncio
+import hashlib
+import json
 import logging
+import re
+import shutil
 import threading
 import time
 import uuid
@@ -25,7 +29,7 @@ from typing import Any
 
 from api.config import Settings
 from api.limits import short, without_file_options
-from api.schemas import TaskState
+from api.schemas import BUILDING_PATTERN, MAX_SINCE_S, TaskState
 from api.security import Caller
 from api.store import StorageError, TaskRecord, TaskStore
 from api.worker_process import PRELOAD_JOBS, resolve
@@ -49,6 +53,7 @@ _JOB_STATES = {
 TaskChecker = Callable[[dict[str, Any], Path | None], list[Any]]  # -> [FieldProblem(field, msg)]
 
 
+_BUILDING_ID = re.compile(BUILDING_PATTERN.removeprefix("^").removesuffix("$"))
 SUPERVISE_S = 0.5  # how often failed writes are retried and worker threads checked
 MAX_ERROR = 2000  # characters of a task's `error`
 
@@ -67,6 +72,14 @@ class IdempotencyConflictError(Exception):
 
 class NotCancellableError(Exception):
     """The task already ended (HTTP 409)."""
+
+
+class BuildingWorldError(Exception):
+    """The task names a building that is another world (HTTP 422 naming `building`)."""
+
+
+class BuildingBusyError(Exception):
+    """The building has tasks queued or running (HTTP 409 for a forget)."""
 
 
 class ClientGoneError(Exception):
@@ -111,6 +124,10 @@ class TaskManager:
         self._plan_jobs: Counter[str] = Counter()  # owner -> plan/check jobs in flight
         self._stopping = threading.Event()
         self._supervisor: threading.Thread | None = None
+        # one task at a time per building: the task admitted to the pool, and those waiting
+        self._gate = threading.Lock()
+        self._admitted: dict[str, str] = {}  # building -> task id in the pool (or running)
+        self._waiting: dict[str, deque[str]] = {}  # building -> queued task ids, in order
 
     # -- life cycle -------------------------------------------------------------------------
 
@@ -168,10 +185,20 @@ class TaskManager:
             if quota and self.store.count_state(TaskState.QUEUED, owner) >= quota:
                 raise QuotaError(f"key {caller.name!r} already has {quota} queued tasks, its "
                                  "quota; retry when one has started")
+            building = request.get("building")
+            place = None
+            if isinstance(building, str):
+                place = (building, world_identity(request))
+                known = self.store.building(building)
+                if known is not None and known.world != place[1]:
+                    raise BuildingWorldError(
+                        f"building {building!r} is {_world_text(known.world)}; this task "
+                        f"names {_world_text(place[1])} (a building is always the same "
+                        f"world; forget it, DELETE /v1/buildings/{building}, to reuse its id)")
             task_id = uuid.uuid4().hex
-            self.store.insert(task_id, request, owner, idempotency_key, request_hash)
+            self.store.insert(task_id, request, owner, idempotency_key, request_hash, place)
         self._state_event(task_id, TaskState.QUEUED)
-        self._enqueue(task_id)
+        self._enqueue(task_id, building if isinstance(building, str) else None)
         task = self.store.get(task_id)
         assert task is not None
         return Submission(task, replayed=False)
@@ -192,7 +219,45 @@ class TaskManager:
                 event.set()
         return self.store.get(task_id)
 
-    def _enqueue(self, task_id: str) -> None:
+    def _enqueue(self, task_id: str, building: str | None = None) -> None:
+        """Give the task to the worker pool, or, when a task of its building is in the pool,
+        keep it waiting (queued) until that one has ended (`_release`)."""
+        if building is None:
+            task = self.store.get(task_id)
+            building = task.building if task is not None else None
+        if building is not None:
+            with self._gate:
+                holder = self._admitted.get(building)
+                if holder is not None and holder != task_id:
+                    self._waiting.setdefault(building, deque()).append(task_id)
+                    return
+                self._admitted[building] = task_id
+        self._submit(task_id, building)
+
+    def _release(self, building: str | None, task_id: str) -> None:
+        """The task of `building` in the pool has ended (or was skipped): admit the next."""
+        if building is None:
+            return
+        with self._gate:
+            if self._admitted.get(building) != task_id:
+                return
+            waiting = self._waiting.get(building)
+            following = waiting.popleft() if waiting else None
+            if waiting is not None and not waiting:
+                del self._waiting[building]
+            if following is None:
+                del self._admitted[building]
+                return
+            self._admitted[building] = following
+        if not self._stopping.is_set():
+            self._submit(following, building)
+
+    def building_busy(self, building: str) -> bool:
+        """Whether a task of `building` is in the pool or waits for one."""
+        with self._gate:
+            return building in self._admitted
+
+    def _submit(self, task_id: str, building: str | None) -> None:
         cancel = self._cancels.setdefault(task_id, threading.Event())
         output_dir = str((self.settings.tasks_dir / task_id).resolve()) + "/"
         job = Job(
@@ -205,7 +270,7 @@ class TaskManager:
         )
         job.on_start = lambda: self._claim(task_id, job)
         future = self.episodes.submit(job)
-        future.add_done_callback(lambda f: self._finished(task_id, f.result()))
+        future.add_done_callback(lambda f: self._finished(task_id, f.result(), building))
 
     def _episode_spec(self, task: TaskRecord) -> dict[str, Any]:
         """What the episode runner gets: the request (less any option naming a file, which
@@ -219,10 +284,64 @@ class TaskManager:
         request["strict_labels"] = bool(request.get("strict_labels"))  # false: an unknown
         # target label is searched for with an uninformed prior (tasks stored before the
         # field existed lack it)
+        for key in ("memory", "experience", "output_dir"):  # the service's to say, never a
+            request.pop(key, None)  # request's (the schema forbids them; old rows: dropped)
         spec = {**request, "task_id": task.id, "output_dir": str(output_dir.resolve())}
+        if isinstance(request.get("building"), str):
+            spec.update(self._building_spec(request["building"], request.get("since_s")))
+        else:
+            spec.pop("since_s", None)
         if self.record:
             spec["record"] = True
         return spec
+
+    def memory_dir(self, building: str) -> Path:
+        """`DATA_DIR/buildings/ID/memory`: built here from a checked id only (ValueError for
+        one that would leave the buildings directory)."""
+        if not _BUILDING_ID.fullmatch(building):
+            raise ValueError(f"not a building id: {building!r}")
+        root = self.settings.buildings_dir.resolve()
+        folder = (root / building / "memory").resolve()
+        if folder.parent.parent != root:
+            raise ValueError(f"not a building id: {building!r}")
+        return folder
+
+    def _building_spec(self, building: str, since_s: Any) -> dict[str, Any]:
+        """The episode spec's building keys: its memory directory, the experience store and
+        its scope, and the simulated seconds since its previous task (given, or the real
+        seconds since its memory was last written, at most `MAX_SINCE_S`)."""
+        folder = self.memory_dir(building)
+        folder.mkdir(parents=True, exist_ok=True)
+        if not isinstance(since_s, int | float) or isinstance(since_s, bool):
+            try:
+                written = (folder / "memory.json").stat().st_mtime
+            except OSError:
+                since_s = 0.0  # a first task: nothing remembered, no time passed
+            else:
+                since_s = round(min(max(time.time() - written, 0.0), MAX_SINCE_S), 1)
+        return {"memory": str(folder), "since_s": float(since_s), "building": building,
+                "experience": str(self.settings.experience_path.resolve())}
+
+    def forget(self, building: str) -> bool:
+        """Forget a building: its memory files, its scope of the experience store and its
+        record (its tasks and their results stay). False when it is not known;
+        `BuildingBusyError` while a task of it is queued or running."""
+        from avs_planner.jobs import forget_building_experience
+
+        with self._lock:  # no task of it is submitted meanwhile
+            if self.store.building(building) is None:
+                return False
+            live = self.store.building_live(building)
+            if live or self.building_busy(building):
+                raise BuildingBusyError(
+                    f"building {building!r} has {live or 1} task(s) queued or running; "
+                    f"cancel them or wait for them to end before forgetting it")
+            folder = self.memory_dir(building).parent
+            shutil.rmtree(folder, ignore_errors=True)
+            if folder.exists():
+                raise OSError(f"the memory of building {building!r} could not be deleted")
+            forget_building_experience(str(self.settings.experience_path), building)
+            return self.store.forget_building(building)
 
     def _claim(self, task_id: str, job: Job) -> bool:
         """queued -> running and the job's spec; False skips the job: the task is no longer
@@ -239,8 +358,9 @@ class TaskManager:
             return False
         try:
             job.payload = self._episode_spec(task)
-        except OSError as exc:
-            error = f"storage error: cannot create the task's folder: {exc.strerror or exc}"
+        except (OSError, ValueError) as exc:
+            error = f"storage error: cannot create the task's folders: {exc.strerror or exc}" \
+                if isinstance(exc, OSError) else f"cannot start: {exc}"
             self._write(lambda: self._finish(task_id, TaskState.FAILED, None, error))
             return False
         self._state_event(task_id, TaskState.RUNNING, attempt=task.attempts)
@@ -260,7 +380,13 @@ class TaskManager:
                                        "it was stopped")
             cancel.set()
 
-    def _finished(self, task_id: str, result: JobResult) -> None:
+    def _finished(self, task_id: str, result: JobResult, building: str | None = None) -> None:
+        try:
+            self._record_end(task_id, result)
+        finally:
+            self._release(building, task_id)
+
+    def _record_end(self, task_id: str, result: JobResult) -> None:
         try:
             self._cancels.pop(task_id, None)
             failure = self._failures.pop(task_id, None)
@@ -270,6 +396,8 @@ class TaskManager:
                 state, summary, error = TaskState.FAILED, None, failure
             else:
                 state, summary, error = _task_outcome(result)
+            if error:  # a building's memory named by its place in the data dir, not the path
+                error = error.replace(str(self.settings.data_dir.resolve()), "DATA_DIR")
             self._write(lambda: self._finish(task_id, state, summary, error))
         except Exception:  # noqa: BLE001 - a future's callback must not fail silently
             log.exception("recording the end of task %s failed", task_id)
@@ -413,6 +541,31 @@ class TaskManager:
 
     def counts(self) -> tuple[int, int]:
         return self.store.count_state(TaskState.QUEUED), self.store.count_state(TaskState.RUNNING)
+
+
+def world_identity(request: dict[str, Any]) -> str:
+    """Which world a task's request names, as JSON: a built-in world's name, a generated
+    building's arguments (less `day`, `move`, `doors`: the same building on another day), or
+    an inline world file's SHA-256."""
+    if request.get("world") is not None:
+        found: dict[str, Any] = {"world": request["world"]}
+    elif request.get("generate") is not None:
+        found = {"generate": {k: v for k, v in dict(request["generate"]).items()
+                              if k not in ("day", "move", "doors") and v is not None}}
+    else:
+        text = str(request.get("world_file") or "")
+        found = {"world_file": hashlib.sha256(text.encode()).hexdigest()[:16]}
+    return json.dumps(found, sort_keys=True)
+
+
+def _world_text(identity: str) -> str:
+    found = json.loads(identity)
+    if "world" in found:
+        return f"world {found['world']!r}"
+    if "generate" in found:
+        args = ", ".join(f"{k} {v}" for k, v in found["generate"].items())
+        return f"the generated building ({args})"
+    return f"an inline world file (SHA-256 {found['world_file']}...)"
 
 
 def _relative(event: dict[str, Any], root: str) -> dict[str, Any]:

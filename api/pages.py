@@ -1,4 +1,5 @@
-"""The pages: the task list with a submit form at `/`, a task page at `/tasks/{id}`.
+"""The pages: the task list with a submit form at `/`, a task page at `/tasks/{id}`, the
+buildings the service remembers at `/buildings` and one at `/buildings/{id}`.
 
 Plain HTML, CSS and JavaScript shipped in `api/static/` (package data), served as they are:
 no build step, nothing from a CDN. The pages call the API under /v1 like any client, with the
@@ -27,7 +28,8 @@ _HEADERS = {
 
 
 def add_pages(app: FastAPI) -> None:
-    """Add `/`, `/tasks/{task_id}` and the files under /ui."""
+    """Add `/`, `/tasks/{task_id}`, `/buildings`, `/buildings/{building_id}` and the files
+    under /ui."""
     app.mount(ASSETS_URL, StaticFiles(directory=STATIC), name="ui")
 
     @app.get("/", include_in_schema=False)
@@ -38,3 +40,12 @@ def add_pages(app: FastAPI) -> None:
     async def task_page(task_id: str) -> FileResponse:
         # the page reads the task from /v1 and says so when there is no such task
         return FileResponse(STATIC / "task.html", headers=_HEADERS)
+
+    @app.get("/buildings", include_in_schema=False)
+    async def building_list() -> FileResponse:
+        return FileResponse(STATIC / "buildings.html", headers=_HEADERS)
+
+    @app.get("/buildings/{building_id}", include_in_schema=False)
+    async def building_page(building_id: str) -> FileResponse:
+        # the page reads the building from /v1 and says so when there is none
+        return FileResponse(STATIC / "buildings.html", headers=_HEADERS)

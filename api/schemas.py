@@ -26,6 +26,11 @@ from api.limits import (
 )
 
 NAME_PATTERN = r"^[A-Za-z][A-Za-z0-9_-]{0,63}$"
+# a building's id: a directory name under DATA_DIR/buildings/ and the experience store's scope
+# (conceptual_map/knowledge/experience.py: BUILDING_ID); no `/`, and never `.` or `..`
+BUILDING_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"
+MAX_SINCE_S = 30 * 86_400.0  # the default since_s is capped here (a month: sightings fade
+# below the memory's 1% in a few weeks; furniture rates are per year)
 MAX_TEXT = 500_000
 OptionValue = bool | int | float | Annotated[str, Field(max_length=200)] | None
 OptionName = Annotated[str, StringConstraints(pattern=NAME_PATTERN)]
@@ -96,6 +101,13 @@ class GeneratedWorld(BaseModel):
                               "drawn from the seed")
     surprise: float = Field(0.25, ge=0.0, le=1.0, description="share of small objects placed "
                             "where the knowledge base rates them unlikely")
+    day: int | None = Field(None, ge=0, le=100_000, description="the building this many days "
+                            "on (0: as generated): small objects moved and doors toggled day "
+                            "by day, the same for the same arguments", examples=[1])
+    move: float | None = Field(None, ge=0.0, le=1.0, description="with `day`: per day, the "
+                               "probability each small object is moved (default 0.2)")
+    doors: float | None = Field(None, ge=0.0, le=1.0, description="with `day`: per day, the "
+                                "probability each door toggles open or closed (default 0)")
 
 
 class TaskCreate(BaseModel):
@@ -164,6 +176,18 @@ class TaskCreate(BaseModel):
     strict_labels: bool = Field(
         False, description="refuse a target label the knowledge base does not know (422 at "
         "submission); default: such a label is searched for with an uninformed prior")
+    building: str | None = Field(
+        None, pattern=BUILDING_PATTERN, description="the building's id (1-64 letters, digits, "
+        "`_`, `.`, `-`, starting with a letter or digit): the task starts from what the robot "
+        "remembers of it and keeps what it learns (its map, furniture, sightings; "
+        "docs/memory.md) and plans with the priors learned there (docs/learning.md). Tasks of "
+        "one building run one at a time, in order; a building is always the same world",
+        examples=["office-3"])
+    since_s: float | None = Field(
+        None, ge=0, le=10 * 365 * 86_400.0, description="with `building`: simulated seconds "
+        "since the building's previous task (objects are moved at the knowledge's rates in "
+        "that time); default: the real seconds since its memory was last written, at most "
+        f"{MAX_SINCE_S:.0f} (30 days)", examples=[86400])
 
     @field_validator("world_file")
     @classmethod
@@ -197,6 +221,15 @@ class TaskCreate(BaseModel):
         return self
 
     @model_validator(mode="after")
+    def _since_needs_building(self) -> TaskCreate:
+        if self.since_s is not None and self.building is None:
+            raise ValidationError.from_exception_data(type(self).__name__, [InitErrorDetails(
+                type=PydanticCustomError("value_error", "'since_s' applies to a task in a "
+                                         "'building' only"), loc=("since_s",),
+                input=self.since_s)])
+        return self
+
+    @model_validator(mode="after")
     def _task_form(self) -> TaskCreate:
         """The task form's rules (those of the episode runner's `TaskForm.from_spec`), each
         error located at the field it is about."""
@@ -212,11 +245,16 @@ class TaskCreate(BaseModel):
         """The task as stored and given to the episode runner: the body with defaults filled
         in, less the task-form keys it does not use. A task of one label found once reads as
         it did before `targets` existed (`target`, no `mode` or `count` at their defaults);
-        `targets` tasks keep `mode` and `count`; `stop_below` only when given."""
+        `targets` tasks keep `mode` and `count`; `stop_below`, `building`, `since_s` and
+        `generate`'s `day`, `move`, `doors` only when given."""
         request = self.model_dump(mode="json")
-        for key in ("target", "targets", "stop_below"):
+        for key in ("target", "targets", "stop_below", "building", "since_s"):
             if request[key] is None:
                 del request[key]
+        if request.get("generate") is not None:  # a generated day only when asked for
+            for key in ("day", "move", "doors"):
+                if request["generate"][key] is None:
+                    del request["generate"][key]
         if self.targets is None and self.count == "one":
             for key, default in (("mode", "all"), ("count", "one")):
                 if request[key] == default:
@@ -511,3 +549,68 @@ class Message(BaseModel):
 TOO_LARGE: dict[int | str, dict[str, Any]] = {
     413: {"model": Message, "description": "body larger than AVS_MAX_BODY_BYTES"},
 }
+
+
+class BuildingTaskPublic(BaseModel):
+    """A task run in a building (one the caller may see)."""
+
+    id: str
+    state: TaskState
+    name: str | None = Field(None, description="what it looked for, as the summary names it")
+    created_at: float
+    finished_at: float | None = None
+    tasks_before: int | None = Field(None, description="tasks its memory held when it began "
+                                     "(the summary's `memory.tasks_before`)")
+
+
+class RememberedObject(BaseModel):
+    """An object the building's memory holds: `furniture` (a known object again at the next
+    task), `object` (confirmed in the last task; a sighting to check at the next) or
+    `sighting` (seen in an earlier task, not checked since)."""
+
+    kind: Literal["furniture", "object", "sighting"]
+    label: str
+    position: list[float] = Field(description="x, y, z (m)")
+    support: str | None = Field(None, description="the label it stood on")
+    seen_at: float = Field(description="building time it was seen (simulated s)")
+    age_s: float = Field(description="simulated seconds from then to the memory's clock")
+    p_in_place: float = Field(description="P(not moved since) at the memory's clock, by the "
+                              "knowledge's mobility rates")
+
+
+class BuildingPublic(BaseModel):
+    """A building the service keeps a memory of (`GET /v1/buildings`)."""
+
+    id: str
+    world: dict[str, Any] = Field(description="the world it is: `{world: NAME}`, "
+                                  "`{generate: {seed, style, ...}}` or `{world_file: HASH}`")
+    created_at: float = Field(description="when its first task was submitted")
+    tasks: int = Field(description="tasks run (or waiting) there since it was last forgotten")
+    busy: bool = Field(description="a task of it is queued or running")
+    last_task: str | None = Field(None, description="the newest task's id (when the caller "
+                                  "may see it)")
+    last_task_at: float | None = Field(None, description="when the newest task was submitted")
+    memory: dict[str, Any] | None = Field(
+        None, description="what is remembered, in short (`BuildingMemory.summary()`: tasks, "
+        "clock_s, saved, places, rooms, doors, objects, sightings, labels, last_seen); null "
+        "before a task there ended")
+    learned_priors: bool = Field(description="the experience store has counts of it")
+
+
+class BuildingsPublic(BaseModel):
+    data: list[BuildingPublic]
+    count: int
+
+
+class BuildingDetailPublic(BuildingPublic):
+    """One building in full (`GET /v1/buildings/{id}`)."""
+
+    objects: list[RememberedObject] = Field(default_factory=list,
+                                            description="what its memory holds")
+    experience: dict[str, Any] | None = Field(
+        None, description="the experience store's view of it (`avs knowledge show "
+        "--building ID`: rates with counts, file and learned values, category prior, "
+        "episodes per scope); null when it has taught nothing")
+    history: list[BuildingTaskPublic] = Field(
+        default_factory=list, description="its tasks, newest first (at most 100; those "
+        "the caller may see)")

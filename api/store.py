@@ -44,6 +44,11 @@ CREATE TABLE IF NOT EXISTS events (
     PRIMARY KEY (task_id, seq)
 );
 CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT);
+CREATE TABLE IF NOT EXISTS buildings (
+    id TEXT PRIMARY KEY,
+    world TEXT NOT NULL,
+    created_at REAL NOT NULL
+);
 """
 
 
@@ -68,6 +73,19 @@ class TaskRecord:
     error: str | None
     events: int
     attempts: int = 0  # times it started running (more than 1 after a requeue)
+    building: str | None = None  # the building whose memory it reads and keeps (None once
+    # that building was forgotten; its request still names it)
+
+
+@dataclass(frozen=True)
+class BuildingRecord:
+    """One row of `buildings`: a building the service keeps a memory of, the world it is
+    (JSON: a built-in world's name, a generated building's arguments or an inline file's
+    hash), and when its first task (since it was last forgotten) was submitted."""
+
+    id: str
+    world: str
+    created_at: float
 
 
 @dataclass(frozen=True)
@@ -145,7 +163,7 @@ class TaskStore:
                 rows = self._conn.execute("PRAGMA quick_check").fetchall()
                 if rows != [("ok",)]:
                     return "; ".join(str(r[0]) for r in rows[:3])
-                for table in ("tasks", "events"):
+                for table in ("tasks", "events", "buildings"):
                     for _ in self._conn.execute(f"SELECT * FROM {table}"):  # noqa: S608
                         pass
             except sqlite3.DatabaseError as exc:
@@ -155,15 +173,21 @@ class TaskStore:
     def insert(
         self, task_id: str, request: dict[str, Any], owner: str,
         idempotency_key: str | None = None, request_hash: str | None = None,
+        building: tuple[str, str] | None = None,
     ) -> TaskRecord:
-        """Add a queued task."""
+        """Add a queued task; `building` (id, world) records the building it runs in (made
+        known when new)."""
+        now = time.time()
         with self._tx() as db:
             db.execute(
                 "INSERT INTO tasks (id, state, request, owner, idempotency_key, request_hash,"
-                " created_at) VALUES (?, ?, ?, ?, ?, ?, ?)",
+                " created_at, building) VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
                 (task_id, TaskState.QUEUED.value, json.dumps(request), owner,
-                 idempotency_key, request_hash, time.time()),
+                 idempotency_key, request_hash, now, building[0] if building else None),
             )
+            if building is not None:
+                db.execute("INSERT OR IGNORE INTO buildings (id, world, created_at) "
+                           "VALUES (?, ?, ?)", (*building, now))
         record = self.get(task_id)
         assert record is not None
         return record
@@ -261,6 +285,48 @@ class TaskStore:
             db.execute("UPDATE tasks SET events=? WHERE id=?", (seq, task_id))
             return seq
 
+    # -- buildings ------------------------------------------------------------------------
+
+    def building(self, building_id: str) -> BuildingRecord | None:
+        with self._lock:
+            row = self._conn.execute("SELECT id, world, created_at FROM buildings WHERE id=?",
+                                     (building_id,)).fetchone()
+        return BuildingRecord(*row) if row is not None else None
+
+    def buildings(self) -> list[BuildingRecord]:
+        """Every known building, by id."""
+        with self._lock:
+            rows = self._conn.execute(
+                "SELECT id, world, created_at FROM buildings ORDER BY id").fetchall()
+        return [BuildingRecord(*row) for row in rows]
+
+    def building_tasks(self, building_id: str, limit: int = 100) -> tuple[list[TaskRecord], int]:
+        """The newest `limit` tasks of a building's memory (since it was last forgotten),
+        newest first, and how many it has in all."""
+        with self._lock:
+            rows = self._conn.execute(
+                _SELECT + " WHERE t.building=? ORDER BY t.created_at DESC, t.id LIMIT ?",
+                (building_id, limit)).fetchall()
+            count = self._conn.execute("SELECT count(*) FROM tasks WHERE building=?",
+                                       (building_id,)).fetchone()
+        return [_decode(r) for r in rows], int(count[0])
+
+    def building_live(self, building_id: str) -> int:
+        """Tasks of the building still queued or running."""
+        with self._lock:
+            row = self._conn.execute(
+                "SELECT count(*) FROM tasks WHERE building=? AND state IN (?, ?)",
+                (building_id, TaskState.QUEUED.value, TaskState.RUNNING.value)).fetchone()
+        return int(row[0])
+
+    def forget_building(self, building_id: str) -> bool:
+        """Drop the building (False: there was none); its tasks stay, no longer counted as
+        its (their requests still name it)."""
+        with self._tx() as db:
+            cur = db.execute("DELETE FROM buildings WHERE id=?", (building_id,))
+            db.execute("UPDATE tasks SET building=NULL WHERE building=?", (building_id,))
+            return cur.rowcount == 1
+
     def events_after(self, task_id: str, after: int, limit: int = 500) -> list[StoredEvent]:
         with self._lock:
             rows = self._conn.execute(
@@ -272,7 +338,8 @@ class TaskStore:
 
 _SELECT = (
     "SELECT t.id, t.state, t.request, t.owner, t.idempotency_key, t.request_hash, t.created_at,"
-    " t.started_at, t.finished_at, t.result, t.error, t.events, t.attempts FROM tasks t"
+    " t.started_at, t.finished_at, t.result, t.error, t.events, t.attempts, t.building"
+    " FROM tasks t"
 )
 
 
@@ -281,7 +348,7 @@ def _decode(row: tuple[Any, ...]) -> TaskRecord:
         id=row[0], state=TaskState(row[1]), request=json.loads(row[2]), owner=row[3],
         idempotency_key=row[4], request_hash=row[5], created_at=row[6], started_at=row[7],
         finished_at=row[8], result=json.loads(row[9]) if row[9] else None, error=row[10],
-        events=int(row[11]), attempts=int(row[12]),
+        events=int(row[11]), attempts=int(row[12]), building=row[13],
     )
 
 
@@ -290,3 +357,6 @@ def _migrate(conn: sqlite3.Connection) -> None:
     columns = {row[1] for row in conn.execute("PRAGMA table_info(tasks)")}
     if "attempts" not in columns:
         conn.execute("ALTER TABLE tasks ADD COLUMN attempts INTEGER NOT NULL DEFAULT 0")
+    if "building" not in columns:  # stores before buildings: no task ran in one
+        conn.execute("ALTER TABLE tasks ADD COLUMN building TEXT")
+    conn.execute("CREATE INDEX IF NOT EXISTS tasks_building ON tasks (building, created_at)")

@@ -1,14 +1,17 @@
-"""The planner package as the HTTP service sees it: three plain-data jobs, nothing else.
+"""The planner package as the HTTP service sees it: three plain-data jobs, and what the
+service reads and forgets of a building (its memory, its learned priors).
 
-The service runs these in worker processes, so inputs and outputs are JSON-able dicts and the
-heavy modules are imported on first use. A part that cannot be imported (e.g. the episode
+The service runs the jobs in worker processes, so inputs and outputs are JSON-able dicts and
+the heavy modules are imported on first use. A part that cannot be imported (e.g. the episode
 runner, `avs_planner.harness`, in a trimmed install) raises `JobUnavailableError`, never a fake
 result.
 """
 
 from __future__ import annotations
 
+import functools
 import importlib
+import os
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
@@ -120,3 +123,82 @@ def run_episode(spec: Mapping[str, Any], emit: Emit, should_stop: ShouldStop) ->
         raise JobUnavailableError("the episode runner (avs_planner.harness.run_episode) not "
                                   "available yet")
     return runner(dict(spec), emit, should_stop)
+
+
+# ---- buildings (the service's /v1/buildings) ----------------------------------------------
+
+class BuildingReadError(AvsError):
+    """A building's memory or the experience store cannot be read or changed; the message
+    names the file."""
+
+
+def building_memory(directory: str) -> dict[str, Any] | None:
+    """What is remembered of a building (`episode/memory.py`) as plain data, or None when its
+    directory holds no memory yet: `summary` (`BuildingMemory.summary()`) and `objects`, each
+    remembered object (`kind` furniture, object or sighting) with its `label`, `position`,
+    `support` label, `seen_at` (building seconds), `age_s` at the memory's clock and
+    `p_in_place` then (the knowledge's mobility: P(not moved since))."""
+    memory = _require("avs_planner.episode.memory", "the building memory")
+    try:
+        kept = memory.load(directory)
+    except memory.BuildingMemoryError as exc:
+        raise BuildingReadError(str(exc)) from None
+    if kept is None:
+        return None
+    mobility = _knowledge().mobility
+    objects = []
+    for obj in kept.objects:
+        support = obj.get("support")
+        on = (kept.objects[support]["label"] if isinstance(support, int)
+              and 0 <= support < len(kept.objects) else None)
+        kind = "furniture" if mobility.fixed(obj["label"]) else "object"
+        objects.append(_remembered(kind, obj, on, kept.clock, mobility))
+    objects += [_remembered("sighting", s, s.get("support"), kept.clock, mobility)
+                for s in kept.sightings]
+    return {"summary": kept.summary(), "objects": objects}
+
+
+def _remembered(kind: str, obj: Mapping[str, Any], support: Any, clock: float,
+                mobility: Any) -> dict[str, Any]:
+    seen_at = float(obj["seen_at"])
+    age = max(clock - seen_at, 0.0)
+    return {"kind": kind, "label": obj["label"],
+            "position": [round(float(v), 3) for v in obj["position"]],
+            "support": support if isinstance(support, str) else None,
+            "seen_at": round(seen_at, 1), "age_s": round(age, 1),
+            "p_in_place": round(mobility.still_there(obj["label"], age / 86400.0), 4)}
+
+
+@functools.cache
+def _knowledge() -> Any:
+    """The default knowledge file (its mobility rates; the base the store's priors change)."""
+    return _require("conceptual_map.knowledge.loader", "the knowledge base").load_knowledge()
+
+
+def building_experience(path: str, building: str) -> dict[str, Any] | None:
+    """The experience store's view of one building (`ExperienceStore.show` for its scope,
+    with the all-buildings rates it has counts for), or None when the store does not exist
+    or has no episode of that building."""
+    if not os.path.isfile(path):
+        return None
+    experience = _require("conceptual_map.knowledge.experience", "the experience store")
+    try:
+        with experience.ExperienceStore(path, create=False) as store:
+            if experience.building_scope(building) not in store.scopes():
+                return None
+            return store.show(_knowledge(), building)
+    except experience.ExperienceError as exc:
+        raise BuildingReadError(str(exc)) from None
+
+
+def forget_building_experience(path: str, building: str) -> int:
+    """Reset one building's scope of the experience store (what it taught the all-buildings
+    scope stays); the counts removed (0 without a store)."""
+    if not os.path.isfile(path):
+        return 0
+    experience = _require("conceptual_map.knowledge.experience", "the experience store")
+    try:
+        with experience.ExperienceStore(path, create=False) as store:
+            return store.reset(experience.building_scope(building))
+    except experience.ExperienceError as exc:
+        raise BuildingReadError(str(exc)) from None

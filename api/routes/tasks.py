@@ -29,6 +29,7 @@ from api.deps import (
 )
 from api.limits import file_option_problems, short
 from api.manager import (
+    BuildingWorldError,
     IdempotencyConflictError,
     NotCancellableError,
     QueueFullError,
@@ -154,6 +155,8 @@ def create_task(
     except IdempotencyConflictError as exc:
         message = f"Idempotency-Key {exc} was already used with a different request body"
         raise _invalid([("idempotency-key", message)], where="header") from exc
+    except BuildingWorldError as exc:
+        raise _invalid([("building", str(exc))]) from exc
     except QueueFullError as exc:
         raise HTTPException(
             status.HTTP_503_SERVICE_UNAVAILABLE, detail=f"task queue is full ({exc}); retry later",

@@ -50,6 +50,10 @@
     if ($("f-strategy").value) out.strategy = $("f-strategy").value;
     const budget = $("f-budget").value.trim();
     if (budget !== "") out.time_budget_s = Number(budget);
+    const building = $("f-building").value.trim();
+    if (building) out.building = building;
+    const since = $("f-since").value.trim();
+    if (since !== "") out.since_s = Number(since);
     return out;
   }
 
@@ -57,7 +61,7 @@
     world: "f-world", target: "f-target", targets: "f-target", mode: "f-mode", count: "f-count",
     stop_below: "f-stop", category: "f-category", robot: "f-robot",
     start_room: "f-start-room", start: "f-x", seed: "f-seed", strategy: "f-strategy",
-    time_budget_s: "f-budget",
+    time_budget_s: "f-budget", building: "f-building", since_s: "f-since",
   };
 
   function showErrors(detail) {

@@ -47,6 +47,11 @@
   let form = null; // the task's form (GET /v1/tasks/ID: `task`)
   let targets = null; // a task of several: each label's part (AVS_TARGETS)
   let taskStart = 0; // the simulated time of the `task` event
+  let building = null; // the task's building (request), if any
+  let memoryEvents = []; // the trace's `memory` events (what was recalled, checked, dropped)
+  let memoryPart = null; // the summary's `memory` and `experience` parts, once it ended
+  let experiencePart = null;
+  let memoryDirty = false;
   function reset() {
     M = {
       grid: null, image: null, tinted: null, known: null, places: [], placeholders: [],
@@ -56,6 +61,7 @@
     plan = null;
     outcome = null;
     targets = null;
+    memoryEvents = [];
   }
   reset();
 
@@ -72,7 +78,7 @@
       case "state":
         if (e.state === "running" && (e.attempt || 1) > 1) {
           reset(); // a requeued task runs again from the start
-          gridDirty = tintDirty = planDirty = targetsDirty = true;
+          gridDirty = tintDirty = planDirty = targetsDirty = memoryDirty = true;
         }
         state = e.state;
         break;
@@ -107,6 +113,10 @@
         taskStart = typeof e.t === "number" ? e.t : 0;
         targets = AVS_TARGETS.open(e.targets || []);
         targetsDirty = true;
+        break;
+      case "memory":
+        memoryEvents.push(e);
+        memoryDirty = true;
         break;
       case "turn":
       case "target":
@@ -180,6 +190,7 @@
         ? ((e.watch || []).length ? `, also watching for ${e.watch.join(", ")}` : "")
         : `: ${e.outcome}${e.reason ? ` (${e.reason})` : ""}`);
       case "target": return `${e.target}: ${e.outcome}${e.reason ? `: ${e.reason}` : ""}`;
+      case "memory": return AVS_MEMORY.describe(e);
       default: {
         const { t, wall, type, seq, retry, ...rest } = e;
         const text = JSON.stringify(rest);
@@ -231,6 +242,29 @@
     if (!parts) return;
     $("targets-form").textContent = form ? `${form.name}: ${AVS_TARGETS.formText(form)}` : "";
     $("targets").replaceChildren(AVS_TARGETS.table(parts, form));
+  }
+
+  // what came from the building's memory (and the learned priors): hidden for a task in no
+  // building
+  function renderMemory() {
+    memoryDirty = false;
+    const card = $("memory-card");
+    card.hidden = !building && !memoryEvents.length && !memoryPart && !experiencePart;
+    if (card.hidden) return;
+    const link = $("memory-building");
+    if (building) {
+      link.href = `/buildings/${encodeURIComponent(building)}`;
+      link.textContent = `building ${building}`;
+    }
+    const recalled = memoryEvents.find((e) => e.recalled);
+    if (memoryPart) AVS_MEMORY.rows($("memory"), AVS_MEMORY.summaryRows(memoryPart));
+    else if (recalled) AVS_MEMORY.rows($("memory"), [["tasks before", recalled.tasks], ["places", recalled.places],
+      ["rooms", recalled.rooms], ["furniture", recalled.furniture], ["sightings", (recalled.sightings || []).length]]);
+    else AVS_MEMORY.rows($("memory"), [["memory", AVS.TERMINAL.has(state) ? "none kept" : "nothing recalled yet"]]);
+    $("memory-events").replaceChildren(...memoryEvents.filter((e) => !e.recalled).map((e) =>
+      el("li", { class: e.dropped ? "dropped" : e.seen ? "seen" : "", text: AVS_MEMORY.describe(e) })));
+    $("experience-part").hidden = !experiencePart;
+    if (experiencePart) AVS_MEMORY.rows($("experience"), AVS_MEMORY.experienceRows(experiencePart));
   }
 
   function renderState() {
@@ -321,6 +355,9 @@
         for (const part of targets) if (part.outcome === "open") part.outcome = "stopped";
       }
       renderTargets();
+      memoryPart = s.memory && typeof s.memory === "object" ? s.memory : null;
+      experiencePart = s.experience && typeof s.experience === "object" ? s.experience : null;
+      renderMemory();
     }
     const files = [];
     if (["succeeded", "gave_up", "timeout"].includes(state)) {
@@ -678,6 +715,7 @@
     renderLog(batch);
     if (planDirty) renderPlan();
     if (targetsDirty) renderTargets();
+    if (memoryDirty) renderMemory();
     renderState();
     for (const e of batch) unstamped.push(e.seq);
     if (gridDirty) decodeGrid();
@@ -729,7 +767,9 @@
       [el("dt", { text: k }), el("dd", { text: Array.isArray(v) ? v.join(", ") : typeof v === "object" ? JSON.stringify(v) : String(v) })]));
     state = answer.body.state;
     form = answer.body.task || null;
+    building = typeof r.building === "string" ? r.building : null;
     renderTargets();
+    renderMemory();
     renderState();
     scheduleDraw();
     page.stream = "live";

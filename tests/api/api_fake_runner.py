@@ -50,6 +50,12 @@ def run(spec: dict[str, Any], emit: Any, should_stop: Any) -> dict[str, Any]:
             if should_stop():
                 return {"outcome": "gave_up", "stopped": True}
             time.sleep(0.02)
+    if behaviour == "stint":  # 0.8 s of work, with when it ran (building serialisation tests)
+        started = time.time()
+        deadline = time.monotonic() + 0.8
+        while time.monotonic() < deadline and not should_stop():
+            time.sleep(0.02)
+        return {"outcome": "found", "started": started, "ended": time.time(), "spec": spec}
     if behaviour == "echo":  # what the episode runner was given
         return {"outcome": "found", "spec": spec}
     if behaviour == "parts":  # a task of several, summarised as the real runner does

@@ -157,11 +157,14 @@ _NAMES = "a name pattern without '/' (looked up among known names, never a path)
 _INLINE = "inline text, parsed as text (never opened)"
 _CLOSED = "one of a closed set of values"
 _CHECKED = "refused when it looks like a path (strategy options, qsr)"
+_FOLDER = ("an id pattern without '/', starting with a letter or digit (so never '.' or "
+           "'..'): one folder the service builds under DATA_DIR/buildings")
 TASK_FIELDS = {
     "target": _NAMES, "targets[]": _NAMES, "category": _NAMES, "world": _NAMES,
     "start_room": _NAMES, "strategy": _NAMES, "world_file": _INLINE, "robot": _CLOSED,
     "mode": _CLOSED, "count": _CLOSED, "generate.style": _CLOSED,
     "strategy_options.*": _CHECKED, "qsr[].*": _CHECKED, "qsr.*": _CHECKED,
+    "building": _FOLDER,
 }
 PLAN_FIELDS = {"domain": _INLINE, "problem": _INLINE, "problems[]": _INLINE}
 
@@ -177,6 +180,9 @@ def test_every_string_field_of_every_request_is_classified() -> None:
             assert "/" not in fields[name]["pattern"] and fields[name]["pattern"].startswith("^")
         if how is _CLOSED:
             assert "enum" in fields[name] or "const" in fields[name], name
+        if how is _FOLDER:
+            pattern = fields[name]["pattern"]
+            assert "/" not in pattern and pattern.startswith("^[A-Za-z0-9]"), name
 
 
 def test_a_path_in_any_task_field_is_refused(client: TestClient, file_watch: _FileWatch) -> None:
@@ -196,6 +202,7 @@ def test_a_path_in_any_task_field_is_refused(client: TestClient, file_watch: _Fi
         "strategy_options.*": {**BODY, "strategy_options": {"views": path}},
         "qsr[].*": {**BODY, "qsr": [{"target": "cup", "relations": ["right"], "of": path}]},
         "qsr.*": {**BODY, "qsr": {"descriptions": path}},
+        "building": {**BODY, "building": path},
     }
     assert set(bodies) == set(TASK_FIELDS)
     for name, body in bodies.items():

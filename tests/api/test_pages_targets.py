@@ -117,7 +117,7 @@ def test_the_task_page_has_the_targets_card_and_its_script() -> None:
     page = (STATIC / "task.html").read_text(encoding="utf-8")
     assert '<section class="card" id="targets-card" hidden>' in page
     scripts = re.findall(r'<script src="/ui/([^"]+)"', page)
-    assert scripts == ["common.js", "targets.js", "task.js"]  # targets.js before task.js
+    assert scripts == ["common.js", "targets.js", "memory.js", "task.js"]  # before task.js
     form = (STATIC / "index.html").read_text(encoding="utf-8")
     for field in ('id="f-mode"', 'id="f-count"', 'id="f-stop"'):
         assert field in form
