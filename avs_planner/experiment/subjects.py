@@ -285,7 +285,7 @@ class Building:
     def targets(self, where: Where) -> list[Wanted]:
         """The generator's own targets (`targets: auto`)."""
         try:
-            pairs = generated_targets(self.seed, self.style, self.rooms, self.table)
+            pairs = generated_targets(self.seed, self.style, self.rooms, **_table(self.table))
         except AvsError as exc:
             raise where.error(f"world seed {self.seed}: {exc}") from None
         return [Wanted(label, _EXPECTED[not present]) for label, present in pairs]
@@ -312,13 +312,14 @@ def generated_name(seed: int, style: str, rooms: int | None, table: str = DEFAUL
     return name(seed, style, rooms, table)
 
 
-def generated_targets(seed: int, style: str, rooms: int | None, table: str = DEFAULT_TABLE
+def generated_targets(seed: int, style: str, rooms: int | None, **table: str
                       ) -> list[tuple[str, bool]]:
-    """The generator's (label, present in the world) targets for one generated world."""
+    """The generator's (label, present in the world) targets for one generated world (`table`:
+    of another placement table than the default)."""
     from avs_planner.harness.worlds import generated_targets as targets
 
     try:
-        return list(targets(seed, style, rooms, **_table(table)))
+        return list(targets(seed, style, rooms, **table))
     except ImportError as exc:
         raise CampaignError(f"generated worlds are not available in this build: {exc}") from None
 
