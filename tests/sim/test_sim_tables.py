@@ -76,6 +76,7 @@ def test_the_default_table_by_name_is_the_same_world_and_differs_from_moved() ->
     moved = generate_world(401, "office", table="moved")
     plain = generate_world(401, "office")
     assert moved.data["rooms"] == plain.data["rooms"]  # same layout: the table moves objects
+    assert moved.data["furniture"] == plain.data["furniture"]
     assert moved.data["objects"] != plain.data["objects"]
 
 
