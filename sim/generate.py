@@ -31,7 +31,7 @@ from sim.generation.freespace import approach_point, free_space
 from sim.generation.furnish import Piece, furnish
 from sim.generation.layout import Layout, plan_layout
 from sim.generation.objects import SmallObject, place_objects
-from sim.generation.table import PlacementTable, StyleRule, placement_table
+from sim.generation.table import DEFAULT_TABLE, PlacementTable, StyleRule, placement_table
 from sim.world_file import ROBOT_MODELS, load_world_text
 from sim.world_spec import WorldSpec
 
@@ -56,6 +56,7 @@ class GeneratedWorld:
     day: int = 0  # days after the building was generated (objects moved, doors toggled)
     move: float = DEFAULT_MOVE  # per day, the probability each small object moves
     doors: float = DEFAULT_DOORS  # per day, the probability each door toggles
+    table: str = DEFAULT_TABLE  # the placement table it was built with (`generation/table.py`)
 
     def yaml(self) -> str:
         """The world file as YAML text (docs/architecture.md's format), headed by its command."""
@@ -64,6 +65,8 @@ class GeneratedWorld:
                    f"{self.data['robot']['model']}")
         if self.day:
             command += f" --day {self.day} --move {self.move!r} --doors {self.doors!r}"
+        if self.table != DEFAULT_TABLE:
+            command += f" --table {self.table}"
         return world_yaml(self.data, command)
 
     def spec(self) -> WorldSpec:
@@ -79,7 +82,7 @@ class GeneratedWorld:
         vocabulary that are not in it (a benchmark's targets for this world)."""
         rng = np.random.default_rng(rng_seed)
         here = self.labels_present()
-        missing = sorted(set(placement_table().object_labels) - set(here))
+        missing = sorted(set(placement_table(self.table).object_labels) - set(here))
         if present > len(here) or absent > len(missing) or min(present, absent) < 0:
             raise GenerationError(f"{self.data['name']}: cannot pick {present} present and "
                                   f"{absent} absent labels (present: {', '.join(here)}; "
@@ -90,13 +93,18 @@ class GeneratedWorld:
 
 def generate_world(seed: int, style: str = "office", rooms: int | None = None,
                    surprise: float = 0.25, robot: str = "pioneer", day: int = 0,
-                   move: float = DEFAULT_MOVE, doors: float = DEFAULT_DOORS) -> GeneratedWorld:
+                   move: float = DEFAULT_MOVE, doors: float = DEFAULT_DOORS,
+                   table: str = DEFAULT_TABLE) -> GeneratedWorld:
     """A world for `seed` (same arguments, same world); `rooms` counts the rooms off the spine.
 
     `day` k > 0 is the same building k days later: each day every small object moves with
     probability `move` and every door toggles with probability `doors` (`generation/days.py`);
-    day 0 is the building as generated, whatever `move` and `doors` say."""
-    table = placement_table()
+    day 0 is the building as generated, whatever `move` and `doors` say. `table` names the
+    placement table (`generation/table.py`, `TABLES`): `default`, or `moved` (a building whose
+    cups, books and staplers are elsewhere than the robot's knowledge expects; the world is
+    named `<style>_<seed>_moved`)."""
+    table_name = table
+    table = placement_table(table_name)
     rule = _check_arguments(table, seed, style, rooms, surprise, robot)
     _check_days(day, move, doors)
     code = zlib.crc32(style.encode())
@@ -111,11 +119,12 @@ def generate_world(seed: int, style: str = "office", rooms: int | None = None,
         objects_rng, doors_rng = day_streams(seed, code, k)
         objects = next_objects(objects_rng, table, layout, pieces, objects, surprise, move)
         layout = next_doors(doors_rng, layout, doors)
-    data = world_data(f"{style}_{seed}", layout, pieces, objects, robot, start)
+    name = f"{style}_{seed}" + ("" if table_name == DEFAULT_TABLE else f"_{table_name}")
+    data = world_data(name, layout, pieces, objects, robot, start)
     if not day:
         move, doors = DEFAULT_MOVE, DEFAULT_DOORS  # day 0 is the same world whatever they say
     return GeneratedWorld(data, seed, style, tuple(o.name for o in objects if o.unusual),
-                          float(surprise), day, float(move), float(doors))
+                          float(surprise), day, float(move), float(doors), table_name)
 
 
 def _small_objects(rng: np.random.Generator, table: PlacementTable, layout: Layout,

@@ -48,6 +48,10 @@ def _register_run(sub: Any) -> None:
                      help="run again the episodes recorded as crashed, timed out, failed or "
                      "cut by the wall-clock budget (status wall_cut)")
     run.add_argument("--limit", type=int, help="run at most N episodes now, then stop")
+    run.add_argument("--experience", type=Path, metavar="PATH",
+                     help="the experience store for every episode that uses one, instead of "
+                     "the campaign's `experience.store` (relative to --out); e.g. the store a "
+                     "training campaign wrote (docs/learning.md)")
     run.add_argument("--json", action="store_true", help="print the final counts as JSON")
     run.set_defaults(func=run_campaign_command)
 
@@ -70,7 +74,7 @@ def run_campaign_command(args: argparse.Namespace) -> int:
         return 1
     campaign = load_campaign(args.campaign)
     options = RunOptions(args.out, args.backend, args.workers, args.address,
-                         args.retry_failed, args.limit)
+                         args.retry_failed, args.limit, experience=args.experience)
     line = _ProgressLine(sys.stderr.isatty())
     try:
         result = run_campaign(campaign, options, line)

@@ -10,6 +10,7 @@ from typing import Any
 _EXIT_OK = 0
 _EXIT_BAD_INPUT = 1
 _STYLES = ("office", "apartment", "lab")  # sim.generate.STYLES; not imported at parser time
+_TABLES = ("default", "moved")  # sim.generation.table.TABLES (a test checks they agree)
 
 
 def register(subparsers: Any) -> None:
@@ -42,6 +43,10 @@ def register(subparsers: Any) -> None:
     generate.add_argument("--doors", type=float, default=0.0,
                           help="per day, the probability each door toggles open/closed; every "
                                "room stays reachable (default: 0)")
+    generate.add_argument("--table", default="default", choices=_TABLES,
+                          help="placement table: default, or moved (cups, books and staplers "
+                               "kept elsewhere than the knowledge expects: "
+                               "sim/generation/placement-moved.yaml; default: default)")
     generate.add_argument("--out", help="YAML file to write (default: standard output)")
     generate.set_defaults(func=run_generate)
 
@@ -52,7 +57,7 @@ def run_generate(args: argparse.Namespace) -> int:
 
     try:
         world = generate_world(args.seed, args.style, args.rooms, args.surprise, args.robot,
-                               args.day, args.move, args.doors)
+                               args.day, args.move, args.doors, args.table)
         world.spec()  # every generated world passes sim's own checks; say so if one does not
     except SimError as exc:
         print(f"avs: error: {exc}", file=sys.stderr)

@@ -6,7 +6,10 @@ format is in docs/experiments.md. `load_campaign` reads and checks a file
 (or a built-in by name, from `campaigns/`), and `Campaign.runs()` expands it into one `RunSpec`
 per episode, each with a stable run id (the name of its directory in the output). A campaign
 with `sequence` (`sequences.py`) runs each generated building's tasks day after day, with and
-without the robot's memory; its runs carry their sequence, task index and memory arm.
+without the robot's memory; its runs carry their sequence, task index and memory arm. A
+campaign with `experience` (`priors.py`) trains the experience store of learned priors (every
+episode adds to it) or reads it: with `priors: [default, learned]`, each episode runs once on
+the knowledge file alone and once on the store's priors, its runs carrying the arm.
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ import yaml
 
 from avs_planner.errors import AvsError
 from avs_planner.experiment.errors import CampaignError
+from avs_planner.experiment.priors import Experience, parse_experience, parse_priors
 from avs_planner.experiment.sequences import Arm, Sequence, parse_sequence
 from avs_planner.experiment.subjects import (
     Subject,
@@ -37,7 +41,7 @@ DEFAULT_STRATEGY = "switching"
 HELDOUT_WORLD_SEEDS_FROM = 10000  # generated building seeds from here on
 HELDOUT_FIG3_NOISE_SEEDS = range(100, 120)  # sensor-noise seeds of Fig. 3 a-f
 _TOP_KEYS = {"name", "description", "worlds", "scenarios", "targets", "strategies", "robots",
-             "seeds", "time_budget_s", "wall_budget_s", "sequence"}
+             "seeds", "time_budget_s", "wall_budget_s", "sequence", "experience", "priors"}
 _STRATEGY_KEYS = {"name", "label", "options"}
 
 
@@ -65,6 +69,7 @@ class RunSpec:
     sequence: str = ""
     task_index: int | None = None
     memory: str = ""
+    priors: str = ""  # a campaign with `priors`: the arm (default / learned); "" otherwise
 
     def columns(self) -> dict[str, Any]:
         """The run's coordinates as results-table columns."""
@@ -74,7 +79,7 @@ class RunSpec:
                 "strategy": self.strategy.label, "robot": self.robot or "", "seed": self.seed,
                 "task": s.kind, "task_labels": " ".join(s.labels) if s.task else "",
                 "sequence": self.sequence, "task_index": self.task_index,
-                "memory": self.memory}
+                "memory": self.memory, "priors": self.priors}
 
 
 @dataclass(frozen=True)
@@ -91,6 +96,8 @@ class Campaign:
     time_budget_s: float | None = None
     wall_budget_s: float | None = None
     sequence: Sequence | None = None
+    experience: Experience | None = None  # the experience store its episodes use, if any
+    priors: tuple[str, ...] = ()  # arms: default (no store) and learned (the store, read)
 
     def runs(self) -> list[RunSpec]:
         runs: list[RunSpec] = []
@@ -101,10 +108,27 @@ class Campaign:
         for seed in self.seeds:
             for subject in self.subjects:
                 for robot in self.robots:
-                    runs.extend(self._run(subject, strategy, robot, seed)
-                                for strategy in self.strategies)
+                    for strategy in self.strategies:
+                        run = self._run(subject, strategy, robot, seed)
+                        if self.priors:
+                            runs += [self._arm(run, arm) for arm in self.priors]
+                        else:
+                            runs.append(self._with_store(run))
         _check_unique(runs, self.source)
         return runs
+
+    def _with_store(self, run: RunSpec) -> RunSpec:
+        """The run with the campaign's experience store (and its world as the building)."""
+        if self.experience is None:
+            return run
+        episode = {**run.episode, **self.experience.episode_keys(run.subject.world)}
+        return dataclasses.replace(run, episode=episode)
+
+    def _arm(self, run: RunSpec, arm: str) -> RunSpec:
+        """The run in one arm of `priors`: `learned` reads the store, `default` has none."""
+        if arm == "learned":
+            run = self._with_store(run)
+        return dataclasses.replace(run, run_id=_slug(f"{run.run_id}-priors-{arm}"), priors=arm)
 
     def _run(self, subject: Subject, strategy: Strategy, robot: str | None, seed: int
              ) -> RunSpec:
@@ -186,6 +210,7 @@ def parse_campaign(data: Any, source: str, base: Path) -> Campaign:
     sequence = None
     if "sequence" in data:
         sequence = parse_sequence(data["sequence"], where.at("sequence"))
+    experience, priors = _experience(data, where, sequence)
     return Campaign(
         name=str(data.get("name") or Path(source).stem),
         description=str(data.get("description") or ""), source=source,
@@ -195,8 +220,26 @@ def parse_campaign(data: Any, source: str, base: Path) -> Campaign:
         seeds=tuple(parse_seeds(data.get("seeds", 0), where.at("seeds"))),
         time_budget_s=_budget(data, "time_budget_s", where),
         wall_budget_s=_budget(data, "wall_budget_s", where),
-        sequence=sequence,
+        sequence=sequence, experience=experience, priors=priors,
     )
+
+
+def _experience(data: dict[str, Any], where: Where, sequence: Sequence | None
+                ) -> tuple[Experience | None, tuple[str, ...]]:
+    """The campaign's `experience` and `priors` (`priors.py`); not with `sequence`."""
+    for key in ("experience", "priors"):
+        if key in data and sequence is not None:
+            raise where.at(key).error("not with 'sequence' (a campaign sequence runs with its "
+                                      "memory on and off; learned priors are measured on "
+                                      "campaigns of worlds and targets)")
+    experience = None
+    if "experience" in data:
+        experience = parse_experience(data["experience"], where.at("experience"))
+    priors: tuple[str, ...] = ()
+    if "priors" in data:
+        priors = parse_priors(data["priors"], experience, where.at("priors"),
+                              where.at("experience"))
+    return experience, priors
 
 
 def _subjects(data: dict[str, Any], where: Where, base: Path, sequence: Sequence | None

@@ -18,7 +18,8 @@ header and every section's stamp), `report_outcomes.py` (the outcome and compari
 `report_planner.py` (the DT sub-planner, and beside the paper), `report_map.py` (map
 quality), `report_tasks.py` (tasks of several objects: in a campaign with tasks, the other
 tables cover its single-label searches and the tasks have sections of their own) and
-`report_sequences.py` (campaign sequences: memory on against memory off).
+`report_sequences.py` (campaign sequences: memory on against memory off) and
+`report_priors.py` (learned priors: the default arm against the learned one).
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ from avs_planner.experiment.report_outcomes import (
     targets_table,
 )
 from avs_planner.experiment.report_planner import PAPER, PAPER_OUTCOME, beside_the_paper, dt_table
+from avs_planner.experiment.report_priors import priors_tables
 from avs_planner.experiment.report_rows import Pair, Row, as_expected, comparable, normalised
 from avs_planner.experiment.report_sequences import sequence_tables
 from avs_planner.experiment.report_tasks import is_task, task_tables
@@ -89,6 +91,7 @@ def render(rows: list[Row], meta: dict[str, Any], out: Path) -> str:
             lines += beside_the_paper(rows, groups, stamp)
     lines += task_tables(every, stamp)
     lines += sequence_tables(every, stamp)
+    lines += priors_tables(every, stamp)
     if rows:
         lines += _figures(rows, groups, strategies, out)
     lines += _failures(every)

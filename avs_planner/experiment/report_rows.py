@@ -77,13 +77,13 @@ def _robot(row: Row) -> str:
 
 def runs_by_key(rows: list[Row]) -> dict[tuple[Any, ...], Row]:
     """Each run by (strategy, scenario, world, target, robot, seed, and for a campaign
-    sequence's task its index and memory arm): what pairs are made of."""
+    sequence's task its index and memory arm, and the priors arm): what pairs are made of."""
     return {(r["strategy"], *_pair_key(r)): r for r in rows}
 
 
 def _pair_key(row: Row) -> tuple[Any, ...]:
     return (row["scenario"], row["world"], row["target"], row["robot"], row["seed"],
-            row.get("task_index"), row.get("memory") or "")
+            row.get("task_index"), row.get("memory") or "", row.get("priors") or "")
 
 
 def pairs_of(by_key: dict[tuple[Any, ...], Row], a: str, b: str) -> list[Pair]:

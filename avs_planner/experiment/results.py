@@ -46,6 +46,9 @@ TASK_KEY_COLUMNS = ["task", "task_labels"]
 # (the building's day) and the memory arm, on or off; empty otherwise (and absent from tables
 # written before sequences: not required when read)
 SEQUENCE_COLUMNS = ["sequence", "task_index", "memory"]
+# a campaign with `priors` (`priors.py`): the arm, default (the knowledge file) or learned
+# (the experience store's priors, read only); empty otherwise (and absent from older tables)
+PRIORS_COLUMNS = ["priors"]
 TASK_COLUMNS = ["targets_outcome", "targets_found", "reports", "reports_correct",
                 "instances", "distinct", "targets_json"]
 VALUE_COLUMNS = ["status", "error", "outcome", "reason", "correct", "success",
@@ -56,14 +59,14 @@ VALUE_COLUMNS = ["status", "error", "outcome", "reason", "correct", "success",
                  "dt_rejected", "views_processed",
                  *(f"map_{k}" for k in MAP_SCORE_KEYS),
                  "episode_s", "wall_s", "overhead_s", "backend", "commit"]
-COLUMNS = KEY_COLUMNS + TASK_KEY_COLUMNS + SEQUENCE_COLUMNS + VALUE_COLUMNS
+COLUMNS = KEY_COLUMNS + TASK_KEY_COLUMNS + SEQUENCE_COLUMNS + PRIORS_COLUMNS + VALUE_COLUMNS
 _INTS = {"seed", "plans", "replans", "cp_calls", "dt_calls", "dt_decisions", "dt_confirmed",
          "dt_rejected", "views_processed", "targets_found", "reports", "reports_correct",
          "instances", "distinct", "task_index"}
 _BOOLS = {"correct", "success", "correct_give_up", "false_report"}
 _TEXT = {"run_id", "scenario", "world", "group", "target", "expected", "strategy", "robot",
          "status", "error", "outcome", "reason", "found_label", "backend", "commit", "task",
-         "task_labels", "targets_outcome", "targets_json", "sequence", "memory"}
+         "task_labels", "targets_outcome", "targets_json", "sequence", "memory", "priors"}
 
 
 def is_wall_cut(outcome: Any, reason: Any) -> bool:
@@ -86,7 +89,8 @@ def row(record: Mapping[str, Any]) -> dict[str, Any]:
     A wall-cut run keeps its episode's numbers (how far it got) but no verdict: `correct`,
     `success`, `correct_give_up` and `false_report` stay empty."""
     out: dict[str, Any] = {k: record.get(k)
-                           for k in KEY_COLUMNS + TASK_KEY_COLUMNS + SEQUENCE_COLUMNS}
+                           for k in KEY_COLUMNS + TASK_KEY_COLUMNS + SEQUENCE_COLUMNS
+                           + PRIORS_COLUMNS}
     out.update({k: record.get(k) for k in ("status", "error", "episode_s", "wall_s",
                                            "overhead_s", "backend", "commit")})
     summary = record.get("summary")

@@ -37,6 +37,7 @@ from avs_planner.experiment.backends import (
 )
 from avs_planner.experiment.campaign import Campaign, RunSpec
 from avs_planner.experiment.errors import CampaignError
+from avs_planner.experiment.priors import placed_store, prepare_stores
 from avs_planner.experiment.provenance import describe, git_state
 from avs_planner.experiment.results import RESULTS_FILE, run_status, write_results
 from avs_planner.experiment.sequences import ordered, placed
@@ -57,6 +58,8 @@ class RunOptions:
     limit: int | None = None  # run at most this many episodes now (a trial, or a test)
     episode_runner: str = DEFAULT_RUNNER
     kill_margin_s: float = 30.0  # beyond the wall budget, before the hard kill
+    # the experience store for every episode that uses one (instead of the campaign's)
+    experience: Path | None = None
 
 
 @dataclass
@@ -98,7 +101,8 @@ class CampaignResult:
 
 def run_campaign(campaign: Campaign, options: RunOptions,
                  on_progress: Callable[[Progress], None] | None = None) -> CampaignResult:
-    runs = [dataclasses.replace(run, episode=placed(dict(run.episode), options.out))
+    runs = [dataclasses.replace(run, episode=placed_store(
+                placed(dict(run.episode), options.out), options.out, options.experience))
             for run in campaign.runs()]
     backend = make_backend(options.backend, options.workers, options.address,
                            options.episode_runner)
@@ -113,6 +117,7 @@ def _run(campaign: Campaign, runs: list[RunSpec], options: RunOptions, backend: 
     started = time.strftime("%Y-%m-%dT%H:%M:%S%z")
     git = git_state()
     meta = _claim(options.out, campaign, len(runs))
+    prepare_stores([dict(run.episode) for run in runs])  # before any episode writes one
     records = load_records(options.out, runs)
     todo = _todo(runs, records, options.retry_failed)
     skipped = len(runs) - len(todo)

@@ -13,7 +13,7 @@ placed (`harness/worlds.py`: the experimenter's knowledge, never the robot's): t
 present, sorted, then shuffled by `random.Random(building seed)`; an `all: N` or `any: N` task
 takes the first N of that order (so `any: 2` takes two of the labels `all: 3` takes), and
 `count: all` every label with at least `MIN_COUNTED` instances, in that order (`pick: N`: the
-first N of them).
+first N of them); `labels: N` is a single search for each of the first N (no task).
 """
 
 from __future__ import annotations
@@ -32,12 +32,13 @@ from avs_planner.experiment.values import Where, parse_seeds
 
 AUTO = "auto"
 AUTO_PRESENT = "present"  # tasks over the labels a generated building holds
+DEFAULT_TABLE = "default"  # the generator's default placement table (sim.generation.table)
 MIN_COUNTED = 2  # `{auto: present, count: all}`: labels with at least this many instances
 _WORLD_KEYS = {"world", "generate", "targets", "start_room", "start"}
-_GENERATE_KEYS = {"seeds", "style", "rooms"}
+_GENERATE_KEYS = {"seeds", "style", "rooms", "table"}
 _TARGET_KEYS = {"label", "expected"}
 _TASK_KEYS = {"targets", "label", "mode", "count", "stop_below", "expected", "singles"}
-_AUTO_KEYS = {"auto", "all", "any", "count", "stop_below", "pick", "singles"}
+_AUTO_KEYS = {"auto", "all", "any", "count", "labels", "stop_below", "pick", "singles"}
 FORM_KEYS = {"auto", "label", "targets"}  # a `targets` mapping with one of these is one form
 _EXPECTED = ("found", "gave_up")
 _FORMS = ("a label or {label, expected}, or a task: {targets: [a, b], mode: all|any} or "
@@ -190,33 +191,53 @@ def _from_file(entry: dict[str, Any], top: Any, at: Where, where: Where, base: P
 
 def _generated(entry: dict[str, Any], targets: tuple[Any, Where], at: Where
                ) -> Iterator[Subject]:
-    style, rooms, group, seeds = _generate_entry(entry, at)
+    style, rooms, group, seeds, table = _generate_entry(entry, at)
     value, t_at = targets
     entries = _entries(value, t_at, generated=True)
     for seed in seeds:
-        spec = {"generate": {"seed": seed, "style": style, "rooms": rooms}}
-        building = Building(seed, style, rooms)
-        name = generated_name(seed, style, rooms)
+        spec = {"generate": {"seed": seed, "style": style, "rooms": rooms, **_table(table)}}
+        building = Building(seed, style, rooms, table)
+        name = generated_name(seed, style, rooms, table)
         for wanted in _unique([w for e in entries for w in e.resolve(building)]):
             yield Subject(name, group, wanted.name, wanted.expected, None, spec, wanted.task)
 
 
 def _generate_entry(entry: dict[str, Any], at: Where
-                    ) -> tuple[str, int | None, str, list[int]]:
-    """A `{generate: {seeds, style, rooms}}` entry: style, rooms, group and building seeds."""
+                    ) -> tuple[str, int | None, str, list[int], str]:
+    """A `{generate: {seeds, style, rooms, table}}` entry: style, rooms, group, building
+    seeds and placement table (`default` unless given)."""
     gen = entry["generate"]
     g_at = at.at("generate")
     if not isinstance(gen, dict) or "seeds" not in gen or set(gen) - _GENERATE_KEYS:
-        raise g_at.error(f"a mapping with 'seeds' and optionally 'style', 'rooms' (keys "
-                         f"{sorted(_GENERATE_KEYS)})")
+        raise g_at.error(f"a mapping with 'seeds' and optionally 'style', 'rooms', 'table' "
+                         f"(keys {sorted(_GENERATE_KEYS)})")
     style, rooms = gen.get("style", "office"), gen.get("rooms")
     if not isinstance(style, str):
         raise g_at.at("style").error(f"a world style name, got {style!r}")
     if rooms is not None and (isinstance(rooms, bool) or not isinstance(rooms, int)
                               or rooms < 1):
         raise g_at.at("rooms").error(f"a positive number of rooms, got {rooms!r}")
-    group = f"gen-{style}" + (f"-r{rooms}" if rooms is not None else "")
-    return style, rooms, group, parse_seeds(gen["seeds"], g_at.at("seeds"))
+    table = gen.get("table", DEFAULT_TABLE)
+    tables = placement_tables()
+    if not isinstance(table, str) or table not in tables:
+        raise g_at.at("table").error(f"a placement table, one of {', '.join(tables)}; got "
+                                     f"{table!r}")
+    group = (f"gen-{style}" + (f"-r{rooms}" if rooms is not None else "")
+             + ("" if table == DEFAULT_TABLE else f"-{table}"))
+    return style, rooms, group, parse_seeds(gen["seeds"], g_at.at("seeds")), table
+
+
+def _table(table: str) -> dict[str, str]:
+    """The `table` key of an episode's `generate` mapping: only for a table other than the
+    default (so the specs of default worlds stay as they were, and their records match)."""
+    return {} if table == DEFAULT_TABLE else {"table": table}
+
+
+def placement_tables() -> tuple[str, ...]:
+    """The generator's placement tables by name (`sim.generation.table.TABLES`)."""
+    from avs_planner.harness.worlds import placement_tables as tables
+
+    return tables()
 
 
 def sequence_subjects(worlds: Any, sequence: Sequence, where: Where) -> Iterator[Subject]:
@@ -234,11 +255,11 @@ def sequence_subjects(worlds: Any, sequence: Sequence, where: Where) -> Iterator
             raise at.error(f"unknown keys {sorted(set(entry) - {'generate'})}: with "
                            f"'sequence', an entry is {{generate: {{seeds, style, rooms}}}} "
                            f"(targets are drawn per task)")
-        style, rooms, group, seeds = _generate_entry(entry, at)
+        style, rooms, group, seeds, table = _generate_entry(entry, at)
         for seed in seeds:
-            name = generated_name(seed, style, rooms)
+            name = generated_name(seed, style, rooms, table)
             for day in range(sequence.tasks):
-                days = sequence.generate(day)
+                days = {**sequence.generate(day), **_table(table)}
                 try:
                     counts = generated_instances(seed, style, rooms, **days)
                 except AvsError as exc:
@@ -259,11 +280,12 @@ class Building:
     seed: int
     style: str
     rooms: int | None
+    table: str = DEFAULT_TABLE
 
     def targets(self, where: Where) -> list[Wanted]:
         """The generator's own targets (`targets: auto`)."""
         try:
-            pairs = generated_targets(self.seed, self.style, self.rooms)
+            pairs = generated_targets(self.seed, self.style, self.rooms, **_table(self.table))
         except AvsError as exc:
             raise where.error(f"world seed {self.seed}: {exc}") from None
         return [Wanted(label, _EXPECTED[not present]) for label, present in pairs]
@@ -272,7 +294,7 @@ class Building:
         """The labels the building holds with their instance counts, in the building's own
         order (sorted, then shuffled by `random.Random(seed)`: see the module's doc)."""
         try:
-            counts = generated_instances(self.seed, self.style, self.rooms)
+            counts = generated_instances(self.seed, self.style, self.rooms, **_table(self.table))
         except AvsError as exc:
             raise where.error(f"world seed {self.seed}: {exc}") from None
         ordered = sorted(label for label, n in counts.items() if n > 0)
@@ -280,21 +302,24 @@ class Building:
         return [(label, counts[label]) for label in ordered]
 
     def name(self) -> str:
-        return generated_name(self.seed, self.style, self.rooms)
+        return generated_name(self.seed, self.style, self.rooms, self.table)
 
 
-def generated_name(seed: int, style: str, rooms: int | None) -> str:
+def generated_name(seed: int, style: str, rooms: int | None, table: str = DEFAULT_TABLE
+                   ) -> str:
     from avs_planner.harness.worlds import generated_name as name
 
-    return name(seed, style, rooms)
+    return name(seed, style, rooms, table)
 
 
-def generated_targets(seed: int, style: str, rooms: int | None) -> list[tuple[str, bool]]:
-    """The generator's (label, present in the world) targets for one generated world."""
+def generated_targets(seed: int, style: str, rooms: int | None, **table: str
+                      ) -> list[tuple[str, bool]]:
+    """The generator's (label, present in the world) targets for one generated world (`table`:
+    of another placement table than the default)."""
     from avs_planner.harness.worlds import generated_targets as targets
 
     try:
-        return list(targets(seed, style, rooms))
+        return list(targets(seed, style, rooms, **table))
     except ImportError as exc:
         raise CampaignError(f"generated worlds are not available in this build: {exc}") from None
 
@@ -350,11 +375,13 @@ class _AutoTargets(_Entry):
 @dataclass(frozen=True)
 class _AutoTask(_Entry):
     """`{auto: present, all: N}`, `{auto: present, any: N}`, `{auto: present, count: all}`:
-    tasks over the labels each generated building holds (see the module's doc)."""
+    tasks over the labels each generated building holds (see the module's doc);
+    `{auto: present, labels: N}`: a single search for each of its first N labels."""
 
     where: Where
-    kind: str  # all, any or count
-    size: int | None  # all / any: labels per task; count: `pick` (None: every eligible one)
+    kind: str  # all, any, count, or labels (single searches)
+    size: int | None  # all / any: labels per task; count: `pick` (None: every eligible one);
+    # labels: how many labels (a single search each)
     stop_below: float | None
     singles: bool
 
@@ -370,6 +397,14 @@ class _AutoTask(_Entry):
                     f"{MIN_COUNTED} or more instances; the building has {len(eligible)}"
                     + (f" ({', '.join(eligible)})" if eligible else ""))
             groups = [[label] for label in eligible[:self.size]]
+        elif self.kind == "labels":
+            if len(labels) < (self.size or 0):
+                raise self.where.at("labels").error(
+                    f"{about}: labels: {self.size} asks for {self.size} labels the building "
+                    f"holds; it holds {len(labels)} "
+                    f"({', '.join(label for label, _ in labels)})")
+            return [Wanted(_known(label, self.where), "found")
+                    for label, _ in labels[:self.size]]
         else:
             if len(labels) < (self.size or 0):
                 raise self.where.at(self.kind).error(
@@ -467,10 +502,11 @@ def _auto_task(item: dict[str, Any], where: Where) -> _AutoTask:
     if item[AUTO] != AUTO_PRESENT:
         raise where.at(AUTO).error(f"'{AUTO_PRESENT}' (tasks over labels the building "
                                    f"holds); got {item[AUTO]!r}")
-    kinds = [k for k in ("all", "any", "count") if k in item]
+    kinds = [k for k in ("all", "any", "count", "labels") if k in item]
     if len(kinds) != 1:
         raise where.error("give one of 'all: N' (one object of each of N labels), 'any: N' "
-                          "(one of any of N labels) or 'count: all' (every instance)")
+                          "(one of any of N labels), 'count: all' (every instance) or "
+                          "'labels: N' (a single search for each of N labels)")
     kind = kinds[0]
     from avs_planner.harness.tasks import MAX_TARGETS
 
@@ -486,6 +522,15 @@ def _auto_task(item: dict[str, Any], where: Where) -> _AutoTask:
         if "stop_below" in item:
             stop = _form({"target": "x", "count": "all", "stop_below": item["stop_below"]},
                          where).stop_below
+    elif kind == "labels":
+        size = item["labels"]
+        if isinstance(size, bool) or not isinstance(size, int) or size < 1:
+            raise where.at("labels").error(f"a positive number of labels, got {size!r}")
+        for key in ("pick", "stop_below", "singles"):
+            if key in item:
+                raise where.at(key).error(f"'{key}' does not go with 'labels: N' (single "
+                                          "searches already)")
+        stop = None
     else:
         size = item[kind]
         if isinstance(size, bool) or not isinstance(size, int) \

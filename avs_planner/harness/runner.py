@@ -48,7 +48,7 @@ _KEYS = {"target", "targets", "mode", "count", "stop_below", "category", "world"
          "robot", "start_room", "start", "seed", "time_budget_s", "wall_budget_s", "task_id",
          "output_dir", "pre_explore", "dt_policy",
          "strategy", "strategy_options", "generate", "qsr", "record", "view", "strict_labels",
-         "memory", "since_s", "experience", "building"}
+         "memory", "since_s", "experience", "building", "learn"}
 
 
 @dataclass(frozen=True)
@@ -85,6 +85,7 @@ class EpisodeSpec:
     since_s: float = 3600.0  # simulated seconds since the building's previous task
     experience: str | None = None  # path of the experience store (learned priors), if any
     building: str | None = None  # the building's id: its scope in the experience store
+    learn: bool = True  # add the episode's evidence to the store (false: only read it)
 
     @property
     def form(self) -> TaskForm:
@@ -147,9 +148,10 @@ def _flag(spec: Mapping[str, Any], key: str) -> bool:
     return value
 
 
-def _experience(spec: Mapping[str, Any]) -> dict[str, str | None]:
+def _experience(spec: Mapping[str, Any]) -> dict[str, Any]:
     """`experience`: the store's path (a non-empty string); `building`: an id of at most 64
-    letters, digits, `_`, `.`, `-`, starting with a letter or digit."""
+    letters, digits, `_`, `.`, `-`, starting with a letter or digit; `learn` (default true):
+    false reads the store without adding to it (opened read-only)."""
     from conceptual_map.knowledge.experience import BUILDING_ID
 
     path, building = spec.get("experience"), spec.get("building")
@@ -161,7 +163,11 @@ def _experience(spec: Mapping[str, Any]) -> dict[str, str | None]:
         raise EpisodeError(f"episode spec: 'building' must be an id of 1-64 letters, digits, "
                            f"'_', '.' or '-' starting with a letter or digit, got "
                            f"{reprlib.repr(building)}")
-    return {"experience": path, "building": building}
+    learn = _flag({"learn": spec.get("learn", True)}, "learn")
+    if "learn" in spec and path is None:
+        raise EpisodeError("episode spec: 'learn' says whether the episode adds to an "
+                           "experience store: give 'experience' too")
+    return {"experience": path, "building": building, "learn": learn}
 
 
 def _recording(spec: Mapping[str, Any]) -> dict[str, bool]:
@@ -321,7 +327,7 @@ class Episode:
         if self.spec.experience is None:
             return load_knowledge()
         try:
-            store = ExperienceStore(self.spec.experience)
+            store = ExperienceStore(self.spec.experience, readonly=not self.spec.learn)
             knowledge = store.knowledge_for(load_knowledge(), self.spec.building)
         except ExperienceError as exc:
             raise EpisodeError(f"episode spec: 'experience': {exc}") from None
@@ -339,7 +345,10 @@ class Episode:
 
         part: dict[str, Any] = {"store": self.experience.store.path.name,
                                 "building": self.spec.building,
-                                "updated": result.reason != "stopped on request"}
+                                "updated": (self.spec.learn
+                                            and result.reason != "stopped on request")}
+        if not self.spec.learn:
+            part["learn"] = False  # read only: the store was not opened for writing
         if part["updated"]:
             evidence = self.experience.with_learned(episode_evidence(self.mind))
             try:

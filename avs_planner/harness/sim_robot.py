@@ -148,15 +148,16 @@ def load_spec(world: str | Path, robot: str | None = None, start: Sequence[float
     return _with_robot(spec, robot, start, start_room, closed_doors)
 
 
-GENERATE_KEYS = ("seed", "style", "rooms", "surprise", "day", "move", "doors")
+GENERATE_KEYS = ("seed", "style", "rooms", "surprise", "day", "move", "doors", "table")
 
 
 def generated_spec(generate: Mapping[str, Any], robot: str | None = None,
                    start: Sequence[float] | None = None,
                    start_room: str | None = None) -> WorldSpec:
-    """A generated world (`{seed, style, rooms, surprise, day, move, doors}`, see
+    """A generated world (`{seed, style, rooms, surprise, day, move, doors, table}`, see
     `sim.generate`): `day` k > 0 is the building k days on, objects moved with probability
-    `move` and doors toggled with probability `doors` each day."""
+    `move` and doors toggled with probability `doors` each day; `table` names the placement
+    table (`default`, or `moved`: sim/generation/placement-moved.yaml)."""
     try:
         world = generate_world_of(generate)
         spec = world.spec()
@@ -169,6 +170,7 @@ def generate_world_of(generate: Mapping[str, Any]) -> Any:
     """`sim.generate.generate_world` of an episode's `generate` mapping (a `GeneratedWorld`);
     EpisodeError naming the key when a key is unknown or a value is not of its kind."""
     from sim.generate import DEFAULT_DOORS, DEFAULT_MOVE, generate_world
+    from sim.generation.table import DEFAULT_TABLE, TABLES
 
     if not isinstance(generate, Mapping):
         raise EpisodeError(f"generate: expected a mapping of {', '.join(GENERATE_KEYS)}; "
@@ -176,7 +178,7 @@ def generate_world_of(generate: Mapping[str, Any]) -> Any:
     unknown = set(generate) - set(GENERATE_KEYS)
     if unknown or "seed" not in generate:
         raise EpisodeError(f"generate: expected keys seed (required), style, rooms, surprise, "
-                           f"day, move, doors; got {sorted(generate)}")
+                           f"day, move, doors, table; got {sorted(generate)}")
     day = generate.get("day", 0)
     if isinstance(day, bool) or not isinstance(day, int) or day < 0:
         raise EpisodeError(f"generate.day: expected an integer >= 0, got {day!r}")
@@ -186,11 +188,15 @@ def generate_world_of(generate: Mapping[str, Any]) -> Any:
                 or not 0.0 <= value <= 1.0:
             raise EpisodeError(f"generate.{key}: expected a probability in [0, 1], got "
                                f"{value!r}")
+    table = generate.get("table", DEFAULT_TABLE)
+    if not isinstance(table, str) or table not in TABLES:
+        raise EpisodeError(f"generate.table: expected a placement table, one of "
+                           f"{', '.join(TABLES)}; got {table!r}")
     try:
         return generate_world(int(generate["seed"]), str(generate.get("style", "office")),
                               generate.get("rooms"), float(generate.get("surprise", 0.25)),
                               day=day, move=float(generate.get("move", DEFAULT_MOVE)),
-                              doors=float(generate.get("doors", DEFAULT_DOORS)))
+                              doors=float(generate.get("doors", DEFAULT_DOORS)), table=table)
     except (TypeError, ValueError) as exc:
         raise EpisodeError(f"generate: {exc}") from exc
 

@@ -4,7 +4,9 @@ Campaigns and benchmarks ask which labels to search for in a generated world (tw
 absent) and how many objects of each label it holds (tasks that count every instance); the
 answer comes from the generator's own record of what it placed, which is the experimenter's
 knowledge, never the robot's. A world of a later day (`day`, `move`, `doors`: the building
-with objects moved and doors toggled, see `sim.generate`) is asked about as that day's world.
+with objects moved and doors toggled, see `sim.generate`) is asked about as that day's world,
+and one of another placement table (`table: moved`) as that table built it; these keywords
+(`**days`) go into the world's `generate` mapping as they are.
 """
 
 from __future__ import annotations
@@ -44,9 +46,12 @@ def generated_targets(seed: int, style: str = "office", rooms: int | None = None
     return [(label, label in there) for label in labels]
 
 
-def generated_name(seed: int, style: str = "office", rooms: int | None = None) -> str:
-    """The name a generated world is known by in tables and run ids."""
-    return f"gen-{style}-{seed}" + (f"-r{rooms}" if rooms is not None else "")
+def generated_name(seed: int, style: str = "office", rooms: int | None = None,
+                   table: str = "default") -> str:
+    """The name a generated world is known by in tables and run ids (`-<table>` at the end
+    for a placement table other than the default: `gen-office-400-moved`)."""
+    return (f"gen-{style}-{seed}" + (f"-r{rooms}" if rooms is not None else "")
+            + ("" if table == "default" else f"-{table}"))
 
 
 def generated_instances(seed: int, style: str = "office", rooms: int | None = None,
@@ -61,3 +66,10 @@ def generated_instances(seed: int, style: str = "office", rooms: int | None = No
     for obj in world.data["objects"]:
         counts[obj["label"]] = counts.get(obj["label"], 0) + 1
     return dict(sorted(counts.items()))
+
+
+def placement_tables() -> tuple[str, ...]:
+    """The generator's placement tables by name (`default`, `moved`: sim/generation/)."""
+    from sim.generation.table import TABLES
+
+    return tuple(TABLES)

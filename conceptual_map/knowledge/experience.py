@@ -81,6 +81,11 @@ NEIGHBOUR_STRENGTH = 20.0
 """Dirichlet concentration of the pair distribution the file's connectivity implies: worth
 twenty door links seen."""
 
+BUSY_TIMEOUT_S = 60.0
+"""How long a write waits for another process's transaction on the same file (SQLite's busy
+timeout): episodes running side by side in a campaign add to one store, each in one short
+transaction."""
+
 Counts = dict[tuple[str, ...], tuple[float, float]]
 """A key -> (found, exposure)."""
 
@@ -158,18 +163,25 @@ class ExperienceStore:
     """Counts of what episodes found, per scope, in one SQLite file (see the module doc).
 
     `ExperienceStore(path)` opens the file, making a new store when it does not exist (or is
-    empty) and `create` is true; ExperienceError for a file that is not such a store. Use it
-    as a context manager, or `close` it."""
+    empty) and `create` is true; ExperienceError for a file that is not such a store. With
+    `readonly`, the file must exist and is opened read-only (SQLite's `mode=ro`): `update`
+    and `reset` fail, and the file is left as it was. Use it as a context manager, or
+    `close` it."""
 
-    def __init__(self, path: str | Path, create: bool = True) -> None:
+    def __init__(self, path: str | Path, create: bool = True, readonly: bool = False) -> None:
         self.path = Path(path)
+        self.readonly = readonly
         exists = self.path.is_file() and self.path.stat().st_size > 0
-        if not exists and not create:
+        if not exists and (readonly or not create):
             raise ExperienceError(f"{self.path}: no experience store there")
         if self.path.exists() and not self.path.is_file():
             raise ExperienceError(f"{self.path}: not a file")
         try:
-            self._db = sqlite3.connect(self.path)
+            if readonly:
+                self._db = sqlite3.connect(f"{self.path.resolve().as_uri()}?mode=ro",
+                                           uri=True, timeout=BUSY_TIMEOUT_S)
+            else:
+                self._db = sqlite3.connect(self.path, timeout=BUSY_TIMEOUT_S)
         except sqlite3.Error as exc:
             raise ExperienceError(f"{self.path}: cannot open: {exc}") from None
         try:
@@ -229,6 +241,8 @@ class ExperienceStore:
     def update(self, building: str | None, evidence: Evidence) -> None:
         """Add one episode's evidence to the all-buildings scope and, given a building, to
         its scope: one transaction (both or neither)."""
+        if self.readonly:
+            raise ExperienceError(f"{self.path}: opened read-only; nothing is added")
         scopes = [ALL] + ([building_scope(building)] if building is not None else [])
         rows_rates = [(kind, *key, found, exposure)
                       for kind, table in (("room", evidence.rooms), ("support", evidence.supports))
@@ -386,6 +400,8 @@ class ExperienceStore:
         prior both ways, and the episodes per scope; the counts shown are the scope's
         (the building's, when one is given)."""
         learned = self.knowledge_for(base, building)
+        if self.readonly:
+            raise ExperienceError(f"{self.path}: opened read-only; nothing is added")
         scopes = [ALL] + ([building_scope(building)] if building is not None else [])
         rates = []
         for kind in ("room", "support"):

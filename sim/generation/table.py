@@ -1,7 +1,10 @@
-"""The generator's placement table (`placement.yaml` beside this file), read and validated.
+"""The generator's placement tables (`placement.yaml` beside this file), read and validated.
 
-The table says which styles exist, which furniture each room category holds, and where small
-objects usually (and unusually) go. See the comment block of `placement.yaml`.
+A table says which styles exist, which furniture each room category holds, and where small
+objects usually (and unusually) go. See the comment block of `placement.yaml`. Besides the
+default table there are variants (`TABLES`), each an overlay of it that replaces the
+placements of a few labels (`placement-moved.yaml`: a building whose cups, books and staplers
+are not where the robot's commonsense knowledge expects them; see its header).
 """
 
 from __future__ import annotations
@@ -16,6 +19,10 @@ import yaml
 from sim.errors import GenerationError
 
 TABLE_PATH = Path(__file__).with_name("placement.yaml")
+DEFAULT_TABLE = "default"
+TABLES = {DEFAULT_TABLE: TABLE_PATH, "moved": Path(__file__).with_name("placement-moved.yaml")}
+"""The placement tables a generated world may be built with, by name (`generate_world(...,
+table=NAME)`)."""
 
 CATEGORIES = ("corridor", "kitchen", "office", "meeting_room", "living_room", "bathroom")
 """Room categories the generator may write: the conceptual map's vocabulary (kept here, since
@@ -101,20 +108,53 @@ class PlacementTable:
 
 
 @cache
-def placement_table() -> PlacementTable:
-    """The built-in table, read once."""
-    return load_table(TABLE_PATH)
+def placement_table(name: str = DEFAULT_TABLE) -> PlacementTable:
+    """A built-in table by name (`TABLES`), read once; `GenerationError` for an unknown one."""
+    if not isinstance(name, str) or name not in TABLES:
+        raise GenerationError(f"table: unknown placement table {name!r} (known: "
+                              f"{', '.join(TABLES)})")
+    return load_table(TABLES[name])
 
 
 def load_table(path: Path) -> PlacementTable:
-    """Read and validate a placement table; `GenerationError` names the bad entry."""
+    """Read and validate a placement table, or an overlay of one (`base`, `moved`,
+    `placements`); `GenerationError` names the bad entry."""
     data = yaml.safe_load(path.read_text(encoding="utf-8"))
     try:
+        if isinstance(data, dict) and "base" in data:
+            data = _overlaid(path, data)
         table = _parse(data)
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         raise GenerationError(f"{path.name}: malformed placement table: {exc!r}") from None
     _validate(table, path.name)
     return table
+
+
+def _overlaid(path: Path, overlay: dict[str, Any]) -> dict[str, Any]:
+    """The base table's data with the overlay's `moved` labels' placement rows replaced by
+    the overlay's rows (added after the base's rows of the same category and kind)."""
+    unknown = set(overlay) - {"base", "moved", "placements"}
+    if unknown:
+        raise GenerationError(f"{path.name}: unknown keys {sorted(unknown)} in an overlay "
+                              "(base, moved, placements)")
+    base = yaml.safe_load(path.with_name(str(overlay["base"])).read_text(encoding="utf-8"))
+    moved = {str(label) for label in overlay["moved"]}
+    placements: dict[str, dict[str, list[Any]]] = {
+        cat: {kind: [row for row in rows if str(row[0]) not in moved]
+              for kind, rows in kinds.items()}
+        for cat, kinds in base["placements"].items()}
+    for cat, kinds in overlay["placements"].items():
+        for kind, rows in kinds.items():
+            if kind not in ("usual", "unusual"):
+                raise GenerationError(f"{path.name}: placements.{cat}: {kind!r} is not usual "
+                                      "or unusual")
+            for row in rows:
+                if str(row[0]) not in moved:
+                    raise GenerationError(f"{path.name}: placements.{cat}.{kind}: {row!r}: "
+                                          f"label {row[0]!r} is not one of the moved labels "
+                                          f"({', '.join(sorted(moved))})")
+            placements.setdefault(cat, {}).setdefault(kind, []).extend(rows)
+    return {**base, "placements": placements}
 
 
 def _parse(data: dict[str, Any]) -> PlacementTable:

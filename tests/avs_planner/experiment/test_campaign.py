@@ -354,7 +354,8 @@ def test_a_task_subject_becomes_an_episode_spec_with_targets_mode_and_count():
         "run_id": "office-cup-or-book-switching-s0", "scenario": "", "world": "office",
         "group": "office", "target": "cup or book", "expected": "found",
         "strategy": "switching", "robot": "", "seed": 0, "task": "any",
-        "task_labels": "cup book", "sequence": "", "task_index": None, "memory": ""}
+        "task_labels": "cup book", "sequence": "", "task_index": None, "memory": "",
+        "priors": ""}
     assert runs[1].columns()["task"] == "count"
     from avs_planner.harness.runner import EpisodeSpec
 

@@ -29,7 +29,7 @@ def test_a_generated_spec_of_a_later_day_is_that_days_world() -> None:
     ({"seed": 1, "move": 2}, "generate.move: expected a probability in [0, 1], got 2"),
     ({"seed": 1, "doors": True}, "generate.doors: expected a probability in [0, 1]"),
     ({"seed": 1, "days": 3}, "expected keys seed (required), style, rooms, surprise, day, "
-                             "move, doors; got ['days', 'seed']"),
+                             "move, doors, table; got ['days', 'seed']"),
 ])
 def test_bad_day_keys_are_refused_naming_the_key(generate: dict, message: str) -> None:
     with pytest.raises(EpisodeError, match=re.escape(message)):
