@@ -13,14 +13,15 @@ counts into posterior means:
   one support instance) looked through completely with a perfect detector. An episode adds
   the objects it found, n, and its exposure E, the rooms' worth its looks covered (each
   look's share of the room times the detector's hit rate: `1 - remaining` in the object
-  ledger). The conjugate prior on lambda is Gamma(a0, b0) centred on the file's rate lambda0
-  (b0 = a0 / lambda0), so the posterior mean is (a0 + n) / (b0 + E)
-  (`posterior_rate`). `PRIOR_STRENGTH` is a0 for the all-buildings scope; one building's rate
-  is the same update again with the all-buildings posterior as its prior mean and the
-  knowledge's `rate_shape` as a0 (how much buildings differ from buildings in general, the
-  same number the episode's own rate multiplier uses), fed with that building's counts only;
-  the all-buildings level then takes the other buildings' counts (all less this one), so no
-  episode counts twice.
+  ledger). The conjugate prior on lambda is a Gamma centred on the file's rate lambda0 and
+  worth `PRIOR_EXPOSURE` (b0) units of exposure, so the posterior mean is
+  (b0 lambda0 + n) / (b0 + E) (`learned.posterior_mean`, where the choice is explained);
+  one building's rate is the same update again with the all-buildings posterior as its
+  prior mean and the knowledge's `rate_shape` as the Gamma's shape (how much buildings
+  differ from buildings in general, the same number the episode's own rate multiplier
+  uses), fed with that building's counts only; the all-buildings level then takes the other
+  buildings' counts (all less this one), so no episode counts twice. A relation the file
+  does not list is added once something was found on such a support.
 - **Room categories**: a Dirichlet with concentration `CATEGORY_STRENGTH` x the file's prior
   and the counts of rooms seen per category: posterior mean (alpha pi_c + n_c) / (alpha + N);
   then one building's counts on top of that with `BUILDING_CATEGORY_STRENGTH`.
@@ -46,12 +47,19 @@ from collections.abc import Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from types import MappingProxyType
 from typing import Any
 
-import numpy as np
-
 from conceptual_map.errors import ExperienceError
+from conceptual_map.knowledge.learned import (
+    BUILDING_CATEGORY_STRENGTH,
+    CATEGORY_STRENGTH,
+    PRIOR_EXPOSURE,
+    Counts,
+    posterior_knowledge,
+    posterior_mean,
+    posterior_rate,
+    rate_of,
+)
 from conceptual_map.knowledge.model import Knowledge
 from conceptual_map.qsr.model import QsrDescription, QsrKnowledge, QsrStep
 
@@ -60,35 +68,10 @@ STORE_KIND = "avs-experience"
 ALL = "all"
 BUILDING_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
 
-PRIOR_STRENGTH = 2.0
-"""a0: the shape of the Gamma prior on a rate in the all-buildings scope, i.e. the file's rate
-counts as much as two objects found (and a0 / lambda0 rooms searched). The file says its
-rates are plausible guesses, not measurements: shape 2 (coefficient of variation 0.71) lets a
-handful of searched rooms move a rate by a factor of about two, where an exponential prior
-(a0 = 1) would let one lucky find double it; and a prior stronger than one building's
-(`rate_shape` = 1 in the default file), since buildings in general vary less than one
-building may differ from them."""
-
-CATEGORY_STRENGTH = 20.0
-"""Dirichlet concentration of the file's room-category prior in the all-buildings scope: worth
-twenty rooms seen (a few buildings' worth), so one building's mix does not become everyone's."""
-
-BUILDING_CATEGORY_STRENGTH = 5.0
-"""The same for one building on top of the all-buildings posterior: its own rooms soon
-dominate (an office floor is mostly offices)."""
-
-NEIGHBOUR_STRENGTH = 20.0
-"""Dirichlet concentration of the pair distribution the file's connectivity implies: worth
-twenty door links seen."""
-
 BUSY_TIMEOUT_S = 60.0
 """How long a write waits for another process's transaction on the same file (SQLite's busy
 timeout): episodes running side by side in a campaign add to one store, each in one short
 transaction."""
-
-Counts = dict[tuple[str, ...], tuple[float, float]]
-"""A key -> (found, exposure)."""
-
 
 @dataclass(frozen=True)
 class Evidence:
@@ -111,15 +94,6 @@ class Evidence:
     def empty(self) -> bool:
         return not (self.rooms or self.supports or self.categories or self.neighbours
                     or self.qsr)
-
-
-def posterior_rate(prior_mean: float, strength: float, found: float, exposure: float) -> float:
-    """Posterior mean of a Poisson rate with a Gamma(a0, a0 / prior_mean) prior after `found`
-    objects in `exposure` units: (a0 + n) / (a0 / prior_mean + E). A zero prior mean stays 0
-    (the knowledge rules the label out there)."""
-    if prior_mean <= 0.0:
-        return 0.0
-    return (strength + found) / (strength / prior_mean + max(0.0, exposure))
 
 
 def qsr_chain_key(chain: Iterable[QsrStep]) -> str:
@@ -342,15 +316,19 @@ class ExperienceStore:
         if scope is not None:
             categories = _less(categories, self._counts("categories", scope))
             neighbours = _less(neighbours, self._counts("neighbours", scope))
-        knowledge = _posterior(base, rooms, supports, categories, neighbours, PRIOR_STRENGTH,
-                               CATEGORY_STRENGTH)
+        knowledge = posterior_knowledge(base, rooms, supports, categories, neighbours,
+                                        posterior_mean, CATEGORY_STRENGTH)
         if scope is not None:
-            shape = base.rate_shape if base.rate_shape is not None else PRIOR_STRENGTH
-            knowledge = _posterior(knowledge, self._rates(scope, "room"),
-                                   self._rates(scope, "support"),
-                                   self._counts("categories", scope),
-                                   self._counts("neighbours", scope), shape,
-                                   BUILDING_CATEGORY_STRENGTH)
+            shape = base.rate_shape if base.rate_shape is not None else PRIOR_EXPOSURE
+
+            def building_rate(prior: float, found: float, exposure: float) -> float:
+                return posterior_rate(prior, shape, found, exposure)
+
+            knowledge = posterior_knowledge(knowledge, self._rates(scope, "room"),
+                                            self._rates(scope, "support"),
+                                            self._counts("categories", scope),
+                                            self._counts("neighbours", scope), building_rate,
+                                            BUILDING_CATEGORY_STRENGTH)
         name = f"{base.source} + experience {self.path.name} ({scope or ALL})"
         return replace(knowledge, source=name, _category_index={})
 
@@ -408,7 +386,9 @@ class ExperienceStore:
             keys = sorted({k for s in scopes for k in self._rates(s, kind)})
             for key in keys:
                 n, e = self._rates(scopes[-1], kind).get(key, (0.0, 0.0))
-                before, after = _rate_of(base, key), _rate_of(learned, key)
+                before, after = rate_of(base, key), rate_of(learned, key)
+                if before is None and after is not None and len(key) == 4:
+                    before = float(base.default_relation_lambda)  # a relation learned
                 if before is None or after is None:
                     continue
                 entry = ({"label": key[0], "category": key[1]} if kind == "room" else
@@ -447,68 +427,6 @@ def _less(total: Mapping[Any, Any], part: Mapping[Any, Any]) -> dict[Any, Any]:
         else:
             out[key] = max(0.0, value - minus)
     return out
-
-
-def _rate_of(knowledge: Knowledge, key: tuple[str, ...]) -> float | None:
-    category = key[-1]
-    if category not in knowledge.categories:
-        return None
-    k = knowledge.category_index(category)
-    if len(key) == 2:
-        row = knowledge.object_lambda.get(key[0])
-    else:
-        row = knowledge.relation_lambda.get((key[0], key[1], key[2]))
-    return None if row is None else float(row[k])
-
-
-def _posterior(base: Knowledge, rooms: Counts, supports: Counts,
-               categories: Mapping[str, float], neighbours: Mapping[tuple[str, str], float],
-               strength: float, category_strength: float) -> Knowledge:
-    """One level of the update: `base`'s values are the prior means (module doc). Counts
-    for labels, relations or categories `base` does not list are left out."""
-    index = {c: i for i, c in enumerate(base.categories)}
-    objects = {label: row.copy() for label, row in base.object_lambda.items()}
-    for (label, category), (n, e) in rooms.items():
-        if label in objects and category in index:
-            k = index[category]
-            objects[label][k] = posterior_rate(float(objects[label][k]), strength, n, e)
-    relations = {key: row.copy() for key, row in base.relation_lambda.items()}
-    for (label, relation, support, category), (n, e) in supports.items():
-        key = (label, relation, support)
-        if key in relations and category in index:
-            k = index[category]
-            relations[key][k] = posterior_rate(float(relations[key][k]), strength, n, e)
-    counts = np.zeros(len(index))
-    for category, n in categories.items():
-        if category in index:
-            counts[index[category]] += n
-    prior = (category_strength * base.prior + counts) / (category_strength + counts.sum())
-    return replace(base, object_lambda=MappingProxyType(objects),
-                   relation_lambda=MappingProxyType(relations), prior=prior,
-                   connectivity=_connectivity(base, neighbours, index), _category_index={})
-
-
-def _connectivity(base: Knowledge, neighbours: Mapping[tuple[str, str], float],
-                  index: Mapping[str, int]) -> np.ndarray:
-    """phi scaled by P(pair) / P0(pair) (module doc)."""
-    phi = base.connectivity.copy()
-    n = np.zeros_like(phi)
-    for (a, b), count in neighbours.items():
-        if a in index and b in index:
-            i, j = index[a], index[b]
-            n[i, j] += count
-            if i != j:
-                n[j, i] += count
-    total = float(np.triu(n).sum())
-    if total <= 0.0:
-        return phi
-    pair = np.outer(base.prior, base.prior) * phi
-    upper = np.triu(pair) + np.triu(pair, 1)  # unordered pairs: a != b drawn either way
-    p0 = upper / upper.sum()
-    p0 = np.maximum(p0, p0.T)  # the same value on both sides of the diagonal
-    alpha = NEIGHBOUR_STRENGTH
-    ratio = (alpha + np.divide(n, p0, out=np.zeros_like(n), where=p0 > 0)) / (alpha + total)
-    return phi * ratio
 
 
 @dataclass

@@ -84,7 +84,7 @@ def test_knowledge_show_export_and_reset(tmp_path, capsys) -> None:
     assert shown["episodes"] == {"all": 2, "building:b1": 1, "building:b2": 1}
     cup = next(r for r in shown["rates"] if r["label"] == "cup")
     assert cup["category"] == "kitchen" and cup["file"] == 0.3
-    assert cup["learned"] == pytest.approx(round(5 / (2 / 0.3 + 3), 4))
+    assert cup["learned"] == pytest.approx(round((2 * 0.3 + 3) / (2 + 3), 4))
     assert (cup["found"], cup["exposure"]) == (3.0, 3.0)
     assert main(["knowledge", "show", "--store", str(path), "--building", "b1"]) == 0
     assert "scope: building:b1" in capsys.readouterr().out  # yaml by default

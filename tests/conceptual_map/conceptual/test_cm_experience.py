@@ -11,12 +11,11 @@ import pytest
 from conceptual_map.errors import ExperienceError
 from conceptual_map.knowledge import load_knowledge
 from conceptual_map.knowledge.experience import (
-    PRIOR_STRENGTH,
     Evidence,
     ExperienceSession,
     ExperienceStore,
-    posterior_rate,
 )
+from conceptual_map.knowledge.learned import PRIOR_EXPOSURE, posterior_mean, posterior_rate
 from conceptual_map.qsr import QsrDescription, QsrStep, load_qsr
 
 BASE = load_knowledge()
@@ -31,23 +30,38 @@ def store(tmp_path):
 
 
 def test_the_conjugate_update_moves_a_rate_toward_the_counts_by_hand(store) -> None:
-    """Gamma(a0, a0 / lambda0) prior: posterior mean (a0 + n) / (a0 / lambda0 + E)."""
-    assert PRIOR_STRENGTH == 2.0
+    """A Gamma prior centred on the file's rate lambda0 and worth b0 rooms of looking:
+    posterior mean (b0 lambda0 + n) / (b0 + E)."""
+    assert PRIOR_EXPOSURE == 2.0
     assert BASE.object_lambda["cup"][KITCHEN] == 0.3
     store.update(None, Evidence(rooms={("cup", "kitchen"): (3.0, 2.0)}))
     learned = store.knowledge_for(BASE)
-    # (2 + 3) / (2 / 0.3 + 2) = 5 / 8.6667: found 3 in 2 rooms' worth, 1.5 a room observed
-    assert learned.object_lambda["cup"][KITCHEN] == pytest.approx(5 / (2 / 0.3 + 2))
+    # (2 x 0.3 + 3) / (2 + 2) = 0.9: found 3 in 2 rooms' worth, 1.5 a room observed
+    assert learned.object_lambda["cup"][KITCHEN] == pytest.approx(3.6 / 4)
     assert 0.3 < learned.object_lambda["cup"][KITCHEN] < 1.5
     # more searching without finds lowers it below the file's value
     store.update(None, Evidence(rooms={("cup", "kitchen"): (0.0, 20.0)}))
     lower = store.knowledge_for(BASE).object_lambda["cup"][KITCHEN]
-    assert lower == pytest.approx(5 / (2 / 0.3 + 22))
+    assert lower == pytest.approx(3.6 / 24)
     assert lower < 0.3
+
     # what has no counts is the file's, and the base is not changed
     assert learned.object_lambda["cup"][OFFICE] == BASE.object_lambda["cup"][OFFICE]
     assert np.array_equal(learned.object_lambda["desk"], BASE.object_lambda["desk"])
     assert BASE.object_lambda["cup"][KITCHEN] == 0.3
+
+
+def test_a_rate_the_file_calls_unlikely_is_learned_from_a_few_buildings(store) -> None:
+    """The prior is worth the same looking for every rate: a label the file puts nowhere in
+    a category (its default rate) is found there in a few rooms and learned, where a prior
+    worth two objects found (shape 2, 200 rooms' worth at 0.01) would hardly move."""
+    assert BASE.object_lambda["cup"][BASE.category_index("meeting_room")] == 0.1
+    assert BASE.object_lambda["book"][KITCHEN] == BASE.default_object_lambda == 0.01
+    store.update(None, Evidence(rooms={("book", "kitchen"): (4.0, 5.0)}))
+    learned = store.knowledge_for(BASE).object_lambda["book"][KITCHEN]
+    assert learned == pytest.approx((2 * 0.01 + 4) / (2 + 5))
+    assert learned > 0.5
+    assert posterior_mean(0.01, 4.0, 5.0) == pytest.approx(learned)
 
 
 def test_a_support_rate_updates_the_same_way(store) -> None:
@@ -56,8 +70,21 @@ def test_a_support_rate_updates_the_same_way(store) -> None:
     store.update(None, Evidence(supports={("cerealbox", "on", "table", "kitchen"): (0.0, 4.0)}))
     learned = store.knowledge_for(BASE)
     assert learned.relation_lambda[("cerealbox", "on", "table")][KITCHEN] == pytest.approx(
-        2 / (2 / 0.5 + 4))  # 0.25: four tables looked at, none held one
+        2 * 0.5 / (2 + 4))  # 1/6: four tables looked at, none held one
     assert posterior_rate(0.0, 2.0, 3.0, 1.0) == 0.0  # ruled out by the file stays so
+    assert posterior_mean(0.0, 3.0, 1.0) == 0.0
+
+
+def test_a_relation_the_file_does_not_list_is_added_once_found(store) -> None:
+    key = ("book", "on", "counter")
+    assert key not in BASE.relation_lambda
+    store.update(None, Evidence(supports={(*key, "kitchen"): (0.0, 3.0)}))
+    assert key not in store.knowledge_for(BASE).relation_lambda  # nothing found: not added
+    store.update(None, Evidence(supports={(*key, "kitchen"): (2.0, 1.0)}))
+    row = store.knowledge_for(BASE).relation_lambda[key]
+    d = BASE.default_relation_lambda
+    assert row[KITCHEN] == pytest.approx((2 * d + 2) / (2 + 4))
+    assert row[OFFICE] == pytest.approx(d)  # other categories keep the file's default
 
 
 def test_a_building_scope_refines_the_other_buildings_counts(store) -> None:
@@ -67,14 +94,17 @@ def test_a_building_scope_refines_the_other_buildings_counts(store) -> None:
     store.update("b1", Evidence(rooms={("cup", "kitchen"): (0.0, 10.0)}))
     store.update("b2", Evidence(rooms={("cup", "kitchen"): (4.0, 2.0)}))
     everyone = store.knowledge_for(BASE).object_lambda["cup"][KITCHEN]
-    assert everyone == pytest.approx((2 + 4) / (2 / 0.3 + 12))
-    others = (2 + 4) / (2 / 0.3 + 2)  # b2's counts only
+    assert everyone == pytest.approx((0.6 + 4) / (2 + 12))
+    others = (0.6 + 4) / (2 + 2)  # b2's counts only
     b1 = store.knowledge_for(BASE, "b1").object_lambda["cup"][KITCHEN]
     assert b1 == pytest.approx((1 + 0) / (1 / others + 10))
-    others = 2 / (2 / 0.3 + 10)  # b1's counts only
+    others = 0.6 / (2 + 10)  # b1's counts only
     b2 = store.knowledge_for(BASE, "b2").object_lambda["cup"][KITCHEN]
     assert b2 == pytest.approx((1 + 4) / (1 / others + 2))
-    assert b1 < everyone < b2
+    # each building's own looks move it from what the other buildings say: b1 searched ten
+    # kitchens for nothing, b2 found four cups in two
+    assert b1 < everyone and b1 < (0.6 + 4) / (2 + 2)
+    assert b2 > 0.6 / (2 + 10)
     # a building the store has never seen gets the all-buildings posterior
     new = store.knowledge_for(BASE, "b3").object_lambda["cup"][KITCHEN]
     assert new == pytest.approx(everyone)
