@@ -110,7 +110,11 @@ def _standpoints(executor: Executor, todo: list[Sighting]
     except PathQueryError:
         return []
     camera = executor.camera
-    far = verify_distance(executor.config.agree[0], camera.hfov, camera.vfov)
+    # the field of view the verification before a report uses (the body's, else the
+    # camera's; a camera without a vertical one is taken as square)
+    hfov = body.hfov if body is not None else camera.hfov
+    vfov = body.vfov if body is not None else (camera.vfov or camera.hfov)
+    far = verify_distance(executor.config.agree[0], hfov, vfov)
     occupied = grid.state_grid() == CellState.OCCUPIED
     out = []
     for s in todo:

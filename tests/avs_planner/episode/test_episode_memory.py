@@ -139,3 +139,27 @@ def test_sightings_are_plain_data():
     s = Sighting("cup", (1.0, 2.0, 0.8), seen_at=5.0, weight=0.5, support="table")
     assert s.to_json() == {"label": "cup", "position": [1.0, 2.0, 0.8], "seen_at": 5.0,
                            "weight": 0.5, "support": "table"}
+
+
+def test_a_sighting_the_robot_cannot_get_to_is_kept_and_other_labels_are_not_checked(
+        corridor):
+    """`check_remembered`: only the task's labels are checked (and without any, the robot
+    does not even look round); a spot no standpoint reaches is kept for a later task."""
+    from avs_planner.episode.recall import check_remembered
+
+    mind, _, executor = corridor
+    far = Sighting("cerealbox", (60.0, 60.0, 0.8), seen_at=0.0, weight=0.9)
+    other = Sighting("stapler", (6.5, 3.0, 0.8), seen_at=0.0, weight=0.9)
+    mind.remembered[:] = [far, other]
+    events = []
+
+    def emit(kind, **fields):  # noqa: ANN001, ANN003, ANN202
+        events.append((kind, fields))
+
+    before = executor.robot.clock
+    assert check_remembered(executor, ["cup"], emit) == []
+    assert executor.robot.clock == before and not events  # nothing wanted: nothing done
+    assert check_remembered(executor, ["cerealbox"], emit) == []
+    assert mind.remembered == [far, other]  # kept, not dropped
+    assert [f.get("unreachable") for _, f in events] == ["cerealbox"]
+    assert not any("dropped" in f for _, f in events)
