@@ -11,12 +11,17 @@ the learned priors made the search faster); then the same per target label.
 
 from __future__ import annotations
 
-from typing import Any
-
 from avs_planner.experiment.report_cells import percent_cell, ratio_cell, spread_cell
 from avs_planner.experiment.report_header import stamped
-from avs_planner.experiment.report_rows import Pair, Row, comparable, is_failed, is_timeout
-from avs_planner.experiment.results import WALL_CUT
+from avs_planner.experiment.report_rows import (
+    Pair,
+    Row,
+    arm_pairs,
+    comparable,
+    is_failed,
+    is_timeout,
+    time_ratios,
+)
 
 ARMS = ("default", "learned")
 
@@ -29,23 +34,13 @@ def is_priors_arm(row: Row) -> bool:
 def priors_pairs(rows: list[Row], strategy: str) -> list[Pair]:
     """(learned, default) runs of one strategy on the same world, target, robot and noise
     seed, neither cut by the wall clock."""
-    def key(r: Row) -> tuple[Any, ...]:
-        return r["scenario"], r["world"], r["target"], r["robot"], r["seed"]
-
-    default = {key(r): r for r in rows
-               if r["strategy"] == strategy and r.get("priors") == "default"}
-    return [(r, default[key(r)]) for r in rows
-            if r["strategy"] == strategy and r.get("priors") == "learned"
-            and key(r) in default and WALL_CUT not in (r["status"], default[key(r)]["status"])]
+    return arm_pairs(rows, strategy, "priors", ("learned", "default"),
+                     lambda r: (r["scenario"], r["world"], r["target"], r["robot"], r["seed"]))
 
 
 def priors_ratios(pairs: list[Pair]) -> list[float]:
     """Per-pair sim-time ratios learned / default where both found the target."""
-    def found(row: Row) -> bool:
-        return (row["status"] == "ok" and bool(row["success"])
-                and bool(row["sim_time_s"]) and row["sim_time_s"] > 0)
-
-    return [a["sim_time_s"] / b["sim_time_s"] for a, b in pairs if found(a) and found(b)]
+    return time_ratios(pairs, "found")
 
 
 def priors_tables(rows: list[Row], stamp: str) -> list[str]:

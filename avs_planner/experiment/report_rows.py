@@ -10,7 +10,7 @@ compares as per-pair ratios.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from avs_planner.experiment.results import WALL_CUT, is_wall_cut
@@ -105,3 +105,15 @@ def time_ratios(pairs: list[Pair], kind: str) -> list[float]:
         return not is_present(row) and row["outcome"] == "gave_up"
 
     return [x["sim_time_s"] / y["sim_time_s"] for x, y in pairs if ended(x) and ended(y)]
+
+
+def arm_pairs(rows: list[Row], strategy: str, column: str, arms: tuple[str, str],
+              same: Callable[[Row], tuple[Any, ...]]) -> list[Pair]:
+    """(first arm, second arm) runs of one strategy that agree on `same(row)`, neither cut
+    by the wall clock: the pairs a campaign's two arms (`column` = arms[0] or arms[1]: memory
+    on / off, learned / default priors) are compared over."""
+    second = {same(r): r for r in rows
+              if r["strategy"] == strategy and r.get(column) == arms[1]}
+    return [(r, second[same(r)]) for r in rows
+            if r["strategy"] == strategy and r.get(column) == arms[0] and same(r) in second
+            and WALL_CUT not in (r["status"], second[same(r)]["status"])]

@@ -12,12 +12,16 @@ per-pair ratios of simulated time, memory on / off, over the pairs where both fo
 
 from __future__ import annotations
 
-from typing import Any
-
 from avs_planner.experiment.report_cells import percent_cell, ratio_cell, spread_cell
 from avs_planner.experiment.report_header import stamped
-from avs_planner.experiment.report_rows import Pair, Row, comparable, is_failed
-from avs_planner.experiment.results import WALL_CUT
+from avs_planner.experiment.report_rows import (
+    Pair,
+    Row,
+    arm_pairs,
+    comparable,
+    is_failed,
+    time_ratios,
+)
 
 
 def is_sequence(row: Row) -> bool:
@@ -28,22 +32,13 @@ def is_sequence(row: Row) -> bool:
 def memory_pairs(rows: list[Row], strategy: str) -> list[Pair]:
     """(memory on, memory off) runs of one strategy on the same building, task index, robot
     and noise seed, neither cut by the wall clock."""
-    def key(r: Row) -> tuple[Any, ...]:
-        return r["world"], r["task_index"], r["robot"], r["seed"]
-
-    off = {key(r): r for r in rows if r["strategy"] == strategy and r["memory"] == "off"}
-    return [(r, off[key(r)]) for r in rows
-            if r["strategy"] == strategy and r["memory"] == "on" and key(r) in off
-            and WALL_CUT not in (r["status"], off[key(r)]["status"])]
+    return arm_pairs(rows, strategy, "memory", ("on", "off"),
+                     lambda r: (r["world"], r["task_index"], r["robot"], r["seed"]))
 
 
 def memory_ratios(pairs: list[Pair]) -> list[float]:
     """Per-pair sim-time ratios on / off where both found the target."""
-    def found(row: Row) -> bool:
-        return (row["status"] == "ok" and bool(row["success"])
-                and bool(row["sim_time_s"]) and row["sim_time_s"] > 0)
-
-    return [a["sim_time_s"] / b["sim_time_s"] for a, b in pairs if found(a) and found(b)]
+    return time_ratios(pairs, "found")
 
 
 def sequence_tables(rows: list[Row], stamp: str) -> list[str]:
