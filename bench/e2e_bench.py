@@ -288,7 +288,11 @@ def _git(*args: str) -> str:
 
 
 def _fmt(value, spec: str) -> str:
-    return "-" if value is None else format(value, spec)
+    """`value` by `spec`; "-" for none, as wide as the spec's width."""
+    if value is None:
+        width = "".join(c for c in spec.split(".")[0] if c.isdigit())
+        return "-".rjust(int(width or 0))
+    return format(value, spec)
 
 
 def _yes(value: bool | None) -> str:

@@ -67,3 +67,10 @@ def test_nothing_solved_by_both_gives_no_ratio_and_timeouts_are_counted():
     lines = summary_lines(s)
     assert "median over the 0 both solved: -" in lines[2]
     assert lines[3].startswith("-- ours returned its best plan at --timeout on 1")
+
+
+def test_missing_values_keep_the_table_columns():
+    from bench.e2e_bench import _fmt
+
+    assert _fmt(None, "7.2f") == "      -" and _fmt(1.5, "7.2f") == "   1.50"
+    assert _fmt(None, "g") == "-"
