@@ -50,9 +50,9 @@ from avs_planner.pddl.sexpr import parse_sexprs
 from avs_planner.pddl.up_builder import build_lite, build_problem
 from bench.avs_generator import AvsSize, generate
 from bench.pddl_bench import best_of
+from tests.ipc import IPC  # ../shared/ipc beside the checkout, or $AVS_IPC_DIR
 
 ROOT = Path(__file__).resolve().parents[1]
-IPC = ROOT.parent / "shared" / "ipc"  # beside the checkout
 SIZES = (AvsSize(40, 8, 8, 8), AvsSize(80, 16, 16, 8), AvsSize(160, 32, 32, 8),
          AvsSize(320, 64, 64, 8))
 FD_LIMIT_S = 600.0  # one translator run
