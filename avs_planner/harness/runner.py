@@ -15,16 +15,15 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from avs_planner.episode import memory
 from avs_planner.episode.errors import EpisodeError
 from avs_planner.episode.executor import Executor, ExecutorConfig
 from avs_planner.episode.mind import Mind
 from avs_planner.episode.outcome import SearchResult
-from avs_planner.episode.recall import check_remembered
 from avs_planner.episode.robot_api import fence
 from avs_planner.episode.state_builder import SearchTask, StateBuilder
 from avs_planner.episode.trace import Trace, write_summary
 from avs_planner.episode.viewcones import CameraModel
+from avs_planner.harness.building_memory import EpisodeMemory, memory_keys
 from avs_planner.harness.sim_robot import (
     SimRobot,
     check_categories,
@@ -124,21 +123,8 @@ class EpisodeSpec:
             dt_policy=str(spec.get("dt_policy") or "pouct"), strategy=strategy.name,
             strategy_options=options, generate=generate, world_text=spec.get("world_file"),
             qsr=qsr_descriptions(spec.get("qsr")), strict_labels=_flag(spec, "strict_labels"),
-            **_recording(spec), **_memory(spec), **_experience(spec),
+            **_recording(spec), **memory_keys(spec), **_experience(spec),
         )
-
-
-def _memory(spec: Mapping[str, Any]) -> dict[str, Any]:
-    """`memory` (a directory) and `since_s` (seconds since the building's last task)."""
-    memory = spec.get("memory")
-    if memory is not None and (not isinstance(memory, str | Path) or not str(memory)):
-        raise EpisodeError(f"episode spec: 'memory' must be a directory, got {memory!r}")
-    since = spec.get("since_s", 3600.0)
-    if isinstance(since, bool) or not isinstance(since, int | float) \
-            or not math.isfinite(since) or since < 0:
-        raise EpisodeError(f"episode spec: 'since_s' must be a number >= 0 (simulated seconds "
-                           f"since the building's previous task), got {since!r}")
-    return {"memory": None if memory is None else str(memory), "since_s": float(since)}
 
 
 def _flag(spec: Mapping[str, Any], key: str) -> bool:
@@ -254,18 +240,6 @@ def run_episode(spec: Mapping[str, Any], emit: Emit | None = None,
     """Run one episode; returns the summary dict (also written to `output_dir`)."""
     episode = EpisodeSpec.from_dict(spec)
     return Episode(episode, emit, should_stop).run()
-
-
-@dataclass
-class _Memory:
-    """The building memory of an episode: as loaded, the building time its task began,
-    what was put into the mind, and what the check of its sightings found."""
-
-    kept: memory.BuildingMemory | None
-    start: float
-    recalled: dict[str, Any] | None
-    checked: int = 0
-    confirmed: int = 0
 
 
 class Episode:
@@ -407,7 +381,9 @@ class Episode:
             if self.memory is not None and self.memory.recalled is not None:
                 self.trace.emit("memory", recalled=True, **self.memory.recalled)
             start_clock, start_distance = self._pre_explore()
-            self._check_memory()
+            if self.memory is not None:  # every strategy's task starts so
+                self.memory.check(self.executor, self.spec.form.targets, self._emit,
+                                  lambda: not self.context.budget_spent())
             search = self._strategy().load()
             targets = None
             if self.spec.task is not None:
@@ -416,7 +392,8 @@ class Episode:
             else:
                 result = search(self.context)
             summary = self.summary(result, start_clock, start_distance, targets)
-            self._keep_memory(summary)
+            if self.memory is not None:
+                summary["memory"] = self.memory.keep(self.mind)
             summary.update(self._learn(result))
             if self.out is not None:
                 write_summary(self.out / "summary.json", summary)
@@ -431,44 +408,15 @@ class Episode:
             self.trace.close()
             self.robot.world.close()
 
-    def _recall_memory(self) -> _Memory | None:
-        """The building's memory, put into the fresh mind (`episode/memory.py`)."""
+    def _recall_memory(self) -> EpisodeMemory | None:
+        """The building's memory, put into the fresh mind (`harness/building_memory.py`)."""
         if self.spec.memory is None:
             return None
         try:
-            kept = memory.load(self.spec.memory)
-            start = (kept.clock if kept is not None else 0.0) + self.spec.since_s
-            recalled = memory.recall(self.mind, kept, start) if kept is not None else None
-        except memory.BuildingMemoryError:
+            return EpisodeMemory.recall(self.spec.memory, self.spec.since_s, self.mind)
+        except EpisodeError:
             self.robot.world.close()
             raise
-        return _Memory(kept, start, recalled)
-
-    def _check_memory(self) -> None:
-        """Look where the memory saw a wanted object (`episode/recall.py`); every strategy's
-        task starts so."""
-        if self.memory is None or not self.mind.remembered:
-            return
-        found = check_remembered(self.executor, self.spec.form.targets, self._emit,
-                                 lambda: not self.context.budget_spent())
-        self.memory.checked = sum(1 for e in self.trace.events
-                                  if e["type"] == "memory" and "checked" in e)
-        self.memory.confirmed = len(found)
-
-    def _keep_memory(self, summary: dict[str, Any]) -> None:
-        """Write what the robot knows now to the building's memory; the summary says so."""
-        if self.memory is None or self.spec.memory is None:
-            return
-        kept = memory.remember(self.mind, self.memory.kept, self.memory.start)
-        memory.save(kept, self.spec.memory)
-        recalled = self.memory.recalled or {}
-        summary["memory"] = {
-            "tasks_before": self.memory.kept.tasks if self.memory.kept is not None else 0,
-            "building_clock_s": round(self.memory.start, 1),
-            "furniture": recalled.get("furniture", 0),
-            "sightings": len(recalled.get("sightings", ())),
-            "checked": self.memory.checked, "confirmed": self.memory.confirmed,
-            "saved": True}
 
     def _pre_explore(self) -> tuple[float, float]:
         """Fig. 3f: build the maps first (frontier exploration), then start the clock."""
