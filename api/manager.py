@@ -13,10 +13,7 @@ restarts any worker slot thread that died.
 from __future__ import annotations
 
 import asyncio
-import hashlib
-import json
 import logging
-import re
 import shutil
 import threading
 import time
@@ -27,9 +24,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from api.buildings import building_spec, memory_dir, world_identity, world_text
 from api.config import Settings
 from api.limits import short, without_file_options
-from api.schemas import BUILDING_PATTERN, MAX_SINCE_S, TaskState
+from api.schemas import TaskState
 from api.security import Caller
 from api.store import StorageError, TaskRecord, TaskStore
 from api.worker_process import PRELOAD_JOBS, resolve
@@ -53,7 +51,6 @@ _JOB_STATES = {
 TaskChecker = Callable[[dict[str, Any], Path | None], list[Any]]  # -> [FieldProblem(field, msg)]
 
 
-_BUILDING_ID = re.compile(BUILDING_PATTERN.removeprefix("^").removesuffix("$"))
 SUPERVISE_S = 0.5  # how often failed writes are retried and worker threads checked
 MAX_ERROR = 2000  # characters of a task's `error`
 
@@ -192,8 +189,8 @@ class TaskManager:
                 known = self.store.building(building)
                 if known is not None and known.world != place[1]:
                     raise BuildingWorldError(
-                        f"building {building!r} is {_world_text(known.world)}; this task "
-                        f"names {_world_text(place[1])} (a building is always the same "
+                        f"building {building!r} is {world_text(known.world)}; this task "
+                        f"names {world_text(place[1])} (a building is always the same "
                         f"world; forget it, DELETE /v1/buildings/{building}, to reuse its id)")
             task_id = uuid.uuid4().hex
             self.store.insert(task_id, request, owner, idempotency_key, request_hash, place)
@@ -296,31 +293,12 @@ class TaskManager:
         return spec
 
     def memory_dir(self, building: str) -> Path:
-        """`DATA_DIR/buildings/ID/memory`: built here from a checked id only (ValueError for
-        one that would leave the buildings directory)."""
-        if not _BUILDING_ID.fullmatch(building):
-            raise ValueError(f"not a building id: {building!r}")
-        root = self.settings.buildings_dir.resolve()
-        folder = (root / building / "memory").resolve()
-        if folder.parent.parent != root:
-            raise ValueError(f"not a building id: {building!r}")
-        return folder
+        """`DATA_DIR/buildings/ID/memory` (`buildings.memory_dir`)."""
+        return memory_dir(self.settings, building)
 
     def _building_spec(self, building: str, since_s: Any) -> dict[str, Any]:
-        """The episode spec's building keys: its memory directory, the experience store and
-        its scope, and the simulated seconds since its previous task (given, or the real
-        seconds since its memory was last written, at most `MAX_SINCE_S`)."""
-        folder = self.memory_dir(building)
-        folder.mkdir(parents=True, exist_ok=True)
-        if not isinstance(since_s, int | float) or isinstance(since_s, bool):
-            try:
-                written = (folder / "memory.json").stat().st_mtime
-            except OSError:
-                since_s = 0.0  # a first task: nothing remembered, no time passed
-            else:
-                since_s = round(min(max(time.time() - written, 0.0), MAX_SINCE_S), 1)
-        return {"memory": str(folder), "since_s": float(since_s), "building": building,
-                "experience": str(self.settings.experience_path.resolve())}
+        """The episode spec's building keys (`buildings.building_spec`)."""
+        return building_spec(self.settings, building, since_s)
 
     def forget(self, building: str) -> bool:
         """Forget a building: its memory files, its scope of the experience store and its
@@ -541,31 +519,6 @@ class TaskManager:
 
     def counts(self) -> tuple[int, int]:
         return self.store.count_state(TaskState.QUEUED), self.store.count_state(TaskState.RUNNING)
-
-
-def world_identity(request: dict[str, Any]) -> str:
-    """Which world a task's request names, as JSON: a built-in world's name, a generated
-    building's arguments (less `day`, `move`, `doors`: the same building on another day), or
-    an inline world file's SHA-256."""
-    if request.get("world") is not None:
-        found: dict[str, Any] = {"world": request["world"]}
-    elif request.get("generate") is not None:
-        found = {"generate": {k: v for k, v in dict(request["generate"]).items()
-                              if k not in ("day", "move", "doors") and v is not None}}
-    else:
-        text = str(request.get("world_file") or "")
-        found = {"world_file": hashlib.sha256(text.encode()).hexdigest()[:16]}
-    return json.dumps(found, sort_keys=True)
-
-
-def _world_text(identity: str) -> str:
-    found = json.loads(identity)
-    if "world" in found:
-        return f"world {found['world']!r}"
-    if "generate" in found:
-        args = ", ".join(f"{k} {v}" for k, v in found["generate"].items())
-        return f"the generated building ({args})"
-    return f"an inline world file (SHA-256 {found['world_file']}...)"
 
 
 def _relative(event: dict[str, Any], root: str) -> dict[str, Any]:
