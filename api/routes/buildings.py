@@ -12,15 +12,13 @@ from fastapi import APIRouter, HTTPException, Path, status
 
 from api.deps import ManagerDep, ReadAccess, WriteAccess
 from api.manager import BuildingBusyError, TaskManager
-from api.schemas import (
-    BUILDING_PATTERN,
+from api.schemas import BUILDING_PATTERN, Message, TaskFormPublic
+from api.schemas_buildings import (
     BuildingDetailPublic,
     BuildingPublic,
     BuildingsPublic,
     BuildingTaskPublic,
-    Message,
     RememberedObject,
-    TaskFormPublic,
 )
 from api.security import Caller
 from api.store import BuildingRecord, StorageError
