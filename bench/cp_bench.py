@@ -39,6 +39,7 @@ from unified_planning.model import MinimizeActionCosts, Problem
 from unified_planning.shortcuts import Fluent, IntType, get_environment
 
 from avs_planner.cp.anytime import greedy_search
+from avs_planner.cp.deadline import Deadline
 from avs_planner.cp.grounding import GroundingCache, gc_paused, ground
 from avs_planner.cp.planner import plan
 from avs_planner.cp.search import PlanResult, SearchOptions, objective, search
@@ -179,7 +180,7 @@ def ours_once(case: Case, limit_s: float) -> tuple[float, float, PlanResult, obj
         began = time.perf_counter()
         task = ground(pproblem, cache=GroundingCache())
         result, _ = greedy_search(task, SearchOptions(reward=REWARD), NO_SYMMETRIES,
-                                  start + limit_s)
+                                  Deadline(start, limit_s))
         result = replace(result, planning_time_s=time.perf_counter() - began)
     total = time.perf_counter() - start
     if not result.solved or total > limit_s:

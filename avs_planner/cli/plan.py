@@ -40,7 +40,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="weight w >= 1 on the remaining cost estimate (1: A*; default 2); "
                         "picks the weighted mode")
     parser.add_argument("--timeout", type=float, default=None,
-                        help="seconds (default: none); with it the default mode is anytime")
+                        help="seconds for the whole planning call: reading, grounding and "
+                        "search (default: none). No search starts once it has passed and a "
+                        "search running then stops within one expansion; grounding is not "
+                        "interrupted, so one that alone takes longer ends the call with no "
+                        "plan (exit 3). With it the default mode is anytime")
     parser.add_argument("--node-limit", type=int, default=None, help="max expanded states")
     parser.add_argument("--patience", type=_patience, default=None,
                         help="once a plan is found, expansions without a better one before "
@@ -49,8 +53,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--mode", choices=("auto", "anytime", "weighted"), default="auto",
                         help="anytime: greedy best-first with FF and helpful actions (LAMA's "
                         "first iteration), then weighted A* restarts with w = 5, 3, 2, 1; "
-                        "prints the best plan by objective at --timeout (or when the last "
-                        "restart ends); probabilistic objectives kept. weighted: one weighted "
+                        "prints the best plan by objective at --timeout, or before it when "
+                        "the last restart ends (no restart proves its plan optimal: FF is "
+                        "inadmissible, so only the end of the schedule stops it early); "
+                        "probabilistic objectives kept. weighted: one weighted "
                         "A* search (with --heuristic hmax and --weight 1, optimal). auto (the "
                         "default): anytime when a --timeout bounds it and neither --weight "
                         "nor --heuristic is given, else weighted (the restarts down to w = 1 "
@@ -71,10 +77,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from avs_planner.cp.deadline import Deadline
     from avs_planner.cp.planner import plan
     from avs_planner.cp.search import SearchOptions
     from avs_planner.pddl import read_files
 
+    deadline = Deadline.from_now(args.timeout)  # reading the files counts too
     given = {"reward": args.reward, "weight": args.weight}
     options = SearchOptions(
         heuristic=args.heuristic or "ff", timeout_s=args.timeout, node_limit=args.node_limit,
@@ -85,8 +93,10 @@ def run(args: argparse.Namespace) -> int:
     pproblem = read_files(args.domain, args.problem)
     for warning in pproblem.warnings:
         print(warning, file=sys.stderr)
-    result = plan(pproblem, options)
+    result = plan(pproblem, options, deadline=deadline)
     print(json.dumps(result.as_json()) if args.json else _text(result))
+    if result.status.value == "timeout" and args.timeout is not None:
+        print(f"avs plan: no plan within {args.timeout:g} s", file=sys.stderr)
     hint = _limit_hint(result, options.heuristic)
     if hint:
         print(hint, file=sys.stderr)

@@ -6,11 +6,14 @@ expansion budgets with FF's open lists alternating with goal-count ones, with an
 helpful actions (LAMA's first iteration, with the goal count where LAMA counts landmarks:
 plan length guides it, so it finds a plan fast; see `greedy_search`); then weighted A*
 restarted with decreasing weights (5, 3, 2, 1) on the real objective c + R(1 - p). Every
-plan is judged by that objective and the best so far is kept; at the deadline
-(`timeout_s`) it is returned, with `stopped_by = "timeout"` when a later iteration was
-still running. Probabilistic tasks keep their objective: the greedy phase keeps the
-R(1 - p) term in f, and the restarts use it unchanged. The optimal mode (weight 1 with
-h^max, no `anytime`) is untouched.
+plan is judged by that objective and the best so far is kept; at the deadline it is
+returned, with `stopped_by = "timeout"` when a later iteration was still running. The
+deadline is the planning call's (`deadline.Deadline`: `timeout_s` from before grounding):
+each search gets the time left and none starts once it has passed. No restart proves its
+plan optimal (FF is inadmissible and no search prunes by the incumbent's cost), so the
+schedule ends before the deadline only when its last restart ends. Probabilistic tasks
+keep their objective: the greedy phase keeps the R(1 - p) term in f, and the restarts use
+it unchanged. The optimal mode (weight 1 with h^max, no `anytime`) is untouched.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from avs_planner.cp.deadline import Deadline
 from avs_planner.cp.search import PlanResult, PlanStatus, SearchOptions, search
 from avs_planner.cp.symmetry import NO_SYMMETRIES, Symmetries
 from avs_planner.cp.task import GroundTask
@@ -45,10 +49,12 @@ def unit_cost(task: GroundTask) -> GroundTask:
 
 
 def anytime_search(
-    task: GroundTask, options: SearchOptions, symmetries: Symmetries = NO_SYMMETRIES
+    task: GroundTask, options: SearchOptions, symmetries: Symmetries = NO_SYMMETRIES,
+    deadline: Deadline | None = None,
 ) -> PlanResult:
-    """Greedy first, then restarting weighted A*; the best plan by objective at the end."""
-    run = AnytimeRun()
+    """Greedy first, then restarting weighted A*; the best plan by objective at the end.
+    `deadline`: the planning call's (default: `options.timeout_s` from now)."""
+    run = AnytimeRun(deadline=deadline)
     for _ in anytime_plans(task, options, symmetries, run):
         pass
     return run.result(options)
@@ -57,13 +63,22 @@ def anytime_search(
 @dataclass
 class AnytimeRun:
     """What an `anytime_plans` run leaves behind: its best result, expansions, the history of
-    improvements and why it stopped early (None: it finished its schedule)."""
+    improvements and why it stopped early (None: it finished its schedule). `deadline`: when
+    it must end; None: `options.timeout_s` after `start` (made before grounding when the run
+    is made first, as `planner.improving_plans` callers do)."""
 
     best: PlanResult = field(default_factory=lambda: PlanResult(PlanStatus.TIMEOUT))
     expanded: int = 0
     history: list[dict] = field(default_factory=list)
     stopped: str | None = None
     start: float = field(default_factory=time.perf_counter)
+    deadline: Deadline | None = None
+
+    def deadline_for(self, options: SearchOptions) -> Deadline:
+        """The run's deadline, else `options.timeout_s` after its start."""
+        if self.deadline is not None:
+            return self.deadline
+        return Deadline(self.start, options.timeout_s)
 
     def result(self, options: SearchOptions) -> PlanResult:
         """The best plan with the run's totals (`anytime_search`'s answer)."""
@@ -79,7 +94,7 @@ def anytime_plans(task: GroundTask, options: SearchOptions,
     `AnytimePlanner` hands on). `run` collects the totals (`AnytimeRun.result`)."""
     run = run if run is not None else AnytimeRun()
     start = run.start
-    deadline = None if options.timeout_s is None else start + options.timeout_s
+    deadline = run.deadline_for(options)
     best, expanded = greedy_search(task, options, symmetries, deadline)
     run.best, run.expanded = best, expanded
     if best.solved:
@@ -89,7 +104,7 @@ def anytime_plans(task: GroundTask, options: SearchOptions,
         return
     run.stopped = None if best.solved else "timeout"
     for weight in WEIGHTS:
-        left = None if deadline is None else deadline - time.perf_counter()
+        left = deadline.left()
         if left is not None and left <= 0:
             run.stopped = "timeout"
             break
@@ -139,7 +154,7 @@ VARIANTS = (Variant(True, goal_count=False, commute=True, share=2), Variant(Fals
 
 
 def greedy_search(task: GroundTask, options: SearchOptions, symmetries: Symmetries,
-                  deadline: float | None,
+                  deadline: Deadline | None,
                   variants: tuple[Variant, ...] = VARIANTS) -> tuple[PlanResult, int]:
     """Greedy best-first on unit costs, each variant in turn under an expansion budget that
     grows fourfold per round until one finds a plan or proves there is none; the rounds cost
@@ -149,14 +164,15 @@ def greedy_search(task: GroundTask, options: SearchOptions, symmetries: Symmetri
     helpful-actions lists (they make barman easy and mislead on tetris) FF's open lists
     alternating with goal-count lists (LAMA alternates with its landmark count), expanding
     every order of commuting actions (SearchOptions.goal_count, .commute).
-    `extra["greedy_round"]` says which round and variant found the plan."""
+    `extra["greedy_round"]` says which round and variant found the plan. Each search gets
+    the time `deadline` leaves, and none starts once it has passed (None: no deadline)."""
     unit = unit_cost(task)
     greedy = replace(options, anytime=False, weight=GREEDY_WEIGHT, lazy=True, patience=0)
     budget, expanded = FIRST_BUDGET, 0
     result = PlanResult(PlanStatus.TIMEOUT)
     while True:
         for variant in variants:
-            left = None if deadline is None else deadline - time.perf_counter()
+            left = None if deadline is None else deadline.left()
             if left is not None and left <= 0:
                 return result, expanded
             limit = budget * variant.share

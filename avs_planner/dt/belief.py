@@ -15,13 +15,13 @@ from avs_planner.dt.domain import (
     NOWHERE,
     START,
     ActionKind,
-    DetectorModel,
     DTAction,
     DTObservation,
     DTState,
     ObservationKind,
 )
 from avs_planner.dt.errors import DtSessionError
+from avs_planner.dt.inputs import DetectorModel
 from avs_planner.dt.problem import DTProblem
 
 

@@ -16,8 +16,8 @@ from functools import cached_property
 
 import numpy as np
 
-from avs_planner.dt.domain import DetectorModel, Pose2D, ViewCone
 from avs_planner.dt.errors import DtInputError
+from avs_planner.dt.inputs import DetectorModel, Pose2D, ViewCone
 
 PROBABILITY_TOLERANCE = 1e-9
 

@@ -25,15 +25,13 @@ from avs_planner.dt.domain import (
     NOTHING,
     START,
     ActionKind,
-    DetectorModel,
     DTAction,
     DTObservation,
     ObservationKind,
-    Pose2D,
-    ViewCone,
 )
 from avs_planner.dt.errors import DtSessionError
 from avs_planner.dt.greedy import stop_choice
+from avs_planner.dt.inputs import DetectorModel, Pose2D, ViewCone
 from avs_planner.dt.policies import DTPolicy, PolicyConfig, make_policy, timed_decision
 from avs_planner.dt.pouct import SearchBudget
 from avs_planner.dt.problem import DTProblem, DTRewards, TravelCosts

@@ -21,14 +21,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from avs_planner.cp.search import PlanStep
 from avs_planner.cp.task import Atom
-from avs_planner.dt import DTSession
 from avs_planner.episode.cone_sets import ConeSets, Location, SupportViews, WeightedCones
 from avs_planner.episode.context import Event, ExecutorConfig, SkillContext, Stats
 from avs_planner.episode.driving import TARGET_SEEN, Driver, Point, Pose
-from avs_planner.episode.dt_search import ViewConeSearch
 from avs_planner.episode.glimpses import Glimpses
 from avs_planner.episode.landmarks import RoomLandmarks, landmark_labels
 from avs_planner.episode.mind import KnownObject, Mind
@@ -40,6 +39,10 @@ from avs_planner.episode.verifying import Verifier
 from avs_planner.episode.viewcones import CameraModel, ConeSet
 from conceptual_map.metric import distance_field
 from conceptual_map.metric.path_planning import PathResult
+
+if TYPE_CHECKING:  # the DT (pomdp-py) is imported by the first SEARCHFOROBJECT, not before
+    from avs_planner.dt import DTSession
+    from avs_planner.episode.dt_search import ViewConeSearch
 
 __all__ = ["Event", "Executor", "ExecutorConfig", "Stats"]
 
@@ -229,6 +232,8 @@ class Executor:
 
     def view_cone_search(self, label: str, relation: str, location: str) -> ViewConeSearch:
         """One SEARCHFOROBJECT's DT session over the cones, with this executor's skills."""
+        from avs_planner.episode.dt_search import ViewConeSearch
+
         return ViewConeSearch(self.context, self.driver, self.sensing, self.cone_sets,
                               self.found_sids, label, relation, location,
                               on_look=self.on_look, on_session=self._session_started)

@@ -49,9 +49,8 @@ from avs_planner.flap import (
 )
 from avs_planner.flap.errors import FlapError
 from avs_planner.strategies.flap import _detectable, _size, support_box
+from avs_planner.strategies.switching import VIEWS
 from conceptual_map.errors import MapError
-
-VIEWS = ("cones", "flap")  # values of the switching strategy's `views` option
 
 
 class FlapViews:

@@ -9,12 +9,15 @@ from __future__ import annotations
 import enum
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from pgmpy.factors.discrete import DiscreteFactor
 from scipy import sparse
 
 from conceptual_map.conceptual.errors import ConceptualError
+
+if TYPE_CHECKING:  # factors are read, never made, here: pgmpy is not imported
+    from pgmpy.factors.discrete import DiscreteFactor
 
 _TINY = 1e-300
 

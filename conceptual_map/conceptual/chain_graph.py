@@ -2,27 +2,30 @@
 Large Environments": room categories, place properties, phi_rc between rooms.
 
 One category variable per room; each observed place property is a directed factor
-P(value | category of the place's room) (a pgmpy `DiscreteFactor`, reduced by the evidence);
-adjacent rooms share an undirected phi_rc factor. Changed incrementally by events; `compile()`
-turns it into the pairwise network loopy BP runs on, recomputing only rooms that changed.
+P(value | category of the place's room), reduced by the evidence to a likelihood vector over
+the category; adjacent rooms share an undirected phi_rc factor. Changed incrementally by
+events; `compile()` turns it into the pairwise network loopy BP runs on, recomputing only
+rooms that changed. `factors()` exports it as pgmpy `DiscreteFactor`s (exact inference,
+inspection): pgmpy is imported there only, as it takes ~0.5 s to import and an episode never
+needs it.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
-from pgmpy.factors.discrete import DiscreteFactor
 
 from conceptual_map.conceptual.bp import PairwiseMRF
 from conceptual_map.conceptual.errors import ConceptualError
 from conceptual_map.knowledge import Knowledge
 
+if TYPE_CHECKING:
+    from pgmpy.factors.discrete import DiscreteFactor
+
 PropertyValue = str | Mapping[str, float]
 """A hard property value, or soft evidence: likelihood weight per value (e.g. classifier output)."""
-
-_CATEGORY = "category"
-
 
 def category_variable(room: str) -> str:
     """Name of the category variable of `room` in exported pgmpy factors."""
@@ -43,10 +46,10 @@ class ChainGraph:
         self._room_of: dict[str, str] = {}
         self._neighbours: dict[str, set[str]] = {}
         self._evidence: dict[str, dict[str, np.ndarray]] = {}
-        self._likelihood: dict[str, dict[str, DiscreteFactor]] = {}
+        self._likelihood: dict[str, dict[str, np.ndarray]] = {}  # reduced, over the category
         self._place_log: dict[str, np.ndarray] = {}
         self._room_evidence: dict[str, np.ndarray] = {}
-        self._room_properties: dict[str, dict[str, tuple[np.ndarray, DiscreteFactor]]] = {}
+        self._room_properties: dict[str, dict[str, tuple[np.ndarray, np.ndarray]]] = {}
         self._unary: dict[str, np.ndarray] = {}
 
     # -- structure -------------------------------------------------------------------------
@@ -161,12 +164,12 @@ class ChainGraph:
     def observe_property(self, place: str, kind: str, value: PropertyValue) -> None:
         """Evidence on a place property; replaces earlier evidence of that kind at the place."""
         room = self.room_of(place)
-        weights, factor = self._property_evidence(kind, value)
+        weights, likelihood = self._property_evidence(kind, value)
         self._evidence.setdefault(place, {})[kind] = weights
-        self._likelihood.setdefault(place, {})[kind] = factor
+        self._likelihood.setdefault(place, {})[kind] = likelihood
         with np.errstate(divide="ignore"):
             self._place_log[place] = sum(
-                (np.log(f.values) for f in self._likelihood[place].values()),
+                (np.log(f) for f in self._likelihood[place].values()),
                 start=np.zeros(len(self.knowledge.categories)),
             )
         self._touch(room)
@@ -193,13 +196,14 @@ class ChainGraph:
 
     def _property_evidence(
         self, kind: str, value: PropertyValue
-    ) -> tuple[np.ndarray, DiscreteFactor]:
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The evidence weights over the values and the likelihood over the category."""
         model = self.knowledge.properties.get(kind)
         if model is None:
             known = ", ".join(self.knowledge.properties)
             raise ConceptualError(f"unknown property kind {kind!r} (known: {known})")
         weights = _evidence_vector(model.values, kind, value)
-        return weights, _reduced_property_factor(model.table, kind, weights)
+        return weights, _reduced_likelihood(model.table, weights)
 
     def set_room_evidence(self, room: str, likelihood: np.ndarray | float) -> None:
         """Replace the object/search likelihood vector over `room`'s category (owned by caller)."""
@@ -233,8 +237,8 @@ class ChainGraph:
             np.add.at(log_unary, owners, np.array(logs))
         with np.errstate(divide="ignore"):
             for room in rooms:
-                for _weights, factor in self._room_properties.get(room, {}).values():
-                    log_unary[index[room]] += np.log(factor.values)
+                for _weights, likelihood in self._room_properties.get(room, {}).values():
+                    log_unary[index[room]] += np.log(likelihood)
                 if room in self._room_evidence:
                     log_unary[index[room]] += np.log(self._room_evidence[room])
         for room, row in zip(rooms, _row_softmax(log_unary), strict=True):
@@ -271,8 +275,7 @@ class ChainGraph:
         for room in order:
             variable = category_variable(room)
             if merged:
-                factors.append(DiscreteFactor([variable], [states],
-                                              _max_normalised(self.unary(room))))
+                factors.append(_factor([variable], [states], _max_normalised(self.unary(room))))
             else:
                 factors.extend(self._room_unaries(room, explicit_properties))
             for other in self._neighbours[room]:
@@ -282,22 +285,23 @@ class ChainGraph:
 
     def _room_unaries(self, room: str, explicit: bool) -> list[DiscreteFactor]:
         variable, states = category_variable(room), len(self.knowledge.categories)
-        factors = [DiscreteFactor([variable], [states], self.knowledge.prior.copy())]
+        factors = [_factor([variable], [states], self.knowledge.prior.copy())]
         factors.extend(self._property_factors(room, explicit))
-        for kind, (weights, factor) in self._room_properties.get(room, {}).items():
-            factors.extend(self._evidence_factors(room, f"room:{room}", kind, weights, factor,
-                                                  explicit))
+        for kind, (weights, likelihood) in self._room_properties.get(room, {}).items():
+            factors.extend(self._evidence_factors(room, f"room:{room}", kind, weights,
+                                                  likelihood, explicit))
         if room in self._room_evidence:
             values = _max_normalised(self._room_evidence[room])
-            factors.append(DiscreteFactor([variable], [states], values))
+            factors.append(_factor([variable], [states], values))
         return factors
 
     def _property_factors(self, room: str, explicit: bool) -> list[DiscreteFactor]:
         result = []
         for place in sorted(self._places_of[room]):
             for kind, weights in self._evidence.get(place, {}).items():
-                factor = self._likelihood[place][kind]
-                result += self._evidence_factors(room, place, kind, weights, factor, explicit)
+                likelihood = self._likelihood[place][kind]
+                result += self._evidence_factors(room, place, kind, weights, likelihood,
+                                                 explicit)
         return result
 
     def _evidence_factors(
@@ -306,23 +310,21 @@ class ChainGraph:
         holder: str,
         kind: str,
         weights: np.ndarray,
-        reduced: DiscreteFactor,
+        reduced: np.ndarray,
         explicit: bool,
     ) -> list[DiscreteFactor]:
         """Reduced likelihood over the room category, or the CPD plus an evidence factor."""
         variable, states = category_variable(room), len(self.knowledge.categories)
         if not explicit:
-            return [DiscreteFactor([variable], [states], _max_normalised(reduced.values))]
+            return [_factor([variable], [states], _max_normalised(reduced))]
         prop = property_variable(holder, kind)
         table = self.knowledge.properties[kind].table
-        return [DiscreteFactor([variable, prop], list(table.shape), table.copy()),
-                DiscreteFactor([prop], [len(weights)], weights.copy())]
+        return [_factor([variable, prop], list(table.shape), table.copy()),
+                _factor([prop], [len(weights)], weights.copy())]
 
     def _phi_factor(self, a: str, b: str) -> DiscreteFactor:
         phi = self.knowledge.connectivity
-        return DiscreteFactor(
-            [category_variable(a), category_variable(b)], list(phi.shape), phi.copy()
-        )
+        return _factor([category_variable(a), category_variable(b)], list(phi.shape), phi.copy())
 
 
 def _row_softmax(log_values: np.ndarray) -> np.ndarray:
@@ -360,10 +362,17 @@ def _evidence_vector(values: tuple[str, ...], kind: str, value: PropertyValue) -
     return weights
 
 
-def _reduced_property_factor(
-    table: np.ndarray, kind: str, weights: np.ndarray
-) -> DiscreteFactor:
-    """P(value | category) times the evidence on the value, summed over the value."""
-    cpd = DiscreteFactor([_CATEGORY, kind], list(table.shape), table)
-    evidence = DiscreteFactor([kind], [len(weights)], weights)
-    return cpd.product(evidence, inplace=False).marginalize([kind], inplace=False)
+def _reduced_likelihood(table: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """P(value | category) times the evidence on the value, summed over the value: over the
+    category. The two einsum calls of pgmpy's `DiscreteFactor.product` and `.marginalize`
+    (the same values to the last bit, checked against pgmpy in the tests)."""
+    product = np.einsum(table, [0, 1], weights, [1], [0, 1])
+    return np.einsum(product, [0, 1], [0])
+
+
+def _factor(variables: list[str], cardinality: list[int], values: np.ndarray
+            ) -> DiscreteFactor:
+    """A pgmpy factor (pgmpy imported on the first export only)."""
+    from pgmpy.factors.discrete import DiscreteFactor
+
+    return DiscreteFactor(variables, cardinality, values)

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from types import MappingProxyType
+from typing import TYPE_CHECKING
 
 import numpy as np
-from pgmpy.factors.discrete import DiscreteFactor
 
 from conceptual_map.conceptual.bp import BPResult, BPSettings, PairwiseMRF, loopy_bp
 from conceptual_map.conceptual.chain_graph import ChainGraph, PropertyValue
@@ -31,6 +31,9 @@ from conceptual_map.conceptual.placeholders import (
     predict,
 )
 from conceptual_map.knowledge import Knowledge, load_knowledge
+
+if TYPE_CHECKING:
+    from pgmpy.factors.discrete import DiscreteFactor
 
 
 class ConceptualMap:

@@ -13,8 +13,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 
-from avs_planner.dt.domain import DetectorModel, ViewCone
 from avs_planner.dt.errors import DtInputError
+from avs_planner.dt.inputs import DetectorModel, ViewCone
 from avs_planner.dt.multi.domain import SearchMode
 from avs_planner.dt.problem import DTProblem, DTRewards, TravelCosts
 

@@ -30,10 +30,9 @@ from avs_planner.dt.domain import (
     ActionKind,
     DTObservation,
     ObservationKind,
-    Pose2D,
-    ViewCone,
 )
 from avs_planner.dt.errors import DtSessionError
+from avs_planner.dt.inputs import Pose2D, ViewCone
 from avs_planner.dt.multi.belief import MultiLabelBelief
 from avs_planner.dt.multi.domain import OPEN, MultiAction, MultiObservation, SearchMode
 from avs_planner.dt.multi.lookahead import stop_decision

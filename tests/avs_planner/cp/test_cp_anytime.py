@@ -135,15 +135,14 @@ def _solve_params() -> list:
 @pytest.mark.parametrize("domain", _solve_params())
 def test_greedy_phase_solves_first_instances(domain: str) -> None:
     """LAMA's first iteration on every IPC domain's instance 1 (20 s each); plans valid."""
-    import time
-
     from avs_planner.cp.anytime import greedy_search
+    from avs_planner.cp.deadline import Deadline
     from avs_planner.cp.grounding import ground
     from avs_planner.cp.symmetry import NO_SYMMETRIES
 
     task = _read(domain, 1)
     result, _ = greedy_search(ground(task), SearchOptions(), NO_SYMMETRIES,
-                              time.perf_counter() + 20)
+                              Deadline.from_now(20))
     assert result.status is PlanStatus.SOLVED
     validator = SequentialPlanValidator()
     validator.skip_checks = True

@@ -175,3 +175,24 @@ def test_random_event_sequences_keep_tree_beliefs_exact(seed):
         if step % 10 == 0:
             _assert_matches_exact(cmap, explicit=False, atol=1e-6)
     _assert_matches_exact(cmap, explicit=False, atol=1e-6)
+
+
+def test_property_evidence_is_pgmpy_s_reduced_factor_to_the_last_bit():
+    """The chain graph reduces P(value | category) by the evidence with numpy (pgmpy is not
+    imported by an episode); the values are pgmpy's product and marginalisation exactly,
+    for every property of the default knowledge, hard and soft evidence."""
+    from pgmpy.factors.discrete import DiscreteFactor
+
+    from conceptual_map.conceptual.chain_graph import _reduced_likelihood
+    from conceptual_map.knowledge import load_knowledge
+
+    rng = np.random.default_rng(7)
+    for kind, model in load_knowledge().properties.items():
+        n = model.table.shape[1]
+        evidence = [np.eye(n)[i] for i in range(n)]
+        evidence += [rng.random(n) * 10.0 ** rng.integers(-6, 4) for _ in range(200)]
+        for weights in evidence:
+            cpd = DiscreteFactor(["category", kind], list(model.table.shape), model.table)
+            reduced = cpd.product(DiscreteFactor([kind], [n], weights), inplace=False)
+            expected = reduced.marginalize([kind], inplace=False).values
+            assert np.array_equal(_reduced_likelihood(model.table, weights), expected), kind

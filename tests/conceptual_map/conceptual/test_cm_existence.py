@@ -10,7 +10,13 @@ import numpy as np
 import pytest
 from scipy.stats import poisson
 
-from conceptual_map.conceptual import ConceptualError, ConceptualMap, RelatedSpace, p_at_least_one
+from conceptual_map.conceptual import (
+    ConceptualError,
+    ConceptualMap,
+    RelatedSpace,
+    p_at_least,
+    p_at_least_one,
+)
 from conceptual_map.knowledge import load_knowledge
 
 EXACT = replace(load_knowledge(), rate_shape=None)
@@ -27,6 +33,22 @@ def _posterior_by_enumeration(prior: np.ndarray, lam: np.ndarray, detect: list[f
 def test_p_at_least_one_is_one_minus_exp_minus_lambda():
     assert p_at_least_one(0.0) == 0.0
     assert p_at_least_one(2.0) == pytest.approx(1 - math.exp(-2.0))
+
+
+def test_p_at_least_is_scipy_s_poisson_survival_function_to_the_last_bit():
+    """Computed without scipy.stats (slow to import), as scipy.stats computes it; edge cases
+    included (k <= 0, lambda 0, inf, NaN, negative)."""
+    rng = np.random.default_rng(3)
+    lams = [np.array([0.0, 1e-300, 1e-9, 0.4, 2.0, 60.0, 1e4, np.inf, np.nan, -1.0]),
+            rng.random((4, 5)) * 10.0 ** rng.integers(-6, 3, (4, 5)), 0.0, 2.5, -1.0]
+    for k in range(-1, 9):
+        for lam in lams:
+            with np.errstate(all="ignore"):
+                expected = np.asarray(poisson.sf(k - 1, np.asarray(lam, dtype=float)),
+                                      dtype=float)
+            got = p_at_least(k, lam)
+            assert got.shape == expected.shape
+            assert np.array_equal(got, expected, equal_nan=True), (k, lam)
 
 
 @pytest.mark.parametrize("searches", [[(0.5, 0.8)], [(0.9, 0.8)], [(0.5, 0.8), (0.7, 0.9)]])
