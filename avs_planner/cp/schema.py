@@ -29,7 +29,8 @@ AtomTemplate = tuple[str, ...]  # (predicate, term, ...)
 
 @dataclass(frozen=True)
 class LiftedSchema:
-    """One action: parameters with their types, conditions split static/dynamic, effects."""
+    """One action (or a derived predicate's rule: `derives`): parameters with their types,
+    conditions split static/dynamic, effects."""
 
     name: str
     params: tuple[str, ...]
@@ -47,6 +48,14 @@ class LiftedSchema:
     complex: tuple[FNode, ...] = ()
     never: bool = False
     conditional: tuple[CondEffect, ...] = ()
+    derives: str = ""
+    """A derived predicate's rule (`axioms.py`), not an action: the predicate (`add` holds
+    its head, the conditions its body); rules are grounded like actions."""
+    stratum: int = 0  # a rule's stratum (`pddl.stratify`)
+
+    @property
+    def is_rule(self) -> bool:
+        return bool(self.derives)
 
 
 def atom_template(node: FNode) -> AtomTemplate:
