@@ -87,7 +87,7 @@ def _ground_cnf(
     def code(atom: Atom) -> int:
         c = space.encode(atom)
         if c is None:
-            raise PlanningError(f"action {schema.name}: cannot ground condition atom {atom}")
+            raise PlanningError(f"{schema.what}: cannot ground condition atom {atom}")
         return c
 
     cnf = [c for node in schema.complex for c in formulas.cnf(node, binding)]

@@ -57,6 +57,11 @@ class LiftedSchema:
     def is_rule(self) -> bool:
         return bool(self.derives)
 
+    @property
+    def what(self) -> str:
+        """How messages name it: `action NAME`, or `derived predicate NAME` for a rule."""
+        return f"derived predicate {self.derives}" if self.derives else f"action {self.name}"
+
 
 def atom_template(node: FNode) -> AtomTemplate:
     """`(pred ?x obj)` of a boolean fluent expression."""
