@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 
 from avs_planner.cp.encoding import compile_vector
 from avs_planner.cp.formulas import unsupported_condition
-from avs_planner.cp.schema import AtomTemplate, LiftedSchema, Term
+from avs_planner.cp.schema import AtomTemplate, LiftedSchema, Term, axioms_of, derived_names
 from avs_planner.cp.unsupported import UnsupportedError, in_rule
 from avs_planner.errors import PlanningError
 from avs_planner.pddl.stratify import stratify
@@ -34,16 +34,6 @@ if TYPE_CHECKING:  # the project's own model (`pddl.lite`): UP 1.3's has no axio
 
 MAX_DISJUNCTS = 64  # rule schemas one rule's body may split into
 RULE_PREFIX = ":derived "  # a rule schema's name: no PDDL action name starts with ':'
-
-
-def axioms_of(problem: object) -> tuple[Axiom, ...]:
-    """The problem's rules (a UP problem has none)."""
-    return tuple(getattr(problem, "axioms", ()))
-
-
-def derived_names(problem: object) -> frozenset[str]:
-    """The predicates the problem's rules define."""
-    return frozenset(axiom.name for axiom in axioms_of(problem))
 
 
 def compile_axioms(problem: Problem, static_names: frozenset[str]

@@ -23,13 +23,17 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from avs_planner.cp.action_table import ActionTable
-from avs_planner.cp.axioms import axioms_of, compile_axioms, derived_names
 from avs_planner.cp.compact import compact
 from avs_planner.cp.derived import derived, ids_of, reachable, relevant, task_rows
 from avs_planner.cp.encoding import ConstantExpr, NumericValues
 from avs_planner.cp.formulas import FALSE, FormulaGrounder
-from avs_planner.cp.ground_axioms import GroundAxioms, rules_of_rows
-from avs_planner.cp.schema import LiftedSchema, compile_schemas, is_instantaneous
+from avs_planner.cp.schema import (
+    LiftedSchema,
+    axioms_of,
+    compile_schemas,
+    derived_names,
+    is_instantaneous,
+)
 from avs_planner.cp.settled import SettledAtoms, settled_atoms
 from avs_planner.cp.structure import GroundStructure, bitset, build_structure
 from avs_planner.cp.task import Atom, GroundTask, TaskArrays, WorldState
@@ -40,6 +44,9 @@ from avs_planner.pddl.model import ProbabilisticProblem
 
 if TYPE_CHECKING:  # or the project's own model (`pddl.lite`), read through the same methods
     from unified_planning.model import FNode, Problem
+
+    from avs_planner.cp.ground_axioms import GroundAxioms
+
 
 
 def world_state(problem: Problem) -> WorldState:
@@ -241,6 +248,17 @@ class _HashOnce:
         )
 
 
+def _rule_schemas(pproblem: ProbabilisticProblem, static_names: frozenset[str]
+                  ) -> tuple[LiftedSchema, ...]:
+    """The derived predicates' rule schemas (`axioms.py`, imported only for a problem with
+    rules; so is `ground_axioms.py`)."""
+    if not axioms_of(pproblem.model):
+        return ()
+    from avs_planner.cp.axioms import compile_axioms
+
+    return compile_axioms(pproblem.model, static_names)
+
+
 class GroundingCache:
     """Keeps compiled schemas and ground structures for the last few (domain, objects, statics)."""
 
@@ -269,7 +287,7 @@ class GroundingCache:
         """The actions' schemas, then the derived predicates' rule schemas (if any)."""
         key, names = self._keys(pproblem)
         return self._remember(self._schemas, key, lambda: compile_schemas(pproblem, names)
-                              + compile_axioms(pproblem.model, names))
+                              + _rule_schemas(pproblem, names))
 
     def _keys(self, pproblem: ProbabilisticProblem) -> tuple[tuple, frozenset[str]]:
         """The schema key and static fluent names of a problem, computed once per problem
@@ -524,6 +542,10 @@ def _action_table(st: GroundStructure, kept_rows: np.ndarray, cost: np.ndarray,
         arg_ids=np.take(st.arg_ids, kept_rows, axis=0), objects=st.space.names,
     )
     actions = ActionTable(st, kept_rows, cost, probability, read_mask)
-    axioms = None if rules is None else rules_of_rows(st, rules, derived)
+    axioms = None
+    if rules is not None:
+        from avs_planner.cp.ground_axioms import rules_of_rows
+
+        axioms = rules_of_rows(st, rules, derived)
     st.memo["last_table"] = (key, actions, arrays, axioms)
     return actions, arrays, axioms

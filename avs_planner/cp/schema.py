@@ -118,6 +118,16 @@ def _split_effects(action: InstantaneousAction) -> tuple[list, list, list]:
     return add, delete, conditional
 
 
+def axioms_of(problem: object) -> tuple:
+    """The problem's derived predicates' rules (`pddl.lite.Axiom`; a UP problem has none)."""
+    return tuple(getattr(problem, "axioms", ()))
+
+
+def derived_names(problem: object) -> frozenset[str]:
+    """The predicates the problem's rules define."""
+    return frozenset(axiom.name for axiom in axioms_of(problem))
+
+
 def is_instantaneous(action: Action | lite.InstantaneousAction) -> bool:
     """Whether the action is instantaneous (`lite` has no other kind; a UP action means UP
     is loaded already)."""

@@ -16,7 +16,6 @@ from collections.abc import Iterator
 from avs_planner.pddl.diagnostics import did_you_mean
 from avs_planner.pddl.formulas import FormulaChecker
 from avs_planner.pddl.sexpr import Atom, Node, SList
-from avs_planner.pddl.stratify import stratify
 from avs_planner.pddl.structure import Action, DerivedRule, Domain, Report
 from avs_planner.pddl.support import UNSUPPORTED_CONDITION, numeric_conditions
 
@@ -94,6 +93,9 @@ def occurrences(node: Node, derived: frozenset[str], negated: bool = False
 def _stratification(domain: Domain, report: Report) -> None:
     """One error per negation inside a cycle, at the negated atom, naming the cycle."""
     derived = domain.derived_names
+    if not derived:
+        return
+    from avs_planner.pddl.stratify import stratify  # only domains with rules need it
     found: dict[str, list[Occurrence]] = {name: [] for name in derived}
     for rule in domain.derived:
         if rule.atom.text in derived and rule.body is not None:
