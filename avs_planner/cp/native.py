@@ -94,13 +94,13 @@ def axiom_args(task: GroundTask) -> tuple:
         return ()
     n_facts, n_words = len(task.facts), words(len(task.facts))
     extra = np.zeros((len(task.actions), n_words), dtype="<u8")
-    derived = np.zeros(n_facts + 1, dtype=bool)
-    derived[list(axioms.facts() & _ids(axioms.mask))] = True
+    derived = np.zeros(n_facts + 1, dtype=bool)  # the spare last slot: -1 padding reads it
+    derived[list(axioms.derived)] = True
     if task.arrays is not None:  # only actions reading a derived fact are built
         reading = np.zeros(len(task.actions), dtype=bool)
         for m in (task.arrays.pre, task.arrays.pre_neg):
             m = np.asarray(m, dtype=np.int64).reshape(len(task.actions), -1)
-            reading |= derived[m].any(axis=1)  # -1 padding reads the spare False
+            reading |= derived[m].any(axis=1)
         reading[list(task.arrays.clauses)] = True
         actions = task.steps(np.flatnonzero(reading).tolist())
     else:
@@ -112,9 +112,6 @@ def axiom_args(task: GroundTask) -> tuple:
             extra[a.index] = np.frombuffer(_bits(more, n_bytes, n_facts, a.label), "<u8")
     return axioms.native_args().tobytes(), extra.tobytes()
 
-
-def _ids(mask: int) -> set[int]:
-    return {i for i in range(mask.bit_length()) if mask >> i & 1}
 
 
 def merge_args(merge) -> tuple:
