@@ -48,7 +48,6 @@ if TYPE_CHECKING:  # or the project's own model (`pddl.lite`), read through the 
     from avs_planner.cp.ground_axioms import GroundAxioms
 
 
-
 def world_state(problem: Problem) -> WorldState:
     """The problem's initial state as atoms and numeric values (explicit :init entries)."""
     atoms: set[Atom] = set()
