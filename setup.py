@@ -8,6 +8,7 @@ setup(
         Extension(
             "avs_planner.cp._native",
             ["avs_planner/cp/_native.c"],
+            depends=["avs_planner/cp/_native_axioms.h"],  # included by _native.c
             # -ffp-contract=off: no fused multiply-add, so every float matches the Python search;
             # -pthread: the second evaluating thread of large searches (SearchOptions.threads)
             extra_compile_args=["-O2", "-std=c11", "-ffp-contract=off", "-pthread"],

@@ -38,7 +38,7 @@ SANITIZE_FLAGS = ["-fsanitize=address,undefined", "-fno-omit-frame-pointer",
 TEST_FILES = [
     f"tests/avs_planner/cp/test_cp_{name}.py"
     for name in ("native", "structure_compiled", "cold_path", "grounding", "relaxed_merge",
-                 "settled", "derived", "search", "preferred", "goals")
+                 "settled", "derived", "search", "preferred", "goals", "axioms")
 ]
 # The extension modules and the module attributes through which the planner uses them: each
 # must be the sanitized build, not None (the silent fallback to Python/numpy).

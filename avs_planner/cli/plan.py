@@ -26,7 +26,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "plan",
         help="plan a (probabilistic) PDDL problem",
         description="Find a plan minimising c(pi) + R(1 - p(pi)) (Goebelbecker et al., A Planning "
-        "Approach to Active Visual Search in Large Environments). Exit codes: "
+        "Approach to Active Visual Search in Large Environments). Reads PDDL 2.1 (STRIPS, "
+        "ADL, action costs) with derived predicates (:derived) and PPDDL's single-outcome "
+        "probabilistic effects; domains/README.md has the details. Exit codes: "
         "0 solved, 1 bad input, 2 unsolvable / no plan with p > 0 (or above --min-success), "
         "3 timeout or node limit with no plan found yet (with one found, the best so far is "
         "printed, exit 0, and `stopped_by` says which limit ended the search).",

@@ -36,6 +36,8 @@ enum { STOP_NONE = 0, STOP_TIMEOUT = 1, STOP_NODE_LIMIT = 2, STOP_PATIENCE = 3 }
 
 #define BIT(s, f) (((s)[(f) >> 6] >> ((f) & 63)) & 1u)
 
+#include "_native_axioms.h" /* derived predicates' rules: the closure of a state */
+
 /* ------------------------------------------------------------------------------------------ */
 /* Python's sum() over floats, started from the int 0                                          */
 
@@ -112,6 +114,7 @@ typedef struct {
     Py_ssize_t n_no_pre;
     int32_t *n_pairs_of;          /* number of pairs of each action */
     Py_ssize_t total_add;
+    Axioms ax; /* derived predicates' rules (n_rules 0: none); successors are closed */
 } TaskObject;
 
 static void task_free_arrays(TaskObject *t)
@@ -126,6 +129,7 @@ static void task_free_arrays(TaskObject *t)
                     t->pw_off, t->pw_n_pre, t->pw_idx, t->pw_mask};
     for (size_t i = 0; i < sizeof(ptrs) / sizeof(ptrs[0]); i++)
         free(ptrs[i]);
+    axioms_free(&t->ax);
 }
 
 static void task_dealloc(TaskObject *t)
@@ -436,7 +440,7 @@ nomem:
     return -1;
 }
 
-#define NBUF 23
+#define NBUF 25
 
 /* Append two int32 CSRs (a: n_a rows, b: n_b rows) into a new one. */
 static int join_csr(int32_t **off, int32_t **val, Py_ssize_t n_a, const int32_t *b_off,
@@ -573,16 +577,42 @@ static int sparse_pre(TaskObject *t)
     return 0;
 }
 
+/* The optional derived predicates' rules (b[0]: GroundAxioms.native_args) and what each
+ * action reads through them (b[1]: n_actions * W words OR-ed into its reads, so that
+ * commutes() sees the facts a derived precondition depends on). */
+static int task_axioms(TaskObject *t, Py_buffer *b)
+{
+    if (b[0].obj && b[0].len) {
+        if (b[0].len % 8) {
+            PyErr_SetString(PyExc_ValueError, "native task: the packed rules are not int64");
+            return -1;
+        }
+        if (axioms_parse(&t->ax, b[0].buf, b[0].len / 8, t->n_facts, t->W))
+            return -1;
+    }
+    if (b[1].obj && b[1].len) {
+        Py_ssize_t AW = t->n_actions * t->W;
+        if ((size_t)b[1].len != (size_t)AW * 8) {
+            PyErr_SetString(PyExc_ValueError, "native task: extra reads have the wrong size");
+            return -1;
+        }
+        const word *extra = b[1].buf;
+        for (Py_ssize_t i = 0; i < AW; i++)
+            t->reads[i] |= extra[i];
+    }
+    return 0;
+}
+
 static PyObject *task_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
 {
     Py_ssize_t n_facts, n_actions, n_rfacts, n_merged;
     Py_buffer b[NBUF];
     memset(b, 0, sizeof(b));
-    if (!PyArg_ParseTuple(args, "nny*y*y*y*y*y*y*y*y*y*y*y*y*y*nny*y*y*y*y*y*y*y*y*:Task",
+    if (!PyArg_ParseTuple(args, "nny*y*y*y*y*y*y*y*y*y*y*y*y*y*nny*y*y*y*y*y*y*y*y*|y*y*:Task",
                           &n_facts, &n_actions, &b[0], &b[1], &b[2], &b[3], &b[4], &b[5],
                           &b[6], &b[7], &b[8], &b[9], &b[10], &b[11], &b[12], &b[13],
                           &n_rfacts, &n_merged, &b[14], &b[15], &b[16], &b[17], &b[18],
-                          &b[19], &b[20], &b[21], &b[22]))
+                          &b[19], &b[20], &b[21], &b[22], &b[23], &b[24]))
         return NULL;
     TaskObject *t = NULL;
     if (n_facts < 0 || n_actions < 0 || n_facts > INT32_MAX / 2 || n_actions > INT32_MAX / 2) {
@@ -647,7 +677,7 @@ static PyObject *task_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
         PyErr_NoMemory();
         goto fail;
     }
-    if (task_merge(t, n_rfacts, n_merged, b + 14) || task_derive(t))
+    if (task_merge(t, n_rfacts, n_merged, b + 14) || task_derive(t) || task_axioms(t, b + 23))
         goto fail;
     for (int i = 0; i < NBUF; i++)
         PyBuffer_Release(&b[i]);
@@ -819,6 +849,7 @@ typedef struct {
     Batch batch;
     struct Worker *worker; /* NULL: evaluations run on the search's thread only */
     word *parent; /* the expanded state, copied: the state table may move */
+    AxiomScratch ax; /* closing successors under the task's rules */
     int oom;
     PyThreadState *thread; /* saved while the GIL is released (NULL: not released) */
 } Search;
@@ -1783,6 +1814,8 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
             const word *ad = t->add + a * W, *de = t->del + a * W;
             for (Py_ssize_t i = 0; i < W; i++)
                 succ[i] = (state[i] & ~de[i]) | ad[i];
+            if (t->ax.n_rules)
+                axioms_close(&t->ax, W, &s->ax, succ);
             double kc = c + t->cost[a], kp = p * t->prob[a];
             s->kid_act[n_kids] = (int32_t)a;
             s->kid_c[n_kids] = kc;
@@ -1872,6 +1905,7 @@ static void search_free(Search *s)
         free(ptrs[i]);
     for (int i = 0; i < MAX_EVAL; i++)
         eval_free(&s->ev[i]);
+    axiom_scratch_free(&s->ax);
 }
 
 static int search_alloc(Search *s)
@@ -1887,6 +1921,8 @@ static int search_alloc(Search *s)
     s->parent = xcalloc(W, 8);
     if (!s->goal || !s->goal_neg || !s->goal_facts || !s->is_goal || !s->combined ||
         !s->help_stamp || !s->parent || eval_alloc(t, &s->ev[0]))
+        return -1;
+    if (t->ax.n_rules && axiom_scratch_alloc(&t->ax, &s->ax))
         return -1;
     return grow_slots(s);
 }
@@ -2366,6 +2402,38 @@ done:
     return out;
 }
 
+/* close(task, states) -> bytes: each state (W words) closed under the task's rules, as the
+ * search closes successors (for tests against ground_axioms.py) */
+static PyObject *native_close(PyObject *self, PyObject *args)
+{
+    TaskObject *t;
+    Py_buffer states = {0};
+    if (!PyArg_ParseTuple(args, "O!y*:close", &TaskType, &t, &states))
+        return NULL;
+    PyObject *out = NULL;
+    AxiomScratch x = {0};
+    Py_ssize_t W = t->W;
+    if (states.len % (8 * W)) {
+        PyErr_SetString(PyExc_ValueError, "native close: states are not whole bitsets");
+        goto done;
+    }
+    out = PyBytes_FromStringAndSize(states.buf, states.len);
+    if (!out || !t->ax.n_rules)
+        goto done;
+    if (axiom_scratch_alloc(&t->ax, &x)) {
+        Py_CLEAR(out);
+        PyErr_NoMemory();
+        goto done;
+    }
+    word *data = (word *)PyBytes_AS_STRING(out);
+    for (Py_ssize_t i = 0; i < states.len / (8 * W); i++)
+        axioms_close(&t->ax, W, &x, data + i * W);
+done:
+    axiom_scratch_free(&x);
+    PyBuffer_Release(&states);
+    return out;
+}
+
 static PyMethodDef native_methods[] = {
     {"search", native_search, METH_VARARGS,
      "search(task, init, goal, goal_neg, heuristic, reward, weight, min_success, timeout_s, "
@@ -2373,6 +2441,8 @@ static PyMethodDef native_methods[] = {
      "(status, path, expanded, generated). Use avs_planner.cp.native, not this directly."},
     {"estimates", native_estimates, METH_VARARGS,
      "estimates(task, goal, heuristic, reward, states) -> [(hc, hl, helpful)] (for tests)."},
+    {"close", native_close, METH_VARARGS,
+     "close(task, states) -> states closed under the task's rules (for tests)."},
     {NULL, NULL, 0, NULL},
 };
 

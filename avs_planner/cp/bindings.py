@@ -122,7 +122,7 @@ def join_numpy(
         objects = domain[param]
         if rows * len(objects) > max_bindings:
             raise PlanningError(
-                f"action {schema.name}: more than {max_bindings} partial bindings to ground"
+                f"{schema.what}: more than {max_bindings} partial bindings to ground"
             )
         columns = {p: np.repeat(c, len(objects)) for p, c in columns.items()}
         columns[param] = np.repeat(objects[None, :], rows, axis=0).ravel()  # np.tile, faster
@@ -208,7 +208,7 @@ class CompiledJoin:
         )
         if status == 1:
             raise PlanningError(
-                f"action {schema.name}: more than {max_bindings} partial bindings to ground")
+                f"{schema.what}: more than {max_bindings} partial bindings to ground")
         if status == 2:
             raise PlanningError(f"grounding exceeds {max_rows} actions")
         return np.frombuffer(data, dtype=np.int64).reshape(rows, len(params)), rows

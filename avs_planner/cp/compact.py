@@ -1,4 +1,4 @@
-"""A task's fact table cut down to the facts its reachable actions and its goal use.
+"""A task's fact table cut down to the facts its reachable actions, rules and goal use.
 
 The grounding structure numbers every atom of every statically possible ground action; on
 IPC tetris that is 37,224 facts of which the 9,456 reachable actions read or change 928. A
@@ -131,6 +131,8 @@ def _used(task: GroundTask) -> np.ndarray:
     for bits in {b for row in arrays.clauses.values() for pair in row for b in pair}:
         union |= bits
     used[bits_to_ids(union, n)] = True
+    if task.axioms is not None:
+        used[sorted(task.axioms.facts())] = True
     return np.flatnonzero(used)
 
 
@@ -151,10 +153,10 @@ def compact(task: GroundTask) -> GroundTask:
     hit = hit[1]
     if not hit:
         return task
-    remap, facts, fact_index, actions, arrays = hit
+    remap, facts, fact_index, actions, arrays, axioms = hit
     return replace(task, facts=facts, fact_index=fact_index, actions=actions, arrays=arrays,
                    init=remap.bits(task.init), goal=remap.bits(task.goal),
-                   goal_neg=remap.bits(task.goal_neg))
+                   goal_neg=remap.bits(task.goal_neg), axioms=axioms)
 
 
 def _pieces(task: GroundTask, used: np.ndarray) -> tuple:
@@ -169,4 +171,5 @@ def _pieces(task: GroundTask, used: np.ndarray) -> tuple:
         arg_ids=a.arg_ids, objects=a.objects, bits=None,
     )
     fact_index = {atom: i for i, atom in enumerate(facts)}
-    return remap, facts, fact_index, CompactActions(task.actions, remap), arrays
+    axioms = None if task.axioms is None else task.axioms.remap(remap.new_of.tolist())
+    return remap, facts, fact_index, CompactActions(task.actions, remap), arrays, axioms

@@ -21,7 +21,7 @@ from avs_planner.cp.fact_rows import _PAD_NONE, _PAD_TRUE, _pad
 from avs_planner.cp.formulas import FormulaGrounder
 from avs_planner.cp.schema import LiftedSchema
 from avs_planner.cp.task import Atom
-from avs_planner.cp.unsupported import UnsupportedError, in_action
+from avs_planner.cp.unsupported import UnsupportedError, in_action, in_rule
 from avs_planner.errors import PlanningError
 
 if TYPE_CHECKING:  # UP's model, or the project's own (`pddl.lite`): the same methods
@@ -29,12 +29,16 @@ if TYPE_CHECKING:  # UP's model, or the project's own (`pddl.lite`): the same me
 
 
 def _read_params(nodes: Sequence[FNode]) -> frozenset[str]:
-    """The schema parameters the conditions mention: their CNF depends on nothing else."""
+    """The schema parameters the conditions mention: their CNF depends on nothing else. A
+    derived predicate's rule has its lifted `exists` variables among its parameters
+    (`?v:name`, as `formulas.py` keys a variable)."""
     stack, read = list(nodes), set()
     while stack:
         node = stack.pop()
         if node.is_parameter_exp():
             read.add("?" + node.parameter().name)
+        elif node.is_variable_exp():
+            read.add("?v:" + node.variable().name)
         stack.extend(node.args)
     return frozenset(read)
 
@@ -63,8 +67,9 @@ def _complex_rows(
                         {p: names[i] for p, i in zip(read, ids, strict=True)})
             for ids in distinct.tolist()
         ]
-    except PlanningError as exc:  # name the action, so the reader can place it
-        raise in_action(schema.name, exc) from None
+    except PlanningError as exc:  # name the action (or rule), so the reader can place it
+        raise (in_rule(schema.derives, exc) if schema.is_rule
+               else in_action(schema.name, exc)) from None
     keep = np.array([g[0] for g in grounded], dtype=bool)[inverse]
     pos = _pad([g[1] for g in grounded], _PAD_TRUE)[inverse]
     neg = _pad([g[2] for g in grounded], _PAD_NONE)[inverse]
@@ -82,7 +87,7 @@ def _ground_cnf(
     def code(atom: Atom) -> int:
         c = space.encode(atom)
         if c is None:
-            raise PlanningError(f"action {schema.name}: cannot ground condition atom {atom}")
+            raise PlanningError(f"{schema.what}: cannot ground condition atom {atom}")
         return c
 
     cnf = [c for node in schema.complex for c in formulas.cnf(node, binding)]

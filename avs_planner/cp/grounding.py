@@ -27,7 +27,13 @@ from avs_planner.cp.compact import compact
 from avs_planner.cp.derived import derived, ids_of, reachable, relevant, task_rows
 from avs_planner.cp.encoding import ConstantExpr, NumericValues
 from avs_planner.cp.formulas import FALSE, FormulaGrounder
-from avs_planner.cp.schema import LiftedSchema, compile_schemas, is_instantaneous
+from avs_planner.cp.schema import (
+    LiftedSchema,
+    axioms_of,
+    compile_schemas,
+    derived_names,
+    is_instantaneous,
+)
 from avs_planner.cp.settled import SettledAtoms, settled_atoms
 from avs_planner.cp.structure import GroundStructure, bitset, build_structure
 from avs_planner.cp.task import Atom, GroundTask, TaskArrays, WorldState
@@ -38,6 +44,8 @@ from avs_planner.pddl.model import ProbabilisticProblem
 
 if TYPE_CHECKING:  # or the project's own model (`pddl.lite`), read through the same methods
     from unified_planning.model import FNode, Problem
+
+    from avs_planner.cp.ground_axioms import GroundAxioms
 
 
 def world_state(problem: Problem) -> WorldState:
@@ -81,9 +89,10 @@ def _constant(value: FNode) -> bool | float | None:
 
 
 def static_fluent_names(problem: Problem) -> frozenset[str]:
-    """Fluents no effect assigns: UP's `get_static_fluents`, without the walk over every
-    expression UP also makes (for its unused fluents), which cost ~1 ms per cold call."""
-    changed = set()
+    """Fluents no effect assigns and no rule derives: UP's `get_static_fluents`, without the
+    walk over every expression UP also makes (for its unused fluents), which cost ~1 ms per
+    cold call."""
+    changed = set(derived_names(problem))
     for action in problem.actions:
         if not is_instantaneous(action) or action.simulated_effect is not None:
             return frozenset(f.name for f in problem.get_static_fluents())
@@ -238,6 +247,17 @@ class _HashOnce:
         )
 
 
+def _rule_schemas(pproblem: ProbabilisticProblem, static_names: frozenset[str]
+                  ) -> tuple[LiftedSchema, ...]:
+    """The derived predicates' rule schemas (`axioms.py`, imported only for a problem with
+    rules; so is `ground_axioms.py`)."""
+    if not axioms_of(pproblem.model):
+        return ()
+    from avs_planner.cp.axioms import compile_axioms
+
+    return compile_axioms(pproblem.model, static_names)
+
+
 class GroundingCache:
     """Keeps compiled schemas and ground structures for the last few (domain, objects, statics)."""
 
@@ -263,8 +283,10 @@ class GroundingCache:
         return value
 
     def schemas(self, pproblem: ProbabilisticProblem) -> tuple[LiftedSchema, ...]:
+        """The actions' schemas, then the derived predicates' rule schemas (if any)."""
         key, names = self._keys(pproblem)
-        return self._remember(self._schemas, key, lambda: compile_schemas(pproblem, names))
+        return self._remember(self._schemas, key, lambda: compile_schemas(pproblem, names)
+                              + _rule_schemas(pproblem, names))
 
     def _keys(self, pproblem: ProbabilisticProblem) -> tuple[tuple, frozenset[str]]:
         """The schema key and static fluent names of a problem, computed once per problem
@@ -277,6 +299,7 @@ class GroundingCache:
         static_names = static_fluent_names(problem)
         key = _HashOnce((
             tuple(problem.actions),
+            axioms_of(problem),
             tuple(sorted((k, str(v)) for k, v in pproblem.success.items())),
             tuple(str(m) for m in problem.quality_metrics),
             static_names,
@@ -394,6 +417,10 @@ def _ground(
 ) -> GroundTask:
     cache = DEFAULT_CACHE if cache is None else cache
     state = cache.initial_state(pproblem) if state is None else state
+    derived_predicates = derived_names(pproblem.model)
+    if derived_predicates:  # the rules decide derived atoms; a state gives basic ones only
+        state = WorldState(frozenset(a for a in state.true_atoms
+                                     if a[0] not in derived_predicates), state.values)
     structure = cache.structure(pproblem, state)
     st = structure
     n = len(st.facts)
@@ -412,12 +439,19 @@ def _ground(
     possible = may_apply & (probability > 0.0)
     if (may_apply != possible).any():  # else reachability over `possible` is `may_apply`
         possible = reachable(st, reached, possible)
-    kept = relevant(st, possible, goal, goal_neg)
+    rules = body = None
+    if derived_predicates:  # rule rows (reached like actions) leave `possible` here
+        rules, body = _split_rules(st, possible)
+    if body is None:
+        kept = relevant(st, possible, goal, goal_neg)
+    else:  # every fact a rule reads is needed, either way (an over-approximation)
+        needed = _bits(body[:n])
+        kept = relevant(st, possible, goal | needed, goal_neg | needed)
     cost = _evaluate(st, kept, values, "cost")
     _check(st, kept, cost, "cost")
     # effects on facts nothing reads are dropped (e.g. `visited` of ordinary places), so
     # states differing only there merge
-    read = np.zeros(n + 2, dtype=bool)
+    read = np.zeros(n + 2, dtype=bool) if body is None else body
     read[ids_of(goal | goal_neg)] = True
     kept_rows = np.flatnonzero(kept)
     read[np.take(st.pre, kept_rows, axis=0).ravel()] = True  # np.take: faster than a mask
@@ -433,11 +467,37 @@ def _ground(
                            map(d.clause_bits.__getitem__, with_clauses.tolist()), strict=True))
     read_mask = _bits(read[:n])
     cost, probability = np.take(cost, kept_rows), np.take(probability, kept_rows)
-    actions, arrays = _action_table(st, kept_rows, cost, probability, read, read_mask, clauses)
+    actions, arrays, axioms = _action_table(st, kept_rows, cost, probability, read,
+                                            read_mask, clauses, rules, derived_predicates)
+    if axioms is not None:
+        init = axioms.close(init)
     return compact(GroundTask(
         facts=structure.facts, fact_index=structure.fact_index, actions=actions,
         init=init, goal=goal, goal_neg=goal_neg, goal_impossible=impossible, arrays=arrays,
+        axioms=axioms,
     ))
+
+
+def _split_rules(st: GroundStructure, possible: np.ndarray
+                 ) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The possible rows of derived predicates' rules (taken out of `possible`, in place)
+    and every fact they read (bool over fact ids + pads), or (None, None) if there are no
+    rule rows. Rule schemas come after the actions', so their rows are the last ones."""
+    first = next((b.start for b in st.blocks if b.schema.is_rule), None)
+    if first is None:
+        return None, None
+    rows = first + np.flatnonzero(possible[first:])
+    possible[first:] = False
+    n = len(st.facts)
+    body = np.zeros(n + 2, dtype=bool)
+    body[np.take(st.pre, rows, axis=0).ravel()] = True
+    body[np.take(st.pre_neg, rows, axis=0).ravel()] = True
+    for row in rows.tolist():
+        for pos, neg in st.clauses.get(row, ()):
+            body[list(pos)] = True
+            body[list(neg)] = True
+    body[n:] = False
+    return rows, body
 
 
 def _not_blocked(st: GroundStructure, true_now: np.ndarray) -> np.ndarray:
@@ -461,15 +521,19 @@ def _not_blocked(st: GroundStructure, true_now: np.ndarray) -> np.ndarray:
 
 def _action_table(st: GroundStructure, kept_rows: np.ndarray, cost: np.ndarray,
                   probability: np.ndarray, read: np.ndarray, read_mask: int,
-                  clauses: dict) -> tuple[ActionTable, TaskArrays]:
-    """The action table and arrays of these rows, costs and probabilities: the previous
-    call's on the same structure if they are the same (a replan whose new state reaches the
-    same actions), so what consumers keep with the table (the native packer's task) is
-    reused; else new ones."""
-    key = (kept_rows.tobytes(), cost.tobytes(), probability.tobytes(), read_mask)
+                  clauses: dict, rules: np.ndarray | None = None,
+                  derived: frozenset[str] = frozenset()
+                  ) -> tuple[ActionTable, TaskArrays, GroundAxioms | None]:
+    """The action table and arrays of these rows, costs and probabilities, and the ground
+    rules of the `rules` rows: the previous call's on the same structure if they are the
+    same (a replan whose new state reaches the same actions and rules), so what consumers
+    keep with the table (the native packer's task, which holds the rules too) is reused;
+    else new ones."""
+    key = (kept_rows.tobytes(), cost.tobytes(), probability.tobytes(), read_mask,
+           None if rules is None else rules.tobytes())
     last = st.memo.get("last_table")
     if last is not None and last[0] == key:
-        return last[1], last[2]
+        return last[1], last[2], last[3]
     (pre, pre_neg, add, delete), bits = task_rows(st, kept_rows, read)
     arrays = TaskArrays(
         pre=pre, pre_neg=pre_neg, add=add, delete=delete, bits=bits,
@@ -477,5 +541,10 @@ def _action_table(st: GroundStructure, kept_rows: np.ndarray, cost: np.ndarray,
         arg_ids=np.take(st.arg_ids, kept_rows, axis=0), objects=st.space.names,
     )
     actions = ActionTable(st, kept_rows, cost, probability, read_mask)
-    st.memo["last_table"] = (key, actions, arrays)
-    return actions, arrays
+    axioms = None
+    if rules is not None:
+        from avs_planner.cp.ground_axioms import rules_of_rows
+
+        axioms = rules_of_rows(st, rules, derived)
+    st.memo["last_table"] = (key, actions, arrays, axioms)
+    return actions, arrays, axioms

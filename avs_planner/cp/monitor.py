@@ -63,11 +63,11 @@ def monitor(
     threshold: float = DEFAULT_PROBABILITY_THRESHOLD,
 ) -> MonitorReport:
     """Check `plan` (the steps still to execute) from `state` (default: `task.init`)."""
-    current = task.init if state is None else state
+    current = task.init if state is None else task.close(state)
     probability = 1.0
     assumed: list[tuple[str, float]] = []
     for i, step in enumerate(plan):
-        action = task.action(step.name, step.args)
+        action = task.action_in(step.name, step.args, current)
         if action is None or not action.applicable(current):
             if step.assumptive:
                 assumed.append((step.label, 0.0))
@@ -82,7 +82,7 @@ def monitor(
                 f"to {action.probability:.3g}", assumptions=tuple(assumed),
             )
         probability *= action.probability
-        current = action.apply(current)
+        current = task.successor(action, current)  # derived facts included
     if not task.is_goal(current):
         return MonitorReport(MonitorStatus.GOAL_NOT_REACHED, len(plan), None,
                              "the plan no longer reaches the goal", assumptions=tuple(assumed))

@@ -3,7 +3,9 @@
 The C core runs the same search as `avs_planner.cp.search` (same plan, same expanded and
 generated counts). This module turns the task into flat arrays: the actions once per action
 table (cached, so `GroundTask.with_init` replans reuse them), the initial state, goal,
-symmetries and options on every call. `AVAILABLE` says whether the extension was built.
+symmetries and options on every call; a task's derived predicates' rules go with its
+actions (the core closes each successor under them). `AVAILABLE` says whether the extension
+was built.
 """
 
 from __future__ import annotations
@@ -60,16 +62,17 @@ def pack_task(task: GroundTask):
     memo = getattr(task.actions, "memo", None)
     if memo is not None:  # an ActionTable: the packed task lives (and dies) with it
         hit = memo.get("native")
-        if hit is None or hit[0] is not task.facts:
-            hit = memo["native"] = (task.facts, _pack(task))
+        if hit is None or hit[0] is not task.facts or hit[2] is not task.axioms:
+            hit = memo["native"] = (task.facts, _pack(task), task.axioms)
         return hit[1]
     key = id(task.actions)
     hit = _packed.get(key)
-    if hit is not None and hit[0] is task.actions and hit[1] is task.facts:
+    if (hit is not None and hit[0] is task.actions and hit[1] is task.facts
+            and hit[3] is task.axioms):
         _packed.move_to_end(key)
         return hit[2]
     packed = _pack(task)
-    _packed[key] = (task.actions, task.facts, packed)  # strong refs: ids stay unique
+    _packed[key] = (task.actions, task.facts, packed, task.axioms)  # strong refs: ids stay
     while len(_packed) > _CACHE_SIZE:
         _packed.popitem(last=False)
     return packed
@@ -77,7 +80,38 @@ def pack_task(task: GroundTask):
 
 def _pack(task: GroundTask):
     base = task_arrays(task) if task.arrays is not None else task_args(task)
-    return _native.Task(*base, *merge_args(merge_task(task)))
+    return _native.Task(*base, *merge_args(merge_task(task)), *axiom_args(task))
+
+
+def axiom_args(task: GroundTask) -> tuple:
+    """The optional arguments of `_native.Task` for a task's derived predicates' rules: the
+    packed rules and, per action, the facts it reads through them (n_actions * W words, so
+    the core's commutation test sees them); none without rules."""
+    import numpy as np
+
+    axioms = task.axioms
+    if axioms is None or not len(axioms):
+        return ()
+    n_facts, n_words = len(task.facts), words(len(task.facts))
+    extra = np.zeros((len(task.actions), n_words), dtype="<u8")
+    derived = np.zeros(n_facts + 1, dtype=bool)  # the spare last slot: -1 padding reads it
+    derived[list(axioms.derived)] = True
+    if task.arrays is not None:  # only actions reading a derived fact are built
+        reading = np.zeros(len(task.actions), dtype=bool)
+        for m in (task.arrays.pre, task.arrays.pre_neg):
+            m = np.asarray(m, dtype=np.int64).reshape(len(task.actions), -1)
+            reading |= derived[m].any(axis=1)
+        reading[list(task.arrays.clauses)] = True
+        actions = task.steps(np.flatnonzero(reading).tolist())
+    else:
+        actions = list(task.actions)
+    n_bytes = 8 * n_words
+    for a in actions:
+        more = axioms.expanded_reads(a.reads) & ~a.reads
+        if more:
+            extra[a.index] = np.frombuffer(_bits(more, n_bytes, n_facts, a.label), "<u8")
+    return axioms.native_args().tobytes(), extra.tobytes()
+
 
 
 def merge_args(merge) -> tuple:
@@ -361,6 +395,18 @@ def _c_limit(limit: float | None) -> int:
     if limit is None or limit >= 2**62:
         return -1
     return int(limit)
+
+
+def closures(task: GroundTask, states: list[int]) -> list[int]:
+    """The C core's closure of each state under the task's rules, as the search closes its
+    successors (`ground_axioms.GroundAxioms.close` computes the same)."""
+    packed = pack_task(task)
+    n_facts = len(task.facts)
+    n_bytes = 8 * words(n_facts)
+    blob = _native.close(packed, b"".join(_bits(s, n_bytes, n_facts, "a state")
+                                          for s in states))
+    return [int.from_bytes(blob[i:i + n_bytes], "little")
+            for i in range(0, len(blob), n_bytes)]
 
 
 def estimates(

@@ -5,9 +5,10 @@ the active visual search paper (Göbelbecker et al.).
 main list ordered by f, LAMA's helpful-actions list and the goal-count lists, popped in
 turns with boosts), deferred evaluation of successors (`search_modes._lazy`, flushed after
 STALL expansions without progress), pruning (commuting orders, symmetries, the success
-threshold) and its stopping rules (node limit, timeout, patience). These share the search's
-state and run in its inner loop, so they stay one class; the C core `_native.c` ports it
-field for field (same plan, same expanded/generated counts). Callers go through
+threshold) and its stopping rules (node limit, timeout, patience); a successor of a task
+with derived predicates' rules is closed under them (`ground_axioms.py`). These share the
+search's state and run in its inner loop, so they stay one class; the C core `_native.c`
+ports it field for field (same plan, same expanded/generated counts). Callers go through
 `search.search`, which picks the engine.
 """
 
@@ -185,7 +186,9 @@ class _Search:
         key = (i, j)
         value = self.commutes.get(key)
         if value is None:
-            value = self.commutes[key] = self.task.actions[i].commutes_with(self.task.actions[j])
+            a, b, axioms = self.task.actions[i], self.task.actions[j], self.task.axioms
+            value = self.commutes[key] = (a.commutes_with(b) if axioms is None
+                                          else axioms.commutes(a, b))
         return value
 
     def evaluate(self, node: int) -> bool:
@@ -217,6 +220,7 @@ class _Search:
         expanded = 0
         actions = task.actions
         symmetries = self.symmetries
+        close = None if task.axioms is None else task.axioms.close  # derived facts
         while any(self.queues):
             node = self.pop()
             if not self.alive[node]:
@@ -261,6 +265,8 @@ class _Search:
                     if symmetries.checks and symmetries.prunes(a.index, state):
                         continue  # a mirror image with a lower object is explored
                     succ = (state & ~a.delete) | a.add
+                    if close is not None:
+                        succ = close(succ)
                     self.push(
                         succ, c + a.cost, p * a.probability, node, a.index, a.index in helpful
                     )

@@ -25,7 +25,8 @@ table reuses it), in C when the grounding extension is built (`_fixpoint.relaxed
 ~1.5 ms on p20); the numpy functions below are the fallback and the tests' reference (~9 ms).
 
 Relaxed action ids: the task's actions 0..A-1 (the merged-away ones take no part), then the
-merged actions, then the auxiliary ones; auxiliary facts are numbered after the task's facts.
+merged actions, then the auxiliary ones (the derived predicates' rules last, if the task has
+any); auxiliary facts are numbered after the task's facts.
 """
 
 from __future__ import annotations
@@ -91,16 +92,42 @@ class RelaxedMerge:
 
 def merge_task(task) -> RelaxedMerge:
     """The `RelaxedMerge` of a `GroundTask`, kept with a grounder's action table (its
-    `memo`) so the Python heuristics and the native packer share one."""
+    `memo`) so the Python heuristics and the native packer share one; a task's derived
+    predicates' rules are appended as auxiliary actions (`with_rules`)."""
     memo = getattr(task.actions, "memo", None)
+    axioms = getattr(task, "axioms", None)
     if memo is not None:
         hit = memo.get("relaxed_merge")
-        if hit is not None and hit[0] is task.facts:
+        if hit is not None and hit[0] is task.facts and hit[2] is axioms:
             return hit[1]
     merge = _merge_task(task)
+    if axioms is not None:
+        merge = with_rules(merge, *axioms.relaxed())
     if memo is not None:
-        memo["relaxed_merge"] = (task.facts, merge)
+        memo["relaxed_merge"] = (task.facts, merge, axioms)
     return merge
+
+
+def with_rules(merge: RelaxedMerge, pre: list[tuple[int, ...]], add: list[tuple[int, ...]]
+               ) -> RelaxedMerge:
+    """The merge with one more auxiliary action per rule (weight 0, counted in no estimate,
+    as the merge's own auxiliary actions): a derived fact is reached at the cost of the
+    rule's preconditions (`ground_axioms.py` says which literals those are)."""
+    def extend(off: np.ndarray, values: np.ndarray, rows: list[tuple[int, ...]]
+               ) -> tuple[np.ndarray, np.ndarray]:
+        more = np.cumsum([len(r) for r in rows], dtype=np.int64) + off[-1]
+        flat = np.fromiter((f for r in rows for f in r), dtype=np.int64)
+        return np.concatenate([off, more]), np.concatenate([values, flat])
+
+    pre_off, pre_v = extend(merge.pre_off, merge.pre, pre)
+    add_off, add_v = extend(merge.add_off, merge.add, add)
+    extra = len(pre)
+    return RelaxedMerge(
+        merge.n_facts, merge.n_rfacts, merge.n_actions, merge.n_merged, merge.away,
+        pre_off, pre_v, add_off, add_v,
+        np.concatenate([merge.weight_of, np.full(extra, -1, dtype=np.int64)]),
+        np.concatenate([merge.link, np.zeros(extra, dtype=np.int64)]),
+        merge.member_off, merge.members)
 
 
 def _merge_task(task) -> RelaxedMerge:

@@ -29,7 +29,8 @@ AtomTemplate = tuple[str, ...]  # (predicate, term, ...)
 
 @dataclass(frozen=True)
 class LiftedSchema:
-    """One action: parameters with their types, conditions split static/dynamic, effects."""
+    """One action (or a derived predicate's rule: `derives`): parameters with their types,
+    conditions split static/dynamic, effects."""
 
     name: str
     params: tuple[str, ...]
@@ -47,6 +48,19 @@ class LiftedSchema:
     complex: tuple[FNode, ...] = ()
     never: bool = False
     conditional: tuple[CondEffect, ...] = ()
+    derives: str = ""
+    """A derived predicate's rule (`axioms.py`), not an action: the predicate (`add` holds
+    its head, the conditions its body); rules are grounded like actions."""
+    stratum: int = 0  # a rule's stratum (`pddl.stratify`)
+
+    @property
+    def is_rule(self) -> bool:
+        return bool(self.derives)
+
+    @property
+    def what(self) -> str:
+        """How messages name it: `action NAME`, or `derived predicate NAME` for a rule."""
+        return f"derived predicate {self.derives}" if self.derives else f"action {self.name}"
 
 
 def atom_template(node: FNode) -> AtomTemplate:
@@ -102,6 +116,16 @@ def _split_effects(action: InstantaneousAction) -> tuple[list, list, list]:
             raise PlanningError(f"action {action.name}: non-constant effect {eff}")
         (add if eff.value.bool_constant_value() else delete).append(atom_template(eff.fluent))
     return add, delete, conditional
+
+
+def axioms_of(problem: object) -> tuple:
+    """The problem's derived predicates' rules (`pddl.lite.Axiom`; a UP problem has none)."""
+    return tuple(getattr(problem, "axioms", ()))
+
+
+def derived_names(problem: object) -> frozenset[str]:
+    """The predicates the problem's rules define."""
+    return frozenset(axiom.name for axiom in axioms_of(problem))
 
 
 def is_instantaneous(action: Action | lite.InstantaneousAction) -> bool:

@@ -34,7 +34,9 @@ _NAMED: OrderedDict[int, tuple[ProbabilisticProblem, frozenset[str]]] = OrderedD
 
 
 def _named_objects(pproblem: ProbabilisticProblem) -> frozenset[str]:
-    """Objects the domain or the goal names explicitly (PDDL constants, goal arguments);
+    """Objects the domain or the goal names explicitly (PDDL constants, goal arguments; a
+    derived predicate's rule is part of the domain: the closure of a state is then mirrored
+    by a swap of two objects no rule names, as derived facts are facts of the task);
     kept for the last few problem objects (a problem is not changed once planned)."""
     hit = _NAMED.get(id(pproblem))
     if hit is not None and hit[0] is pproblem:
@@ -55,6 +57,7 @@ def _walk_named(pproblem: ProbabilisticProblem) -> set[str]:
             roots.extend((eff.fluent, eff.value, eff.condition))
     for metric in problem.quality_metrics:
         roots.extend(getattr(metric, "costs", {}).values())
+    roots.extend(axiom.body for axiom in getattr(problem, "axioms", ()))  # derived predicates
     names: set[str] = set()
     stack = roots
     while stack:

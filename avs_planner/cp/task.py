@@ -8,9 +8,12 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from avs_planner.cp.ground_axioms import GroundAxioms
 
 Atom = tuple[str, ...]
 """A ground atom: (predicate, arg1, ..., argN), names as in the problem."""
@@ -138,19 +141,33 @@ class GroundTask:
     goal_impossible: bool = False
     by_signature: Mapping[tuple[str, ...], GroundAction] = field(default_factory=dict)
     arrays: TaskArrays | None = field(default=None, compare=False, repr=False)
+    axioms: GroundAxioms | None = field(default=None, compare=False, repr=False)
+    """Derived predicates' ground rules (`ground_axioms.py`), if the task has any: its
+    states hold the derived facts their basic facts imply (`init` is closed, and so is
+    every successor: `successor`)."""
 
     def is_goal(self, state: int) -> bool:
         return (state & self.goal) == self.goal and not (state & self.goal_neg)
 
+    def close(self, state: int) -> int:
+        """The state with its derived facts (the state itself when there are no rules)."""
+        return state if self.axioms is None else self.axioms.close(state)
+
+    def successor(self, action: GroundAction, state: int) -> int:
+        """The state `action` leads to from `state`, derived facts included."""
+        succ = (state & ~action.delete) | action.add
+        return succ if self.axioms is None else self.axioms.close(succ)
+
     def state_of(self, atoms: Iterable[Atom]) -> int:
-        """Bitset of the given atoms (atoms outside this task's fact table are ignored)."""
+        """Bitset of the given atoms (atoms outside this task's fact table are ignored),
+        closed under the task's rules (derived atoms among them are decided by the rules)."""
         bits = 0
         index = self.fact_index
         for atom in atoms:
             i = index.get(atom)
             if i is not None:
                 bits |= 1 << i
-        return bits
+        return self.close(bits)
 
     def atoms_of(self, state: int) -> list[Atom]:
         return [self.facts[i] for i in range(len(self.facts)) if state >> i & 1]
@@ -162,10 +179,26 @@ class GroundTask:
             return find(name, tuple(args))
         return self.by_signature.get((name.lower(), *(a.lower() for a in args)))
 
+    def action_in(self, name: str, args: Iterable[str], state: int) -> GroundAction | None:
+        """The ground action with this name and arguments that applies in `state`: of an
+        action split into copies by its effects' conditions (`conditional.py`; copies are
+        next to each other), the copy whose conditions hold there; else the first copy, or
+        None if the task has no such action."""
+        first = self.action(name, args)
+        if first is None or first.applicable(state):
+            return first
+        for i in range(first.index + 1, len(self.actions)):
+            copy = self.actions[i]
+            if copy.name != first.name or copy.args != first.args:
+                break
+            if copy.applicable(state):
+                return copy
+        return first
+
     def steps(self, indices: Iterable[int]) -> list[GroundAction]:
         """The actions at these indices (a plan); an `ActionTable` builds only these."""
         take = getattr(self.actions, "take", None)
         return take(indices) if take is not None else [self.actions[i] for i in indices]
 
     def with_init(self, init: int) -> GroundTask:
-        return replace(self, init=init)
+        return replace(self, init=self.close(init))

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from avs_planner.errors import PddlError
+from avs_planner.pddl.axioms import check_derived
 from avs_planner.pddl.diagnostics import Diagnostic
 from avs_planner.pddl.formulas import FormulaChecker, Usage
 from avs_planner.pddl.probabilistic import translate_domain
@@ -138,6 +139,7 @@ def _check_domain(domain: Domain, report: Report, usage: Usage) -> None:
         if action.effect is not None:
             checker.effect(action.effect, scope)
         check_action(action, report)
+    check_derived(domain, report, checker)
     for name, node in usage.changed_functions:
         if name in usage.probability_fluents:
             report.add(
@@ -182,13 +184,18 @@ def _check_names(domain: Domain, report: Report) -> None:
 
 
 def _unused_predicates(domain: Domain, usage: Usage, file: str) -> list[Diagnostic]:
+    """Predicates nothing reads: no action, goal or derived predicate's rule (a rule's
+    head defines its predicate, it does not use it)."""
     report = Report(file)
+    derived = domain.derived_names
     for name, sig in domain.predicates.items():
         if name not in usage.predicates:
+            what = ("derived predicate", "an action, a goal or another rule") if (
+                name in derived) else ("predicate", "an action or goal")
             report.add(
                 sig.atom,
                 "unused-predicate",
-                f"predicate '{name}' is never used by an action or goal",
+                f"{what[0]} '{name}' is never used by {what[1]}",
                 warning=True,
             )
     return report.items

@@ -38,15 +38,21 @@ ASSUMPTIVE_PREFIX = "assume-"
 
 @dataclass(frozen=True)
 class SourceMap:
-    """Where the reader found each action and the goal, so that what the grounder refuses
-    is named with FILE:LINE:COL (a task built in unified-planning directly has none)."""
+    """Where the reader found each action, each derived predicate's rules and the goal, so
+    that what the grounder refuses is named with FILE:LINE:COL (a task built in
+    unified-planning directly has none)."""
 
     actions: Mapping[str, SourcePosition] = field(default_factory=dict)  # by lower-case name
     goal: SourcePosition | None = None  # the :goal's formula
     goal_parts: tuple[SourcePosition, ...] = ()  # its conjuncts, nested `and`s flattened
+    rules: Mapping[str, SourcePosition] = field(default_factory=dict)
+    """Per derived predicate (lower-case), its first `(:derived ...)` rule."""
 
     def action(self, name: str) -> SourcePosition | None:
         return self.actions.get(name.lower())
+
+    def rule(self, name: str) -> SourcePosition | None:
+        return self.rules.get(name.lower())
 
     def goal_part(self, index: int, count: int) -> SourcePosition | None:
         """Conjunct `index` of `count` (as the grounder flattens the goal): its own position

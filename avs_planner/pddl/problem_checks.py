@@ -7,6 +7,7 @@ from itertools import product
 from typing import TYPE_CHECKING
 
 from avs_planner.errors import PddlError
+from avs_planner.pddl.axioms import check_init_fact
 from avs_planner.pddl.diagnostics import Diagnostic
 from avs_planner.pddl.formulas import FormulaChecker, Usage
 from avs_planner.pddl.sexpr import Atom, Node, SList, is_number, parse_sexprs
@@ -49,7 +50,7 @@ def check_problem(domain: Domain, source: PddlSource, usage: Usage) -> list[Diag
         FormulaChecker(domain, report, names, usage).goal(problem.goal, {})
         _disjunctive_goal(problem.goal, True, report)
         numeric_conditions(problem.goal, report, "unsupported-goal", "the goal")
-        _goal_true_in_init(problem, values.atoms, report)
+        _goal_true_in_init(problem, values.atoms, report, domain.derived_names)
     if problem.metric is not None:
         _check_metric(problem.metric, init_checker)
     _check_probabilities(domain, names, problem, usage, values.numbers, report)
@@ -115,7 +116,9 @@ def _check_init(problem: Problem, checker: FormulaChecker) -> InitValues:
     for fact in problem.init:
         if not isinstance(fact, SList) or not fact.items:
             checker.report.add(fact, "syntax", "expected a ground atom or (= (f ...) VALUE)")
-        elif fact.head() == "=":
+            continue
+        check_init_fact(checker.domain, fact, checker.report)
+        if fact.head() == "=":
             _init_assignment(fact, checker, values)
         elif fact.head() == "not":
             inner = fact.items[1] if len(fact.items) == 2 else None
@@ -223,9 +226,12 @@ def _disjunctive_goal(node: Node, positive: bool, report: Report) -> None:
         _disjunctive_goal(node.items[2], positive, report)
 
 
-def _goal_true_in_init(problem: Problem, atoms: set[GroundAtom], report: Report) -> None:
+def _goal_true_in_init(problem: Problem, atoms: set[GroundAtom], report: Report,
+                       derived: frozenset[str]) -> None:
+    """A goal of ground literals over basic facts that :init already makes true (a goal on
+    derived predicates would need their rules: not judged here)."""
     literals = _literals(problem.goal)
-    if literals is None or not literals:
+    if literals is None or not literals or any(fact[0] in derived for fact, _ in literals):
         return
     if all((fact in atoms) == positive for fact, positive in literals):
         report.add(

@@ -3,7 +3,8 @@
 Order: our own checks first (they know positions), then the probabilistic pre-pass, then
 the model of the translated text. That is the project's own (`lite`, built by
 `up_builder.build_lite`, without importing unified-planning) where it takes the text, with
-the UP problem of the same text built when someone asks for it (`ProbabilisticProblem.problem`);
+the UP problem of the same text built when someone asks for it (`ProbabilisticProblem.problem`;
+a domain with derived predicates, which only `lite` reads, has none: asking raises);
 else UP's (`_up_parse`: the fast builder, else UP's PDDLReader), and whatever UP still rejects
 becomes a `PddlError` with the position UP or pyparsing reported.
 """
@@ -64,9 +65,15 @@ def read_text(
     shared = any(d.code == NAME_CLASH for d in checked.lenient)
     up_read = partial(_up_read, text, problem_text, shared, translation.probabilities,
                       domain_name, problem_name)
+    derived = checked.domain.derived if checked.domain is not None else []
     read = _lite_read(text, problem_text, shared, translation.probabilities, domain_name)
-    if read is None:
+    if read is None or isinstance(read, Exception):
+        if derived:  # UP's reader does not take `:derived` either: say so, at the rule
+            raise _derived_error(derived[0].node, domain_name,
+                                 f"the project's model does not take this text ({read})")
         read = up_read()
+    elif derived:
+        read[0].counterpart = partial(_no_counterpart, derived[0].node, domain_name)
     else:
         read[0].counterpart = up_read  # the UP problem, when someone asks for it
     model, success = read
@@ -87,36 +94,53 @@ def _up_read(domain: str, problem_text: str, shared: bool, probabilities: Mappin
 
 def _lite_read(domain: str, problem_text: str, shared: bool,
                probabilities: Mapping[str, list], domain_name: str
-               ) -> tuple[lite.Problem, dict[str, Any]] | None:
-    """The project's own model of the text and its success expressions, or None where UP
-    reads it (a construct `lite` leaves to UP, or anything UP would refuse: UP's reading
-    then reports it as before). A probability our own code refuses (a `PddlError`) is
-    refused alike either way."""
+               ) -> tuple[lite.Problem, dict[str, Any]] | Exception | None:
+    """The project's own model of the text and its success expressions, or why not (None:
+    no reason given) where UP reads it (a construct `lite` leaves to UP, or anything UP
+    would refuse: UP's reading then reports it as before). A probability our own code
+    refuses (a `PddlError`) is refused alike either way."""
     try:
         model = build_lite(domain, problem_text, shared)
         success = {name: _success_expression(model, name, nodes, domain_name)
                    for name, nodes in probabilities.items()}
     except PddlError:
         raise
-    except Exception:  # noqa: BLE001 - Unsupported, ModelError, ...: UP reads it
-        return None
+    except Exception as exc:  # noqa: BLE001 - Unsupported, ModelError, ...: UP reads it
+        return exc
     return model, success
+
+
+def _derived_error(rule: SList, domain_name: str, why: str) -> PddlError:
+    return PddlError(f"derived predicates (:derived) are read by avs-planner's own model "
+                     f"only, and {why}", domain_name, rule.line, rule.column)
+
+
+def _no_counterpart(rule: SList, domain_name: str) -> tuple[Problem, dict[str, FNode]]:
+    """What `ProbabilisticProblem.problem` raises for a domain with derived predicates."""
+    raise _derived_error(rule, domain_name, "unified-planning's model (1.3) has no derived "
+                         "predicates: this task has no unified-planning problem (its engines "
+                         "and plan validators cannot take it)")
 
 
 def _sources(domain: Domain | None, problem_text: str, domain_name: str, problem_name: str
              ) -> SourceMap:
-    """Where each action's name and the goal (and each of its conjuncts) are written."""
+    """Where each action's name, each derived predicate's first rule and the goal (and each
+    of its conjuncts) are written."""
     actions = {} if domain is None else {
         name: SourcePosition(domain_name, a.atom.line, a.atom.column)
         for name, a in domain.actions.items()}
+    rules: dict[str, SourcePosition] = {}
+    for rule in domain.derived if domain is not None else ():
+        rules.setdefault(rule.atom.text, SourcePosition(domain_name, rule.node.line,
+                                                        rule.node.column))
     report = Report(problem_name)  # the text passed the checks: nothing is reported here
     define = find_define(parse_sexprs(problem_text, problem_name), "problem", report)
     goal = None if define is None else read_problem(define, report).goal
     if goal is None:
-        return SourceMap(actions)
+        return SourceMap(actions, rules=rules)
     parts = [SourcePosition(problem_name, n.line, n.column) for n in _conjuncts(goal)]
     return SourceMap(actions, SourcePosition(problem_name, goal.line, goal.column),
-                     tuple(parts))
+                     tuple(parts), rules)
 
 
 def _conjuncts(node: Node) -> list[Node]:

@@ -23,8 +23,9 @@ IMPLIES: dict[str, set[str]] = {
     ":fluents": {":numeric-fluents", ":object-fluents", ":action-costs"},
     ":numeric-fluents": {":action-costs"},
 }
-# Valid PDDL flags that unified-planning's reader does not accept.
-UNSUPPORTED = {":object-fluents", ":derived-predicates"}
+# Valid PDDL flags the planner cannot read (`:derived-predicates`, which unified-planning's
+# reader does not take either, is read by the project's own model, `lite`).
+UNSUPPORTED = {":object-fluents"}
 KNOWN = {
     *IMPLIES[":adl"],
     ":adl",

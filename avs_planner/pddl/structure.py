@@ -86,6 +86,17 @@ class Action:
 
 
 @dataclass
+class DerivedRule:
+    """A `(:derived (p ?x - t ...) BODY)` rule: the head's predicate and variables, and the
+    body (a goal description over the head's variables; None when missing)."""
+
+    node: SList
+    atom: Atom  # the predicate's name in the head
+    params: list[Typed]
+    body: Node | None = None
+
+
+@dataclass
 class Domain:
     """Everything declared in a domain file."""
 
@@ -99,9 +110,16 @@ class Domain:
     predicates: dict[str, Signature] = field(default_factory=dict)
     functions: dict[str, Signature] = field(default_factory=dict)
     actions: dict[str, Action] = field(default_factory=dict)
+    derived: list[DerivedRule] = field(default_factory=list)  # in the order written
     uses_typing: Node | None = None
     # Text edits (start, end, replacement) that make the domain readable by unified-planning
     repairs: list[tuple[int, int, str]] = field(default_factory=list)
+
+    @property
+    def derived_names(self) -> frozenset[str]:
+        """The predicates some `:derived` rule defines (its truth follows from the rules)."""
+        return frozenset(rule.atom.text for rule in self.derived
+                         if rule.atom.text in self.predicates)
 
     def common_supertype(self, names: list[str]) -> str:
         """The most specific type every one of `names` descends from."""
@@ -212,6 +230,8 @@ def _type_after_dash(items: list[Node], i: int, report: Report, either: Either |
 
 
 DOMAIN_ORDER = [":requirements", ":types", ":constants", ":predicates", ":functions", ":action"]
+# Sections written among the actions, in any order with them (PDDL 2.2's structure-defs)
+_LIKE_ACTIONS = (":durative-action", ":derived")
 PROBLEM_ORDER = [":domain", ":requirements", ":objects", ":init", ":goal", ":metric"]
 
 
@@ -222,7 +242,7 @@ def check_order(sections: list[Node], order: list[str], report: Report) -> None:
     for section in sections:
         if not isinstance(section, SList):
             continue
-        head = ":action" if section.head() == ":durative-action" else section.head()
+        head = ":action" if section.head() in _LIKE_ACTIONS else section.head()
         if head not in order:
             continue
         rank = order.index(head)
@@ -443,6 +463,19 @@ def _action_part(action: Action, key: Atom, value: Node, report: Report) -> None
         report.add(key, "syntax", f"unknown action keyword '{key.text}'")
 
 
+def _derived(domain: Domain, section: SList, report: Report) -> None:
+    """`(:derived (p ?x - t ...) BODY)`; what the head and body name is checked later."""
+    head = section.items[1] if len(section) > 1 else None
+    if (len(section) != 3 or not isinstance(head, SList) or not head.items
+            or not isinstance(head.items[0], Atom)):
+        report.add(section, "syntax", "expected (:derived (PREDICATE ?x - type ...) FORMULA)")
+        return
+    name = head.items[0]
+    check_name(name, report)
+    domain.derived.append(DerivedRule(section, name, typed_list(head.items[1:], report),
+                                      section.items[2]))
+
+
 def _unsupported(domain: Domain, section: SList, report: Report) -> None:
     report.add(section, "unsupported", f"'{section.head()}' is not supported by avs-planner")
 
@@ -455,7 +488,7 @@ _DOMAIN_SECTIONS = {
     ":functions": _functions,
     ":action": _action,
     ":durative-action": _unsupported,
-    ":derived": _unsupported,
+    ":derived": _derived,
     ":constraints": _unsupported,
 }
 

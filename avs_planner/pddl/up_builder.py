@@ -19,7 +19,9 @@ equivalence is tested on every file the project reads
 
 `build_lite` builds the same problem in the project's own model (`lite`), which offers the
 model calls the builder makes, without importing UP: `avs plan` grounds that one. What
-`lite` does not mirror raises there too, and the reader then builds UP's.
+`lite` does not mirror raises there too, and the reader then builds UP's. `lite` also
+reads derived predicates (`:derived`), which UP 1.3's model lacks: a domain with them has
+no UP counterpart.
 
 The work is split in three modules: `up_text` tokenizes the text and takes its sections
 apart (and defines `Unsupported`), `up_expressions` turns s-expressions into UP expressions
@@ -133,10 +135,11 @@ class _Builder(ExpressionTranslator):
     # ---- the whole read ---------------------------------------------------------------
 
     def build(self, domain: list[Sexpr], problem_nodes: list[Sexpr]) -> Problem:
+        derived = hasattr(self.kit, "Axiom")  # `lite` has derived predicates, UP 1.3 not
         domain_name, sections = define(domain, "domain")
-        parts = domain_parts(sections)
+        parts = domain_parts(sections, derived)
         problem_name, psections = define(problem_nodes, "problem")
-        pparts = problem_parts(psections)
+        pparts = problem_parts(psections, derived)
 
         problem = self.kit.Problem(domain_name, self.env,
                                    initial_defaults={self.tm.BoolType(): self.em.FALSE()})
@@ -156,6 +159,7 @@ class _Builder(ExpressionTranslator):
                         for name, groups in functions]
         constant_list = self._objects(constants)
         actions = [self._action(a, groups) for a, groups in action_groups]
+        axioms = [self._axiom(node) for node in parts["derived"]]
         object_list = self._objects(typed_groups(pparts.get(":objects", []),
                                                  variables=False))
         init = self._init(pparts[":init"])
@@ -180,6 +184,8 @@ class _Builder(ExpressionTranslator):
         for action in actions:
             self._add_effects(action, costs_from, costs)
             problem.add_action(action.action)
+        for axiom in axioms:
+            problem.add_axiom(axiom)
         for obj in object_list:
             problem.add_object(obj)
         problem.name = problem_name
@@ -273,6 +279,19 @@ class _Builder(ExpressionTranslator):
         if effect is not None:
             built.effects = self._effects(built.parameters, effect)
         return built
+
+    def _axiom(self, node: list[Sexpr]) -> Any:
+        """`(:derived (p ?x - t ...) BODY)` as the model's `Axiom` (only `lite` has them)."""
+        if len(node) != 3 or not isinstance(node[1], list) or not node[1]:
+            raise Unsupported("an odd :derived")
+        head = node[1]
+        fluent = self.fluents.get(str(head[0]))
+        if fluent is None:
+            raise Unsupported(f"derived predicate {head[0]} is not declared")
+        axiom = self.kit.Axiom(fluent, self._parameters(typed_groups(head[1:], True)),
+                               self.env)
+        axiom.set_body(self._expression(node[2], {p.name: p for p in axiom.parameters}, {}))
+        return axiom
 
     def _add_effects(self, built: _Action, costs_from: FNode | None,
                      costs: dict[InstantaneousAction, FNode]) -> None:

@@ -39,6 +39,7 @@ _REQUIREMENTS = frozenset(
     ":duration-inequalities :timed-initial-literals :timed-initial-effects :action-costs "
     ":method-preconditions :constraints :preferences :time :continuous-effects".split()
 )
+_DERIVED = frozenset((":derived-predicates",))  # what a model with derived predicates takes
 _DOMAIN_SECTIONS = (":requirements", ":types", ":constants", ":predicates", ":functions")
 _PROBLEM_SECTIONS = (":domain", ":requirements", ":objects", ":init", ":goal", ":metric")
 TRAJECTORY = frozenset(("always", "sometime", "sometime-before", "sometime-after",
@@ -133,22 +134,24 @@ def needs_object(groups: TypedGroups) -> bool:
     return any(parent in (None, OBJECT) for _, parent in groups)
 
 
-def domain_parts(sections: list[Sexpr]) -> dict[str, Any]:
-    """The sections by keyword, in the order UP's grammar requires; `actions` a list."""
-    parts: dict[str, Any] = {"actions": []}
+def domain_parts(sections: list[Sexpr], derived: bool = False) -> dict[str, Any]:
+    """The sections by keyword, in the order UP's grammar requires; `actions` a list. With
+    `derived` (a model that has derived predicates, `lite`), `:derived` rules too, among the
+    actions, in `derived` (UP's grammar has none: the builder of UP's model leaves them)."""
+    parts: dict[str, Any] = {"actions": [], "derived": []}
     done = -1
     for section in sections:
         assert isinstance(section, list)
         key = section[0]
-        if key == ":action":
+        if key == ":action" or (key == ":derived" and derived):
             done = len(_DOMAIN_SECTIONS)
-            parts["actions"].append(section)
+            parts["actions" if key == ":action" else "derived"].append(section)
             continue
         if key not in _DOMAIN_SECTIONS or _DOMAIN_SECTIONS.index(key) <= done:
             raise Unsupported(f"domain section {key} (or out of UP's order)")
         done = _DOMAIN_SECTIONS.index(key)
         parts[key] = section[1:]
-    check_requirements(parts.get(":requirements"))
+    check_requirements(parts.get(":requirements"), _DERIVED if derived else frozenset())
     if ":types" in parts and not parts[":types"]:
         raise Unsupported("empty :types")
     if ":predicates" in parts:
@@ -158,7 +161,7 @@ def domain_parts(sections: list[Sexpr]) -> dict[str, Any]:
     return parts
 
 
-def problem_parts(sections: list[Sexpr]) -> dict[str, Any]:
+def problem_parts(sections: list[Sexpr], derived: bool = False) -> dict[str, Any]:
     """The sections by keyword, in the order UP's grammar requires; `:goal` unwrapped."""
     parts: dict[str, Any] = {}
     done = -1
@@ -172,7 +175,7 @@ def problem_parts(sections: list[Sexpr]) -> dict[str, Any]:
     domain = parts.get(":domain")
     if domain is None or len(domain) != 1 or not is_name(domain[0]):
         raise Unsupported("no (:domain NAME)")
-    check_requirements(parts.get(":requirements"))
+    check_requirements(parts.get(":requirements"), _DERIVED if derived else frozenset())
     init = parts.get(":init")
     if init is None or not all(isinstance(i, list) and i for i in init):
         raise Unsupported("no :init, or one UP's grammar does not take")
@@ -188,12 +191,14 @@ def problem_parts(sections: list[Sexpr]) -> dict[str, Any]:
     return parts
 
 
-def check_requirements(items: list[Sexpr] | None) -> None:
-    """UP's grammar knows a fixed list; `:hierarchy` and `:contingent` make other kinds
-    of problem (left to UP)."""
+def check_requirements(items: list[Sexpr] | None, extra: frozenset[str] = frozenset()
+                       ) -> None:
+    """UP's grammar knows a fixed list (plus `extra`, flags the model being built takes);
+    `:hierarchy` and `:contingent` make other kinds of problem (left to UP)."""
     if items is None:
         return
-    if not items or any(not isinstance(r, str) or r not in _REQUIREMENTS for r in items):
+    known = _REQUIREMENTS | extra
+    if not items or any(not isinstance(r, str) or r not in known for r in items):
         raise Unsupported("a requirement the builder does not take")
 
 

@@ -25,7 +25,8 @@ compares both models, printed and ground, on every file the project reads.
 The modules, each one concept: `kinds` (node and effect kinds, `ModelError`), `declarations`
 (types and their manager, parameters, variables, objects, fluents), `nodes` (the expression
 node and the walks finding its fluents and free variables), `expression_manager` (one node per
-content, typed and checked, with UP's shortcuts), `interning` (the weak-valued tables behind
+content, typed and checked, with UP's shortcuts), `axioms` (derived predicates' rules,
+which UP's model lacks), `interning` (the weak-valued tables behind
 the managers: a node or type is kept while something holds it, so a process reading many
 texts does not accumulate them), `simplifier`, `shared_environment` (the managers reads
 share), `actions` (actions and effects), `metrics` and `problem` (with its UP
@@ -34,6 +35,7 @@ names is imported here.
 """
 
 from avs_planner.pddl.lite.actions import Effect, InstantaneousAction
+from avs_planner.pddl.lite.axioms import Axiom
 from avs_planner.pddl.lite.declarations import (
     BOOL,
     INT,
@@ -65,10 +67,10 @@ from avs_planner.pddl.lite.shared_environment import (
 from avs_planner.pddl.lite.simplifier import Simplifier
 
 __all__ = [
-    "BOOL", "ENVIRONMENT", "INT", "REAL", "SIMPLIFIER", "Effect", "EffectKind", "Environment",
-    "ExpressionManager", "FNode", "Fluent", "FreeVarsExtractor", "InstantaneousAction",
-    "MaximizeExpressionOnFinalState", "MinimizeActionCosts", "MinimizeExpressionOnFinalState",
-    "MinimizeMakespan", "ModelError", "Object", "OperatorKind", "Parameter", "Problem",
-    "Simplifier", "Type", "TypeManager", "UserType", "Variable", "environment", "free_fluents",
-    "free_variables", "is_lite",
+    "BOOL", "ENVIRONMENT", "INT", "REAL", "SIMPLIFIER", "Axiom", "Effect", "EffectKind",
+    "Environment", "ExpressionManager", "FNode", "Fluent", "FreeVarsExtractor",
+    "InstantaneousAction", "MaximizeExpressionOnFinalState", "MinimizeActionCosts",
+    "MinimizeExpressionOnFinalState", "MinimizeMakespan", "ModelError", "Object",
+    "OperatorKind", "Parameter", "Problem", "Simplifier", "Type", "TypeManager", "UserType",
+    "Variable", "environment", "free_fluents", "free_variables", "is_lite",
 ]

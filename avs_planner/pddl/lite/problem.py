@@ -7,6 +7,7 @@ from collections.abc import Callable, Iterable, Iterator, Mapping
 from typing import Any
 
 from avs_planner.pddl.lite.actions import InstantaneousAction
+from avs_planner.pddl.lite.axioms import Axiom
 from avs_planner.pddl.lite.declarations import BOOL, Fluent, Object, Type, UserType
 from avs_planner.pddl.lite.kinds import ModelError
 from avs_planner.pddl.lite.metrics import _Metric
@@ -32,6 +33,7 @@ class Problem:
         self._fluents: dict[str, Fluent] = {}
         self._fluents_defaults: dict[Fluent, FNode] = {}
         self._actions: dict[str, InstantaneousAction] = {}
+        self._axioms: list[Axiom] = []
         self._objects: dict[str, Object] = {}
         self._type_names: dict[str, UserType] = {}
         self._initial_value: dict[FNode, FNode] = {}
@@ -108,6 +110,14 @@ class Problem:
         for action in actions:
             self.add_action(action)
 
+    def add_axiom(self, axiom: Axiom) -> None:
+        """A rule of a derived predicate (UP's model has none: see `axioms.py`)."""
+        if self._fluents.get(axiom.name) is not axiom.head:
+            raise ModelError(f"derived predicate {axiom.name} is not a fluent of the problem")
+        self._axioms.append(axiom)
+        for parameter in axiom.parameters:
+            self._add_user_type(parameter.type)
+
     def set_initial_value(self, fluent: Any, value: Any) -> None:
         fluent_exp, value_exp = self._env.expression_manager.auto_promote(fluent, value)
         if not fluent_exp.is_fluent_exp():
@@ -143,6 +153,11 @@ class Problem:
     @property
     def actions(self) -> list[InstantaneousAction]:
         return list(self._actions.values())
+
+    @property
+    def axioms(self) -> list[Axiom]:
+        """The derived predicates' rules, in the order read."""
+        return list(self._axioms)
 
     @property
     def all_objects(self) -> list[Object]:
@@ -191,8 +206,9 @@ class Problem:
         return self._type_names[name]
 
     def get_static_fluents(self) -> set[Fluent]:
-        """Fluents no effect changes."""
+        """Fluents no effect changes and no rule derives."""
         changed = {e.fluent.fluent().name for a in self._actions.values() for e in a.effects}
+        changed.update(axiom.name for axiom in self._axioms)
         return {f for f in self._fluents.values() if f.name not in changed}
 
 

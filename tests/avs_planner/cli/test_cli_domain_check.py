@@ -20,6 +20,9 @@ def _broken_files(case: dict, tmp_path: Path) -> tuple[Path, Path, str]:
         "domain": (DATA / "base-domain.pddl").read_text(),
         "problem": (DATA / "base-problem.pddl").read_text(),
     }
+    also = case.get("also")  # one more replacement, made first
+    if also is not None:
+        files[also["file"]] = files[also["file"]].replace(also["old"], also["new"])
     broken = files[case["file"]].replace(case["old"], case["new"])
     files[case["file"]] = broken
     index = (broken.rfind if case.get("last") else broken.find)(case["anchor"])

@@ -1,0 +1,5 @@
+(define (problem blocks-derived-1)
+  (:domain blocks-derived)
+  (:objects a b c - block)
+  (:init (on a b) (ontable b) (ontable c))
+  (:goal (and (above c a) (ontable b))))

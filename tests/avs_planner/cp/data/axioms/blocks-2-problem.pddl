@@ -1,0 +1,5 @@
+(define (problem blocks-derived-2)
+  (:domain blocks-derived)
+  (:objects a b c d e - block)
+  (:init (on a b) (on b c) (ontable c) (on d e) (ontable e))
+  (:goal (and (above a e) (above c d) (on b c) (not (clear b)))))

@@ -1,0 +1,5 @@
+(define (problem blocks-derived-3)
+  (:domain blocks-derived)
+  (:objects a b c d e f - block)
+  (:init (on f e) (on e d) (on d c) (on c b) (on b a) (ontable a))
+  (:goal (and (above a f) (above b e) (ontable f) (clear a))))

@@ -1,0 +1,6 @@
+(define (problem mini-psr-1)
+  (:domain mini-psr)
+  (:objects b1 - breaker  s1 s2 s3 - switch  l1 l2 l3 - line)
+  (:init (con b1 s1) (con s1 l1) (con l1 s2) (con s2 l2) (con l1 s3) (con s3 l3)
+         (closed l1) (closed l2) (closed l3) (closed s3) (faulty l3))
+  (:goal (and (fed l2) (safe) (not (tripped)))))

@@ -1,0 +1,11 @@
+(define (problem mini-psr-3)
+  (:domain mini-psr)
+  (:objects b1 b2 b3 - breaker  s1 s2 s3 s4 s5 s6 s7 s8 - switch
+            l1 l2 l3 l4 l5 l6 - line)
+  (:init (con b1 s1) (con s1 l1) (con l1 s2) (con s2 l2) (con l2 s3) (con s3 l3)
+         (con b2 s4) (con s4 l4) (con l4 s5) (con s5 l5) (con l5 s6) (con s6 l3)
+         (con b3 s7) (con s7 l6) (con l6 s8) (con s8 l5)
+         (con l3 s3) (con l3 s6) (con l5 s5) (con l5 s8)
+         (closed l1) (closed l2) (closed l3) (closed l4) (closed l5) (closed l6)
+         (closed s3) (closed s6) (closed s8) (faulty l3) (faulty l6))
+  (:goal (and (fed l2) (fed l4) (fed l5) (safe) (not (tripped)))))
