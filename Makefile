@@ -11,7 +11,8 @@ $(BIN)/python:
 
 # Stamp files: reinstall when pyproject.toml, setup.py or the C search core change (the
 # install compiles the extensions in avs_planner/cp in place).
-NATIVE := setup.py avs_planner/cp/_native.c avs_planner/cp/_fixpoint.c avs_planner/cp/_ground.c
+NATIVE := setup.py avs_planner/cp/_native.c avs_planner/cp/_native_axioms.h avs_planner/cp/_fixpoint.c \
+	avs_planner/cp/_ground.c
 
 # constraints.txt: the tested set of versions (`make constraints` refreshes it)
 $(VENV)/.installed: pyproject.toml constraints.txt $(NATIVE) | $(BIN)/python
