@@ -17,6 +17,7 @@ from unified_planning.engines.plan_validator import SequentialPlanValidator
 from unified_planning.shortcuts import OneshotPlanner, get_environment
 
 import avs_planner.up_engine  # noqa: F401 - registers the "avs" engine
+from avs_planner.cli import main
 from avs_planner.cp import compact, goal, native
 from avs_planner.cp.continual import ContinualPlanner, Decision
 from avs_planner.cp.grounding import GroundingCache, ground
@@ -136,14 +137,28 @@ def test_rules_grow_with_the_ground_formula_not_its_normal_form() -> None:
     Semantics(task.model).check_plan(steps(result))
 
 
-def test_a_goal_too_large_to_ground_is_refused_naming_it(
-        monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_goal_too_large_to_ground_is_refused_at_one_place(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """What the grounder still refuses in a goal, `avs plan` and `avs domain check` (which
+    grounds each problem) refuse at the same position, without a traceback."""
     monkeypatch.setattr(goal, "MAX_GOAL_ATOMS", 5)
     text = lift_problem("(forall (?p - passenger) (exists (?f - floor) (or (at ?p ?f) "
                         "(lift-at ?f))))")
     with pytest.raises(UnsupportedError, match=r"^p\.pddl:4:10: unsupported goal condition "
                        r".*: the goal grounds to more than 5 atoms"):
         ground(read_text(LIFT, text, "d.pddl", "p.pddl"), cache=GroundingCache())
+    (tmp_path / "d.pddl").write_text(LIFT)
+    (tmp_path / "p.pddl").write_text(text)
+    domain, problem = str(tmp_path / "d.pddl"), str(tmp_path / "p.pddl")
+    assert main(["plan", domain, problem]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"avs: error: {problem}:4:10: unsupported goal condition ")
+    assert "Traceback" not in err
+    assert main(["domain", "check", domain, problem]) == 1
+    out = capsys.readouterr().out
+    assert f"{problem}:4:10: error: unsupported goal condition " in out
+    assert "more than 5 atoms" in out
 
 
 def test_a_fluent_named_like_the_goal_moves_the_goal_aside() -> None:
