@@ -12,14 +12,14 @@ from pathlib import Path
 
 import pytest
 
+from avs_planner.cp import native
 from avs_planner.cp.planner import plan
 from avs_planner.cp.search import PlanStatus, SearchOptions
 from avs_planner.pddl import read_text
 from tests.avs_planner.cp.derived_semantics import Atom, Semantics
-from tests.avs_planner.cp.test_cp_goals import DOMAIN as LIFT
-from tests.avs_planner.cp.test_cp_goals import ENGINES
-from tests.avs_planner.cp.test_cp_goals import _problem as lift_problem
+from tests.avs_planner.cp.pddl_cases import LIFT, lift_problem
 
+ENGINES = ["python", "native"] if native.AVAILABLE else ["python"]
 DATA = Path(__file__).parent / "data" / "axioms"
 BLOCKS = (DATA / "blocks-domain.pddl").read_text()
 BLOCKS_PROBLEM = (DATA / "blocks-1-problem.pddl").read_text()

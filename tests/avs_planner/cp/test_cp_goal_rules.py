@@ -29,12 +29,11 @@ from avs_planner.cp.unsupported import UnsupportedError
 from avs_planner.pddl import read_files, read_text
 from avs_planner.up_engine import to_up_plan
 from tests.avs_planner.cp.derived_semantics import Semantics
+from tests.avs_planner.cp.pddl_cases import LIFT, lift_problem
 from tests.avs_planner.cp.test_cp_axioms import TOGGLE_DOMAIN, TOGGLE_PROBLEM
-from tests.avs_planner.cp.test_cp_goals import DOMAIN as LIFT
-from tests.avs_planner.cp.test_cp_goals import ENGINES
-from tests.avs_planner.cp.test_cp_goals import _problem as lift_problem
 from tests.ipc import IPC
 
+ENGINES = ["python", "native"] if native.AVAILABLE else ["python"]
 DATA = Path(__file__).parent / "data"
 ROOT = Path(__file__).resolve().parents[3]
 get_environment().credits_stream = None
