@@ -27,7 +27,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="plan a (probabilistic) PDDL problem",
         description="Find a plan minimising c(pi) + R(1 - p(pi)) (Goebelbecker et al., A Planning "
         "Approach to Active Visual Search in Large Environments). Reads PDDL 2.1 (STRIPS, "
-        "ADL, action costs) with derived predicates (:derived) and PPDDL's single-outcome "
+        "ADL, action costs) with derived predicates (:derived), any goal formula (or, "
+        "exists, imply, ... compiled into a derived predicate) and PPDDL's single-outcome "
         "probabilistic effects; domains/README.md has the details. Exit codes: "
         "0 solved, 1 bad input, 2 unsolvable / no plan with p > 0 (or above --min-success), "
         "3 timeout or node limit with no plan found yet (with one found, the best so far is "

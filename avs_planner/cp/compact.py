@@ -144,12 +144,13 @@ def compact(task: GroundTask) -> GroundTask:
     memo = getattr(task.actions, "memo", None)
     if task.arrays is None or memo is None or n < MIN_FACTS:
         return task
-    key = (task.goal, task.goal_neg)  # the goal's facts are kept too
+    # the goal's facts are kept too, and the rules' (a goal compiled to rules has its own)
+    key = (task.goal, task.goal_neg, len(task.facts))
     hit = memo.get("compact")
-    if hit is None or hit[0] != key:
+    if hit is None or hit[0] != key or hit[2] is not task.axioms:
         used = _used(task)
         pieces = _pieces(task, used) if len(used) <= MAX_USED_SHARE * n else ()
-        hit = memo["compact"] = (key, pieces)
+        hit = memo["compact"] = (key, pieces, task.axioms)
     hit = hit[1]
     if not hit:
         return task

@@ -26,7 +26,7 @@ from avs_planner.cp.action_table import ActionTable
 from avs_planner.cp.compact import compact
 from avs_planner.cp.derived import derived, ids_of, reachable, relevant, task_rows
 from avs_planner.cp.encoding import ConstantExpr, NumericValues
-from avs_planner.cp.formulas import FALSE, FormulaGrounder
+from avs_planner.cp.goal import ground_goal, with_goal_rules
 from avs_planner.cp.schema import (
     LiftedSchema,
     axioms_of,
@@ -100,83 +100,6 @@ def static_fluent_names(problem: Problem) -> frozenset[str]:
     if problem.events or problem.processes or problem.timed_effects:
         return frozenset(f.name for f in problem.get_static_fluents())
     return frozenset(f.name for f in problem.fluents if f.name not in changed)
-
-
-def _goal(problem: Problem, structure: GroundStructure, true_atoms: frozenset[Atom]
-          ) -> tuple[int, int, bool]:
-    """Goal bitsets (positive, negative) and whether a goal atom no action touches (so its
-    truth is the initial state's) makes it impossible."""
-    pos = neg = 0
-    index = structure.fact_index
-    literals, impossible = _goal_literals(problem)
-    for atom, negated in literals:
-        i = index.get(atom)
-        if i is None:
-            # never mentioned by any action: its truth is fixed by the initial state
-            impossible |= (atom in true_atoms) == negated
-            continue
-        if negated:
-            neg |= 1 << i
-        else:
-            pos |= 1 << i
-    return pos, neg, impossible or bool(pos & neg)
-
-
-def _goal_literals(problem: Problem) -> tuple[list[tuple[Atom, bool]], bool]:
-    """The goal as (atom, negated) literals. A conjunction of literals is read directly;
-    anything else (a `forall` over objects, an `imply`, an `exists` with one way to hold) is
-    grounded over the problem's objects (`FormulaGrounder`, nothing decided as static) and
-    must come out a conjunction of literals: a goal that stays a disjunction is refused,
-    naming it. Also whether a part of it can never hold (a `forall` over a false body)."""
-    literals: list[tuple[Atom, bool]] = []
-    grounder, impossible = None, False
-    conds = [cond for goal in problem.goals for cond in _flatten(goal)]
-    for part, cond in enumerate(conds):
-        negated = cond.is_not()
-        inner = cond.arg(0) if negated else cond
-        if inner.is_fluent_exp() and all(a.is_object_exp() for a in inner.args):
-            literals.append(((inner.fluent().name, *(a.object().name for a in inner.args)),
-                             negated))
-            continue
-        if grounder is None:
-            grounder = FormulaGrounder(
-                frozenset(), set(), lambda t: [o.name for o in problem.objects(t)])
-        try:
-            cnf = grounder.cnf(cond, {})
-        except PlanningError as exc:
-            raise UnsupportedError(_goal_message(cond, str(exc)),
-                                   goal_part=(part, len(conds))) from None
-        if cnf == FALSE:
-            impossible = True
-            continue
-        for clause in cnf:
-            if len(clause) != 1:
-                raise UnsupportedError(
-                    f"unsupported goal condition {cond}: it grounds to a disjunction "
-                    f"({' or '.join(_literal(a, p) for a, p in sorted(clause))}); goals "
-                    "must ground to a conjunction of literals", goal_part=(part, len(conds)))
-            (atom, positive), = clause
-            literals.append((atom, not positive))
-    return literals, impossible
-
-
-def _goal_message(cond: FNode, detail: str) -> str:
-    """`detail` about the goal conjunct `cond`, without naming it twice."""
-    own = f"unsupported condition {cond} "
-    if detail.startswith(own):  # the conjunct itself is the construct refused
-        return "unsupported goal condition " + detail.removeprefix("unsupported condition ")
-    return f"unsupported goal condition {cond}: {detail}"
-
-
-def _literal(atom: Atom, positive: bool) -> str:
-    text = f"({' '.join(atom)})"
-    return text if positive else f"(not {text})"
-
-
-def _flatten(node: FNode) -> list[FNode]:
-    if node.is_and():
-        return [c for a in node.args for c in _flatten(a)]
-    return [node]
 
 
 def _evaluate(st: GroundStructure, rows: np.ndarray, values: NumericValues,
@@ -426,7 +349,8 @@ def _ground(
     n = len(st.facts)
     init_ids = [i for i in map(st.fact_index.get, state.true_atoms) if i is not None]
     init = bitset(init_ids)
-    goal, goal_neg, impossible = _goal(pproblem.model, st, state.true_atoms)
+    goal = ground_goal(pproblem.model, st.fact_index, state.true_atoms)
+    wanted, unwanted = goal.wanted
     reached = np.zeros(n + 2, dtype=bool)
     reached[init_ids] = True
     reached[n] = True  # the padding of preconditions
@@ -443,16 +367,16 @@ def _ground(
     if derived_predicates:  # rule rows (reached like actions) leave `possible` here
         rules, body = _split_rules(st, possible)
     if body is None:
-        kept = relevant(st, possible, goal, goal_neg)
+        kept = relevant(st, possible, wanted, unwanted)
     else:  # every fact a rule reads is needed, either way (an over-approximation)
         needed = _bits(body[:n])
-        kept = relevant(st, possible, goal | needed, goal_neg | needed)
+        kept = relevant(st, possible, wanted | needed, unwanted | needed)
     cost = _evaluate(st, kept, values, "cost")
     _check(st, kept, cost, "cost")
     # effects on facts nothing reads are dropped (e.g. `visited` of ordinary places), so
     # states differing only there merge
     read = np.zeros(n + 2, dtype=bool) if body is None else body
-    read[ids_of(goal | goal_neg)] = True
+    read[ids_of(wanted | unwanted)] = True
     kept_rows = np.flatnonzero(kept)
     read[np.take(st.pre, kept_rows, axis=0).ravel()] = True  # np.take: faster than a mask
     read[np.take(st.pre_neg, kept_rows, axis=0).ravel()] = True
@@ -469,12 +393,16 @@ def _ground(
     cost, probability = np.take(cost, kept_rows), np.take(probability, kept_rows)
     actions, arrays, axioms = _action_table(st, kept_rows, cost, probability, read,
                                             read_mask, clauses, rules, derived_predicates)
+    facts, fact_index = structure.facts, structure.fact_index
+    if goal.rules:  # a goal that is not a conjunction of literals: one derived fact
+        facts, fact_index, axioms = with_goal_rules(facts, fact_index, axioms, goal,
+                                                    actions.memo)
     if axioms is not None:
         init = axioms.close(init)
+    goal_pos, goal_neg = goal.task_goal
     return compact(GroundTask(
-        facts=structure.facts, fact_index=structure.fact_index, actions=actions,
-        init=init, goal=goal, goal_neg=goal_neg, goal_impossible=impossible, arrays=arrays,
-        axioms=axioms,
+        facts=facts, fact_index=fact_index, actions=actions, init=init, goal=goal_pos,
+        goal_neg=goal_neg, goal_impossible=goal.impossible, arrays=arrays, axioms=axioms,
     ))
 
 

@@ -96,7 +96,7 @@ def axiom_args(task: GroundTask) -> tuple:
     extra = np.zeros((len(task.actions), n_words), dtype="<u8")
     derived = np.zeros(n_facts + 1, dtype=bool)  # the spare last slot: -1 padding reads it
     derived[list(axioms.derived)] = True
-    if task.arrays is not None:  # only actions reading a derived fact are built
+    if task.arrays is not None and len(task.actions):  # only actions reading a derived fact
         reading = np.zeros(len(task.actions), dtype=bool)
         for m in (task.arrays.pre, task.arrays.pre_neg):
             m = np.asarray(m, dtype=np.int64).reshape(len(task.actions), -1)

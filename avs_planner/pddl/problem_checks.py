@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from fractions import Fraction
 from itertools import product
 from typing import TYPE_CHECKING
@@ -19,6 +20,7 @@ from avs_planner.pddl.structure import (
     Typed,
     find_define,
     read_problem,
+    typed_list,
 )
 from avs_planner.pddl.support import numeric_conditions, shown
 
@@ -48,9 +50,8 @@ def check_problem(domain: Domain, source: PddlSource, usage: Usage) -> list[Diag
     values = _check_init(problem, init_checker)
     if problem.goal is not None:
         FormulaChecker(domain, report, names, usage).goal(problem.goal, {})
-        _disjunctive_goal(problem.goal, True, report)
         numeric_conditions(problem.goal, report, "unsupported-goal", "the goal")
-        _goal_true_in_init(problem, values.atoms, report, domain.derived_names)
+        _goal_true_in_init(problem, values.atoms, report, domain, names)
     if problem.metric is not None:
         _check_metric(problem.metric, init_checker)
     _check_probabilities(domain, names, problem, usage, values.numbers, report)
@@ -203,37 +204,11 @@ def _check_probabilities(
                 )
 
 
-def _disjunctive_goal(node: Node, positive: bool, report: Report) -> None:
-    """The planner's goal is a conjunction of literals once quantifiers are grounded: a
-    `forall` over objects is one, an `or`, `exists` or `imply` (or an `and`/`forall` under a
-    `not`) is not. Reported here with its position, as `avs plan` would refuse it."""
-    if not isinstance(node, SList) or not node.items:
-        return
-    head = node.head()
-    if head == "not" and len(node.items) == 2:
-        _disjunctive_goal(node.items[1], not positive, report)
-        return
-    disjunctive = head in ("or", "exists", "imply") if positive else head in ("and", "forall")
-    if disjunctive:
-        report.add(node, "unsupported-goal", f"a goal that is a disjunction ({head}"
-                   f"{'' if positive else ' under a not'}) is not supported: the planner "
-                   "reaches a conjunction of literals (forall over objects is fine)")
-        return
-    if head in ("and", "or"):
-        for child in node.items[1:]:
-            _disjunctive_goal(child, positive, report)
-    elif head in ("forall", "exists") and len(node.items) == 3:
-        _disjunctive_goal(node.items[2], positive, report)
-
-
 def _goal_true_in_init(problem: Problem, atoms: set[GroundAtom], report: Report,
-                       derived: frozenset[str]) -> None:
-    """A goal of ground literals over basic facts that :init already makes true (a goal on
-    derived predicates would need their rules: not judged here)."""
-    literals = _literals(problem.goal)
-    if literals is None or not literals or any(fact[0] in derived for fact, _ in literals):
-        return
-    if all((fact in atoms) == positive for fact, positive in literals):
+                       domain: Domain, names: dict[str, Typed]) -> None:
+    """A goal that :init already makes true, judged where that is certain (a goal reading
+    derived predicates would need their rules, a numeric one the values: not judged)."""
+    if _InitTruth(domain, names, atoms).certain(problem.goal, True, {}):
         report.add(
             problem.goal_node or problem.goal,
             "goal-true-in-init",
@@ -242,26 +217,56 @@ def _goal_true_in_init(problem: Problem, atoms: set[GroundAtom], report: Report,
         )
 
 
-def _literals(goal: Node | None) -> list[tuple[GroundAtom, bool]] | None:
-    """A conjunction of ground literals as (atom, positive) pairs, else None."""
-    if not isinstance(goal, SList) or not goal.items:
-        return None
-    if goal.head() == "and":
-        result: list[tuple[GroundAtom, bool]] = []
-        for child in goal.items[1:]:
-            sub = _literals(child)
-            if sub is None:
-                return None
-            result += sub
-        return result
-    if goal.head() == "not" and len(goal) == 2 and isinstance(goal.items[1], SList):
-        inner = _literals(goal.items[1])
-        return None if inner is None or len(inner) != 1 else [(inner[0][0], not inner[0][1])]
-    if goal.head() in ("or", "imply", "forall", "exists", "=", "<", ">", "<=", ">="):
-        return None
-    if any(not isinstance(i, Atom) or i.text.startswith("?") for i in goal.items):
-        return None
-    return [(_ground(goal), True)]
+class _InitTruth:
+    """Whether a goal description certainly has a truth value in :init (a quantifier over
+    the objects of its types; at most MAX_GROUNDINGS atoms are looked at)."""
+
+    def __init__(self, domain: Domain, names: dict[str, Typed], atoms: set[GroundAtom]):
+        self.domain = domain
+        self.names = names
+        self.atoms = atoms
+        self.budget = MAX_GROUNDINGS
+
+    def certain(self, node: Node | None, value: bool, binding: dict[str, str]) -> bool:
+        """True if `node` certainly evaluates to `value` under `binding` in :init."""
+        if not isinstance(node, SList) or not node.items or self.budget <= 0:
+            return False
+        head, args = node.head(), node.items[1:]
+        if head in ("and", "or"):
+            every = (head == "and") == value  # (and) true / (or) false: every part must be
+            parts = (self.certain(child, value, binding) for child in args)
+            return all(parts) if every else any(parts)
+        if head == "not" and len(args) == 1:
+            return self.certain(args[0], not value, binding)
+        if head == "imply" and len(args) == 2:
+            left = self.certain(args[0], not value, binding)
+            return (left or self.certain(args[1], True, binding)) if value else (
+                left and self.certain(args[1], False, binding))
+        if head in ("forall", "exists") and len(args) == 2 and isinstance(args[0], SList):
+            every = (head == "forall") == value
+            parts = (self.certain(args[1], value, inner)
+                     for inner in self._bindings(args[0], binding))
+            return all(parts) if every else any(parts)
+        if head == "=" and len(args) == 2 and all(isinstance(a, Atom) for a in args):
+            left, right = (binding.get(a.text, a.text) for a in args)  # type: ignore[union-attr]
+            return (left == right) == value
+        if head in self.domain.derived_names or head not in self.domain.predicates:
+            return False  # a derived predicate, a comparison, or an error reported elsewhere
+        if not all(isinstance(a, Atom) for a in args):
+            return False
+        self.budget -= 1
+        atom = (head, *(binding.get(a.text, a.text) for a in args))  # type: ignore[union-attr]
+        return (atom in self.atoms) == value
+
+    def _bindings(self, variables: SList, binding: dict[str, str]
+                  ) -> Iterator[dict[str, str]]:
+        entries = typed_list(variables.items, Report(""))
+        pools = [[n for n, e in self.names.items() if self.domain.is_subtype(e.type, v.type)]
+                 for v in entries]
+        for values in product(*pools):
+            inner = dict(binding)
+            inner.update(zip((v.name for v in entries), values, strict=True))
+            yield inner
 
 
 MAX_GROUNDINGS = 100_000

@@ -52,6 +52,18 @@ def test_plan_solved(client: TestClient) -> None:
     assert body["cost"] == 3 and body["probability"] == 0.5 and body["objective"] == 8
 
 
+def test_a_disjunctive_goal_is_planned_for(client: TestClient) -> None:
+    problem = PROBLEM.replace("(:goal (lit kitchen))",
+                              "(:goal (exists (?r - room) (and (lit ?r) (not (at ?r)))))")
+    response = client.post("/v1/plans", json={"domain": DOMAIN, "problem": problem,
+                                              "reward": 10})
+    assert response.status_code == 200, response.text
+    body = response.json()  # light the hall, then leave it: 2 + 1, with p = 0.5
+    assert body["status"] == "solved" and body["plan"] == ["(switch-on hall)",
+                                                          "(go hall kitchen)"]
+    assert body["cost"] == 3 and body["probability"] == 0.5
+
+
 def test_undeclared_requirement_is_a_warning_not_a_422(client: TestClient) -> None:
     domain = DOMAIN.replace(":strips :typing", ":strips")
     response = client.post("/v1/plans", json={"domain": domain, "problem": PROBLEM})

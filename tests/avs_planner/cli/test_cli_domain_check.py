@@ -13,6 +13,7 @@ ROOT = Path(__file__).resolve().parents[3]
 AVS = ROOT / "domains" / "avs"
 DATA = ROOT / "tests" / "avs_planner" / "pddl" / "data"
 CASES = json.loads((DATA / "broken.json").read_text())
+ACCEPTED = json.loads((DATA / "accepted.json").read_text())
 
 
 def _broken_files(case: dict, tmp_path: Path) -> tuple[Path, Path, str]:
@@ -52,6 +53,21 @@ def test_broken_input_exits_1_and_points_at_the_mistake(
     out = capsys.readouterr()
     assert any(line.startswith(expected) for line in out.out.splitlines()), out.out
     assert "Traceback" not in out.err
+
+
+@pytest.mark.parametrize("case", ACCEPTED, ids=lambda c: c["name"])
+def test_what_plan_plans_for_passes_the_check(
+    case: dict, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    case = {**case, "anchor": case["new"]}
+    domain, problem, _ = _broken_files(case, tmp_path)
+    assert main(["domain", "check", str(domain), str(problem)]) == 0
+    out = capsys.readouterr()
+    assert ": error: " not in out.out and "Traceback" not in out.err
+    assert main(["plan", str(domain), str(problem)]) == 0
+    out = capsys.readouterr()
+    steps = [line for line in out.out.splitlines() if line.startswith("(")]
+    assert len(steps) == case["steps"] and "; cost: " in out.out
 
 
 def test_json_output_is_a_list_of_findings(

@@ -1,4 +1,5 @@
-"""Broken inputs: each mistake is found at the right line and column, with the right code."""
+"""Broken inputs: each mistake is found at the right line and column, with the right code;
+and the other way (`accepted.json`): what `avs plan` plans for, `avs domain check` passes."""
 
 from __future__ import annotations
 
@@ -15,6 +16,9 @@ DATA = Path(__file__).parent / "data"
 DOMAIN = (DATA / "base-domain.pddl").read_text()
 PROBLEM = (DATA / "base-problem.pddl").read_text()
 CASES = json.loads((DATA / "broken.json").read_text())
+# Valid inputs near the edge of what the planner takes (goals that are no conjunction of
+# literals): no error from the checks, read, and planned for
+ACCEPTED = json.loads((DATA / "accepted.json").read_text())
 ERRORS = [c for c in CASES if c.get("severity", "error") == "error"]
 # What the reader accepts, as Fast Downward does, or repairs: a warning, never an error
 LENIENT = [c for c in CASES if c.get("severity") == "warning"]
@@ -94,3 +98,27 @@ def test_reader_reads_what_only_the_planner_refuses_and_keeps_where_it_is(case: 
     assert task.model.actions  # the model read (a domain with derived predicates has no UP one)
     assert [(d.file, d.line, d.column, d.code) for d in task.not_grounded] == [
         (*where, case["code"])]
+
+
+@pytest.mark.parametrize("case", ACCEPTED, ids=lambda c: c["name"])
+def test_check_and_plan_accept_it_alike(case: dict) -> None:
+    from unified_planning.engines.plan_validator import SequentialPlanValidator
+
+    from avs_planner.cp.planner import plan
+    from avs_planner.cp.search import PlanStatus, SearchOptions
+    from avs_planner.up_engine import to_up_plan
+
+    texts = {"domain": DOMAIN, "problem": PROBLEM}
+    assert texts[case["file"]].count(case["old"]) == 1, case["name"]
+    texts[case["file"]] = texts[case["file"]].replace(case["old"], case["new"])
+    found = check(PddlSource("domain.pddl", texts["domain"]),
+                  [PddlSource("problem.pddl", texts["problem"])])
+    assert [d for d in found if d.is_error] == []
+    assert [d.code for d in found if d.code == "goal-true-in-init"] == (
+        [case["warning"]] if "warning" in case else [])
+    task = read_text(texts["domain"], texts["problem"], "domain.pddl", "problem.pddl")
+    result = plan(task, SearchOptions())
+    assert result.status is PlanStatus.SOLVED and len(result.plan) == case["steps"]
+    valid = SequentialPlanValidator().validate(task.problem,
+                                               to_up_plan(task.problem, result.plan))
+    assert valid.status.name == "VALID"
