@@ -57,8 +57,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="anytime: greedy best-first with FF and helpful actions (LAMA's "
                         "first iteration), then weighted A* restarts with w = 5, 3, 2, 1; "
                         "prints the best plan by objective at --timeout, or before it when "
-                        "the last restart ends (no restart proves its plan optimal: FF is "
-                        "inadmissible, so only the end of the schedule stops it early); "
+                        "the last restart ends or one runs out of memory (no restart "
+                        "proves its plan optimal: FF is inadmissible, so only the end of the "
+                        "schedule stops it early); "
                         "probabilistic objectives kept. weighted: one weighted "
                         "A* search (with --heuristic hmax and --weight 1, optimal). auto (the "
                         "default): anytime when a --timeout bounds it and neither --weight "
@@ -96,7 +97,13 @@ def run(args: argparse.Namespace) -> int:
     pproblem = read_files(args.domain, args.problem)
     for warning in pproblem.warnings:
         print(warning, file=sys.stderr)
-    result = plan(pproblem, options, deadline=deadline)
+    try:
+        result = plan(pproblem, options, deadline=deadline)
+    except MemoryError:
+        print(f"avs plan: out of memory after {deadline.elapsed():.1f} s with no plan found; "
+              "bound the search with --timeout (the anytime mode then returns its first "
+              "plan) or --node-limit", file=sys.stderr)
+        return EXIT_CODES["node_limit"]
     print(json.dumps(result.as_json()) if args.json else _text(result))
     if result.status.value == "timeout" and args.timeout is not None:
         print(f"avs plan: no plan within {args.timeout:g} s", file=sys.stderr)

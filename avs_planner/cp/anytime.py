@@ -108,8 +108,16 @@ def anytime_plans(task: GroundTask, options: SearchOptions,
         if left is not None and left <= 0:
             run.stopped = "timeout"
             break
-        result = search(task, replace(options, anytime=False, weight=weight, timeout_s=left),
-                        symmetries)
+        try:
+            result = search(task, replace(options, anytime=False, weight=weight,
+                                          timeout_s=left), symmetries)
+        except MemoryError:
+            # a restart's open list outgrew the memory (IPC maintenance 1 without a timeout,
+            # at w = 2 or below): the plan in hand is the answer, as at a deadline
+            if not run.best.solved:
+                raise
+            run.stopped = "memory"
+            break
         run.expanded += result.expanded
         if result.solved and result.objective < run.best.objective - 1e-9:
             run.best = result

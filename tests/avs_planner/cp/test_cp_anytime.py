@@ -47,6 +47,46 @@ def test_probabilistic_objective_is_kept(corridor) -> None:
     assert anytime.objective <= default.objective + 1e-9
 
 
+def test_a_restart_out_of_memory_returns_the_plan_in_hand(corridor, monkeypatch) -> None:
+    """A restart whose open list outgrows the memory (IPC maintenance 1 without a timeout)
+    ends the run with the best plan so far, `stopped_by` "memory"; with no plan yet the
+    error is the caller's."""
+    import avs_planner.cp.anytime as anytime_module
+
+    real = anytime_module.search
+
+    def restarts_out_of_memory(task, options, *args):  # noqa: ANN001, ANN002, ANN202
+        if options.weight != anytime_module.GREEDY_WEIGHT:
+            raise MemoryError
+        return real(task, options, *args)
+
+    monkeypatch.setattr(anytime_module, "search", restarts_out_of_memory)
+    result = plan(corridor, SearchOptions(anytime=True))
+    assert result.status is PlanStatus.SOLVED and result.stopped_by == "memory"
+    assert [h["weight"] for h in result.extra["anytime"]] == ["greedy"]
+
+    def always_out_of_memory(task, options, *args):  # noqa: ANN001, ANN002, ANN202
+        raise MemoryError
+
+    monkeypatch.setattr(anytime_module, "search", always_out_of_memory)
+    with pytest.raises(MemoryError):
+        plan(corridor, SearchOptions(anytime=True))
+
+
+def test_avs_plan_out_of_memory_is_a_clear_error(monkeypatch, capsys) -> None:
+    import avs_planner.cp.planner as planner_module
+    from avs_planner.cli import main
+
+    def out_of_memory(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202
+        raise MemoryError
+
+    monkeypatch.setattr(planner_module, "plan", out_of_memory)
+    folder = require_ipc() / "gripper"
+    assert main(["plan", str(folder / "domain.pddl"), str(folder / "instance-1.pddl")]) == 3
+    err = capsys.readouterr().err
+    assert "out of memory" in err and "--timeout" in err and "Traceback" not in err
+
+
 def test_unsolvable_stays_unsolvable() -> None:
     task = _read("blocks", 1)
     problem = task.problem.clone()
