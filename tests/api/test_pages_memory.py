@@ -7,28 +7,10 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
-import subprocess
-from pathlib import Path
-from typing import Any
 
-import pytest
 from fastapi.testclient import TestClient
 
-from api.pages import STATIC
-
-NODE = shutil.which("node") or shutil.which("nodejs")
-needs_node = pytest.mark.skipif(NODE is None, reason="no node (Node.js) on PATH to run the "
-                                "page's script")
-SHIM = Path(__file__).with_name("pages_dom_shim.js")
-
-
-def _node(script: str, data: Any) -> str:
-    result = subprocess.run([str(NODE), str(SHIM), str(STATIC)],
-                            input=json.dumps({"script": script, "data": data}),
-                            capture_output=True, text=True, timeout=60, check=False)
-    assert result.returncode == 0, result.stderr
-    return result.stdout
+from tests.api.pages_node import needs_node, run_js
 
 
 @needs_node
@@ -42,7 +24,7 @@ def test_memory_events_in_a_line_each() -> None:
          "seen": True, "object": "object3"},
         {"type": "memory", "unreachable": "book", "position": [9.0, 1.0, 0.8]},
     ]
-    lines = json.loads(_node("(es) => JSON.stringify(es.map(AVS_MEMORY.describe))", events))
+    lines = json.loads(run_js("(es) => JSON.stringify(es.map(AVS_MEMORY.describe))", events))
     assert lines == [
         "recalled 2 task(s) before: 14 places, 4 rooms, 6 furniture, 2 sighting(s), 1 faded",
         "checked cerealbox at (2.21, 5.89, 0.87) (P in place 0.992): not there, dropped",
@@ -55,7 +37,7 @@ def test_memory_events_in_a_line_each() -> None:
 def test_the_summary_s_memory_and_experience_parts_as_rows() -> None:
     part = {"tasks_before": 1, "building_clock_s": 651.5, "furniture": 6, "sightings": 2,
             "checked": 1, "confirmed": 0, "saved": True}
-    html = _node("(p) => { const dl = AVS.el('dl'); AVS_MEMORY.rows(dl, "
+    html = run_js("(p) => { const dl = AVS.el('dl'); AVS_MEMORY.rows(dl, "
                  "AVS_MEMORY.summaryRows(p.memory).concat(AVS_MEMORY.experienceRows("
                  "p.experience))); return dl.html; }",
                  {"memory": part, "experience": {"store": "experience.sqlite3",

@@ -5,22 +5,12 @@ Skipped without Node; the browser tests open a real page."""
 
 from __future__ import annotations
 
-import json
 import re
-import shutil
-import subprocess
-from pathlib import Path
-from typing import Any
-
-import pytest
 
 from api.pages import STATIC
+from tests.api.pages_node import needs_node, run_js
 
-NODE = shutil.which("node") or shutil.which("nodejs")
-pytestmark = pytest.mark.skipif(NODE is None, reason="no node (Node.js) on PATH to run the "
-                                "page's script")
-
-SHIM = Path(__file__).with_name("pages_dom_shim.js")
+pytestmark = needs_node
 
 SUMMARY_TARGETS = [
     {"label": "cup", "outcome": "found", "reason": "cup at (1.44, 7.58, 0.89) in room1",
@@ -39,12 +29,6 @@ SUMMARY_TARGETS = [
 ]
 
 
-def _node(script: str, data: Any) -> str:
-    result = subprocess.run([str(NODE), str(SHIM), str(STATIC)],
-                            input=json.dumps({"script": script, "data": data}),
-                            capture_output=True, text=True, timeout=60, check=False)
-    assert result.returncode == 0, result.stderr
-    return result.stdout
 
 
 def _rows(html: str) -> dict[str, str]:
@@ -52,7 +36,7 @@ def _rows(html: str) -> dict[str, str]:
 
 
 def test_each_targets_outcome_objects_and_time_from_the_summary() -> None:
-    html = _node("(parts) => AVS_TARGETS.table(parts).html", SUMMARY_TARGETS)
+    html = run_js("(parts) => AVS_TARGETS.table(parts).html", SUMMARY_TARGETS)
     assert html.startswith('<table class="targets">')
     assert re.findall(r"<th>(\w+)</th>", html) == ["target", "outcome", "objects", "time",
                                                    "turns"]
@@ -77,7 +61,7 @@ def test_each_targets_outcome_objects_and_time_from_the_summary() -> None:
 def test_a_count_says_why_it_stopped() -> None:
     part = {"label": "cup", "outcome": "found", "objects": [], "sim_time_s": 90.0, "turns": 3,
             "reason": "2 found; P(another cup in space not yet searched) = 0.06 < 0.1"}
-    html = _node("(part) => AVS_TARGETS.table([part], {count: 'all'}).html", part)
+    html = run_js("(part) => AVS_TARGETS.table([part], {count: 'all'}).html", part)
     assert '<div class="why muted">2 found; P(another cup' in html
 
 
@@ -97,7 +81,7 @@ def test_a_running_task_is_followed_from_its_events() -> None:
          "reason": "stapler at (8.84, 0.59, 0.85) in room3", "found": ["object7"]},
         {"type": "turn", "t": 70.5, "target": "cup", "status": "start", "watch": []},
     ]
-    rows = _rows(_node(script, events))
+    rows = _rows(run_js(script, events))
     assert ">found</span>" in rows["stapler"]
     assert "<li>object7 at (8.84, 0.59) in room3</li>" in rows["stapler"]
     assert '<td class="num">60.5 s</td><td class="num">1</td>' in rows["stapler"]
@@ -109,7 +93,7 @@ def test_the_forms_read_as_words() -> None:
     script = "(forms) => forms.map((f) => AVS_TARGETS.formText(f)).join(' | ')"
     forms = [{"mode": "all", "count": "one"}, {"mode": "any", "count": "one"},
              {"mode": "all", "count": "all", "stop_below": 0.05}]
-    assert _node(script, forms) == ("one of each | the first of any of them | every instance, "
+    assert run_js(script, forms) == ("one of each | the first of any of them | every instance, "
                                     "until P(another) < 0.05")
 
 
