@@ -103,6 +103,19 @@ bad:
 
 /* Fill `ax` from the packed rules (see the top of this file) over n_facts facts and W words;
  * -1 with an exception set if they are malformed or not stratified. */
+/* One occurrence of fact f in rule r (clause q, -1 for its positive literals): the first pass
+   counts it in occ_off[f + 1], the second stores it at f's next free slot. */
+static inline void axioms_occurrence(Axioms *ax, int pass, int32_t f, int32_t r, int32_t q)
+{
+    if (!pass) {
+        ax->occ_off[f + 1]++;
+        return;
+    }
+    int32_t at = ax->occ_off[f]++;
+    ax->occ_rule[at] = r;
+    ax->occ_clause[at] = q;
+}
+
 static int axioms_parse(Axioms *ax, const int64_t *blob, Py_ssize_t len, Py_ssize_t n_facts,
                         Py_ssize_t W)
 {
@@ -213,31 +226,13 @@ static int axioms_parse(Axioms *ax, const int64_t *blob, Py_ssize_t len, Py_ssiz
         }
         for (Py_ssize_t k = 0; k < S; k++)
             for (int32_t r = ax->strata[k]; r < ax->strata[k + 1]; r++) {
-                for (int32_t j = ax->pos_off[r]; j < ax->pos_off[r + 1]; j++) {
-                    int32_t f = ax->pos[j];
-                    if (stratum_of[f] != k)
-                        continue;
-                    if (!pass) {
-                        ax->occ_off[f + 1]++;
-                        continue;
-                    }
-                    int32_t at_f = ax->occ_off[f]++;
-                    ax->occ_rule[at_f] = r;
-                    ax->occ_clause[at_f] = -1;
-                }
+                for (int32_t j = ax->pos_off[r]; j < ax->pos_off[r + 1]; j++)
+                    if (stratum_of[ax->pos[j]] == k)
+                        axioms_occurrence(ax, pass, ax->pos[j], r, -1);
                 for (int32_t q = ax->cl_off[r]; q < ax->cl_off[r + 1]; q++)
-                    for (int32_t j = ax->clp_off[q]; j < ax->clp_off[q + 1]; j++) {
-                        int32_t f = ax->clp[j];
-                        if (stratum_of[f] != k)
-                            continue;
-                        if (!pass) {
-                            ax->occ_off[f + 1]++;
-                            continue;
-                        }
-                        int32_t at_f = ax->occ_off[f]++;
-                        ax->occ_rule[at_f] = r;
-                        ax->occ_clause[at_f] = q;
-                    }
+                    for (int32_t j = ax->clp_off[q]; j < ax->clp_off[q + 1]; j++)
+                        if (stratum_of[ax->clp[j]] == k)
+                            axioms_occurrence(ax, pass, ax->clp[j], r, q);
             }
     }
     /* the fill advanced each fact's offset to its end: shift back */
