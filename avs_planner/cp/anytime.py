@@ -7,7 +7,8 @@ helpful actions (LAMA's first iteration, with the goal count where LAMA counts l
 plan length guides it, so it finds a plan fast; see `greedy_search`); then weighted A*
 restarted with decreasing weights (5, 3, 2, 1) on the real objective c + R(1 - p). Every
 plan is judged by that objective and the best so far is kept; at the deadline it is
-returned, with `stopped_by = "timeout"` when a later iteration was still running. The
+returned, with `stopped_by = "timeout"` when a later iteration was still running (and with
+`"memory"` when a restart ran out of memory: the plan in hand is kept, as at a deadline). The
 deadline is the planning call's (`deadline.Deadline`: `timeout_s` from before grounding):
 each search gets the time left and none starts once it has passed. No restart proves its
 plan optimal (FF is inadmissible and no search prunes by the incumbent's cost), so the
