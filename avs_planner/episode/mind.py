@@ -14,6 +14,7 @@ import numpy as np
 
 from avs_planner.body import RobotBody
 from avs_planner.episode.blockages import Blockage, Blockages, NarrowOpening, narrow_openings
+from avs_planner.episode.placeholder_outcomes import PlaceholderOutcomes
 from conceptual_map.conceptual import ConceptualMap, RelatedSpace
 from conceptual_map.conceptual.place_events import PlaceMapFeed
 from conceptual_map.knowledge import Knowledge
@@ -81,6 +82,10 @@ class Mind:
     remembered: list = field(default_factory=list)
     # (grid and rooms key, `viewcones.candidate_cells`' result): recomputed when either changes
     cell_cache: tuple | None = field(default=None, init=False, repr=False, compare=False)
+    # vanished placeholders until the map tells what lay behind them: the building's
+    # evidence about its placeholders (`episode/placeholder_outcomes.py`)
+    placeholder_outcomes: PlaceholderOutcomes = field(default_factory=PlaceholderOutcomes,
+                                                      repr=False, compare=False)
 
     def __post_init__(self) -> None:
         self.grid = OccupancyGrid(resolution=self.resolution)
@@ -128,7 +133,8 @@ class Mind:
         if gone:
             self.blocked_retries += 1
             self.grid.set_keep_out([])
-            self._feed.apply(self.place_map.refresh(self.grid, self.clock))
+            before = self.placeholder_outcomes.snapshot(self.cmap, self.place_map)
+            self._apply(before, self.place_map.refresh(self.grid, self.clock))
         return gone
 
     def move_failed(self, target: str) -> None:
@@ -152,12 +158,20 @@ class Mind:
         self.clock = max(self.clock, time)
         self.forget_blockages(time)
         self.grid.integrate_scan(scan)
+        before = self.placeholder_outcomes.snapshot(self.cmap, self.place_map)
         events = self.place_map.follow(self.grid, poses, time)
-        self._feed.apply(events)
+        self._apply(before, events)
         if events:
             self._place_objects()
         self._drop_stale_objects()
         return events
+
+    def _apply(self, before: tuple, events: list[MapEvent]) -> None:
+        """Feed a batch of place-map events to the conceptual map, and what the map now
+        tells of vanished placeholders (`episode/placeholder_outcomes.py`; `before`: the
+        snapshot taken before the batch)."""
+        self._feed.apply(events)
+        self.placeholder_outcomes.update(before, events, self.cmap, self.place_map, self.grid)
 
     def integrate(self, scan: LaserScanLike) -> None:
         """Integrate a scan into the grid only (the next `sense` grows the place map; one

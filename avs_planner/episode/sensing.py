@@ -100,7 +100,12 @@ class Sensing:
         ctx = self.context
         mind = ctx.mind
         before = mind.place_map.current_place
+        resolved = mind.placeholder_outcomes.resolved
         events = mind.sense(ctx.robot.scan(), poses, ctx.robot.clock)
+        if mind.placeholder_outcomes.resolved != resolved:
+            # what the building's placeholders led to so far, and how that corrects the
+            # placeholder model (`conceptual_map/conceptual/calibration.py`)
+            ctx.emit("belief", placeholders=mind.cmap.calibration.summary())
         place = mind.place_map.current_place
         if place is not None and (place != before or place not in mind.classified):
             self.classify()

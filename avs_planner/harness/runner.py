@@ -466,6 +466,9 @@ class Episode:
             "strategy": self.spec.strategy, "details": result.details,
             "wall_time_s": round(self.trace.wall, 2),
             **self._map_score(),
+            # what the robot's placeholders led to, against what the model predicted
+            # (`conceptual_map/conceptual/calibration.py`; the mind's own record)
+            "placeholders": self.mind.cmap.calibration.summary(),
         }
 
     def _task_fields(self) -> dict[str, Any]:

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from conceptual_map.conceptual.bp import BPResult, BPSettings, PairwiseMRF, loopy_bp
+from conceptual_map.conceptual.calibration import PlaceholderCalibration
 from conceptual_map.conceptual.chain_graph import ChainGraph, PropertyValue
 from conceptual_map.conceptual.errors import ConceptualError
 from conceptual_map.conceptual.existence import (
@@ -54,6 +55,8 @@ class ConceptualMap:
         self.last_result: BPResult | None = None
         self._rates: dict[str, tuple[BPResult, RatePosterior]] = {}
         self._merged: dict[str, str] = {}  # a merged room -> the room that took it
+        # how this building's placeholders ended, correcting the placeholder model
+        self.calibration = PlaceholderCalibration(self.knowledge.placeholder)
 
     # -- structure events ------------------------------------------------------------------
 
@@ -141,6 +144,13 @@ class ConceptualMap:
             old.open_space_m2 if open_space_m2 is None else open_space_m2,
             old.p_door if p_door is None else p_door,
         )
+
+    def observe_placeholder_outcome(self, evidence: PlaceholderEvidence,
+                                    led_to_new_room: bool) -> None:
+        """A placeholder that vanished with `evidence` led to a new room, or did not (the
+        robot's own map tells: `avs_planner/episode/placeholder_outcomes.py`). The placeholders
+        still open are predicted with the building's outcomes so far (`calibration.py`)."""
+        self.calibration.record(evidence, led_to_new_room)
 
     def remove_placeholder(self, placeholder: str) -> None:
         self._placeholder(placeholder)
@@ -273,8 +283,11 @@ class ConceptualMap:
         return _named(self.knowledge.categories, self.room_marginal(room))
 
     def placeholder_prediction(self, placeholder: str) -> PlaceholderPrediction:
+        """What lies behind `placeholder`: the hypotheses of `placeholders.py`, weighted as
+        this building's placeholders so far calibrate them (`calibration.py`)."""
         evidence = self._placeholder(placeholder)
-        return predict(self.knowledge, self.room_marginal(evidence.room), evidence)
+        return predict(self.knowledge, self.room_marginal(evidence.room), evidence,
+                       self.calibration.weights(evidence))
 
     def placeholder_category(self, placeholder: str) -> dict[str, float]:
         """P(placeholder leads to a new room of each category), plus `"none"`: no new room."""
@@ -384,7 +397,8 @@ class ConceptualMap:
         posterior = self.rate_posterior(label)
         return p_label_beyond(self.knowledge, self.room_marginal(evidence.room), evidence,
                               self.objects.fresh_room_lambda(label),
-                              None if posterior is None else posterior.p_none)
+                              None if posterior is None else posterior.p_none,
+                              self.calibration.weights(evidence))
 
     def p_object_at_category(
         self, label: str, category: str, support_label: str | None = None, relation: str = "on"

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
@@ -101,10 +101,13 @@ def hypothesis_weights(
 
 
 def predict(
-    knowledge: Knowledge, room_marginal: np.ndarray, evidence: PlaceholderEvidence
+    knowledge: Knowledge, room_marginal: np.ndarray, evidence: PlaceholderEvidence,
+    weights: Mapping[Hypothesis, float] | None = None,
 ) -> PlaceholderPrediction:
-    """Combine the hypotheses' category posteriors with their weights."""
-    weights = hypothesis_weights(knowledge.placeholder, evidence)
+    """Combine the hypotheses' category posteriors with their weights (`hypothesis_weights`
+    unless given, e.g. calibrated to the building: `calibration.py`)."""
+    if weights is None:
+        weights = hypothesis_weights(knowledge.placeholder, evidence)
     one = _one_room(knowledge, room_marginal)
     first_of_two, any_of_two = _two_rooms(knowledge, room_marginal)
     any_room = np.zeros_like(one)
@@ -144,14 +147,17 @@ def _two_rooms(knowledge: Knowledge, room_marginal: np.ndarray) -> tuple[np.ndar
 def p_label_beyond(
     knowledge: Knowledge, room_marginal: np.ndarray, evidence: PlaceholderEvidence,
     room_lambda: np.ndarray, p_none: Callable[[np.ndarray], np.ndarray] | None = None,
+    weights: Mapping[Hypothesis, float] | None = None,
 ) -> float:
     """P(at least one object in the new rooms behind the placeholder), where a new room of
     category c holds Poisson(`room_lambda[c]`) of them: each hypothesis's rooms with their
     category posterior (one room, or the chain N1 - N2 jointly), weighted as in `predict`.
     `p_none(m)`: P(no object where m are expected), exp(-m) unless the building's rate is
-    uncertain (`ConceptualMap.rate_posterior`); two rooms share it, so their masses add."""
+    uncertain (`ConceptualMap.rate_posterior`); two rooms share it, so their masses add.
+    `weights`: as for `predict`."""
     none_of = p_none or (lambda m: np.exp(-m))
-    weights = hypothesis_weights(knowledge.placeholder, evidence)
+    if weights is None:
+        weights = hypothesis_weights(knowledge.placeholder, evidence)
     lam = np.asarray(room_lambda, dtype=float)
     one = 1.0 - float(_one_room(knowledge, room_marginal) @ none_of(lam))
     phi, prior = knowledge.connectivity, knowledge.prior

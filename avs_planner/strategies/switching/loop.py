@@ -86,6 +86,9 @@ class LoopConfig:
     # give up when no continuation is worth its cost against the building-level belief
     # (`stopping.py`), not only when no single plan reaches the threshold
     stop_rule: bool = True
+    # predict what lies behind placeholders with the building's own outcomes so far
+    # (`conceptual_map/conceptual/calibration.py`; measured always, used only when on)
+    calibrate_placeholders: bool = False
 
     def executor_config(self, base: ExecutorConfig | None = None) -> ExecutorConfig:
         """The executor's settings these loop settings decide (R, the watch, glimpses, the
@@ -122,6 +125,7 @@ class SwitchingLoop:
                                "settings (`LoopConfig.executor_config`, `builder_config`): "
                                + "; ".join(differ))
         self.should_stop = should_stop or (lambda: False)
+        builder.mind.cmap.calibration.apply = self.config.calibrate_placeholders
         self.result = SearchResult(Outcome.GAVE_UP, "")
         self.planner: ContinualPlanner | None = None
         self.start_clock = executor.robot.clock
