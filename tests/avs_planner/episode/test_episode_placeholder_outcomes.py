@@ -103,3 +103,15 @@ def test_outcomes_lower_what_the_remaining_placeholders_promise():
     _see(grid, 4.0, 8.0, occupied=True)
     _vanish(cmap, place_map, outcomes, grid)
     assert cmap.placeholder_category("ph2")["none"] > before
+
+
+def test_the_switching_option_decides_whether_the_correction_is_used(
+        corridor, switching_loop) -> None:  # noqa: ANN001
+    from avs_planner.episode.trace import Trace
+    from avs_planner.strategies.switching.loop import LoopConfig
+
+    mind, builder, executor = corridor
+    switching_loop(builder, executor, Trace(lambda: 0.0))
+    assert mind.cmap.calibration.apply is False
+    switching_loop(builder, executor, Trace(lambda: 0.0), LoopConfig(calibrate_placeholders=True))
+    assert mind.cmap.calibration.apply is True

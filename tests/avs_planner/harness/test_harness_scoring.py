@@ -163,3 +163,18 @@ def test_an_episode_summary_carries_the_map_score(tmp_path: Path) -> None:
     for true_room in score["rooms"]:
         if true_room["robot_room"] is not None:
             assert final[true_room["robot_room"]]["believed"] == true_room["believed"]
+
+
+def test_an_episode_summary_carries_what_its_placeholders_led_to(tmp_path: Path) -> None:
+    """The summary and the trace's last `placeholders` belief agree on the placeholders the
+    robot's own map resolved, per kind, with the model's mean prediction for them."""
+    summary = run_episode({"target": "cerealbox", "world": "office", "seed": 1,
+                           "output_dir": str(tmp_path)})
+    placeholders = summary["placeholders"]
+    assert json.loads((tmp_path / "summary.json").read_text())["placeholders"] == placeholders
+    assert sum(kind["resolved"] for kind in placeholders.values()) > 0
+    for kind in placeholders.values():
+        assert 0 <= kind["new_room"] <= kind["resolved"] and 0.0 < kind["predicted"] < 1.0
+    events = [json.loads(line) for line in (tmp_path / "trace.jsonl").read_text().splitlines()]
+    traced = [e["placeholders"] for e in events if e["type"] == "belief" and "placeholders" in e]
+    assert traced and traced[-1] == placeholders
