@@ -5,9 +5,9 @@
  * compute the same least fixpoints as the numpy versions in avs_planner/cp/derived.py, which
  * stay as the fallback when this module is not built; tests compare the two.
  *
- * gather_rows: the fact ids of a list of structure rows sorted and unique, and their bitset
- *   words, written to fresh k-row arrays, optionally keeping only the facts a `read` mask
- *   marks (a call's kept rows: sorting them afresh is cheaper than keeping a structure-wide
+ * gather_rows: the fact ids of a list of structure rows sorted and unique, and (if asked)
+ *   their bitset words, written to fresh k-row arrays, optionally keeping only the facts a
+ *   `read` mask marks (a call's kept rows: sorting them afresh is cheaper than keeping a structure-wide
  *   cache of sorted rows, which only the numpy fallback in derived.py does).
  * index: rows by fact (CSR) of a matrix, built once per structure and passed to the others
  *   (one int64 buffer: n_facts + 1 offsets, then the row ids; every occurrence once).
@@ -119,13 +119,15 @@ static void sorted_row(const int64_t *src, Py_ssize_t width, Py_ssize_t n_facts,
         }
         tmp[at] = f;
     }
-    memset(words, 0, (size_t)n_words * sizeof(uint64_t));
+    if (words)
+        memset(words, 0, (size_t)n_words * sizeof(uint64_t));
     Py_ssize_t u = 0;
     for (Py_ssize_t j = 0; j < m; j++) {
         if (u && row[u - 1] == tmp[j])
             continue;
         row[u++] = tmp[j];
-        words[tmp[j] >> 6] |= (uint64_t)1 << (tmp[j] & 63);
+        if (words)
+            words[tmp[j] >> 6] |= (uint64_t)1 << (tmp[j] & 63);
     }
     for (; u < width; u++)
         row[u] = -1;
@@ -144,20 +146,27 @@ static PyObject *gather_rows(PyObject *self, PyObject *args)
         return NULL;
     }
     Py_buffer b[5];
-    int got = 0, n_specs = read_o == Py_None ? 4 : 5;
+    int got = 0, n_specs = 3, at_bits = -1, at_read = -1;
     PyObject *result = NULL;
     int64_t *tmp = NULL;
-    const Spec specs[5] = {
+    Spec specs[5] = {
         {src_o, rows * width, 8, 0, "gather_rows: matrix"},
         {idx_o, k, 8, 0, "gather_rows: rows"},
         {out_o, k * width, 8, 1, "gather_rows: out"},
-        {bits_o, k * n_words, 8, 1, "gather_rows: bits"},
-        {read_o, n_facts, 1, 0, "gather_rows: read"},
     };
+    if (bits_o != Py_None) { /* None: no bitset words */
+        at_bits = n_specs;
+        specs[n_specs++] = (Spec){bits_o, k * n_words, 8, 1, "gather_rows: bits"};
+    }
+    if (read_o != Py_None) {
+        at_read = n_specs;
+        specs[n_specs++] = (Spec){read_o, n_facts, 1, 0, "gather_rows: read"};
+    }
     if (get_all(specs, n_specs, b, &got) < 0)
         goto done;
     const int64_t *src = b[0].buf, *idx = b[1].buf;
-    const uint8_t *read = n_specs == 5 ? b[4].buf : NULL;
+    const uint8_t *read = at_read >= 0 ? b[at_read].buf : NULL;
+    uint64_t *bits = at_bits >= 0 ? b[at_bits].buf : NULL;
     if (check_range(idx, k, rows, "gather_rows: rows") < 0)
         goto done;
     tmp = malloc(((size_t)width + 1) * sizeof(int64_t));
@@ -167,7 +176,7 @@ static PyObject *gather_rows(PyObject *self, PyObject *args)
     }
     for (Py_ssize_t i = 0; i < k; i++)
         sorted_row(src + idx[i] * width, width, n_facts, read, tmp,
-                   (int64_t *)b[2].buf + i * width, (uint64_t *)b[3].buf + i * n_words, n_words);
+                   (int64_t *)b[2].buf + i * width, bits ? bits + i * n_words : NULL, n_words);
     result = Py_None;
     Py_INCREF(result);
 done:

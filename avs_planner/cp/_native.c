@@ -81,12 +81,21 @@ typedef struct {
     PyObject_HEAD
     Py_ssize_t n_facts, n_actions, W;
     Py_ssize_t n_rfacts, n_rel; /* with the merge's auxiliary facts, extra actions */
-    word *pre, *pre_neg, *add, *del, *reads; /* n_actions * W each */
-    /* pre and pre_neg without their zero words: per action (CSR pw_off), the index and
-     * bits of each non-zero word, pre's first (pw_n_pre of them; the one with the most bits
-     * first), then pre_neg's; what successor generation tests instead of 2W words */
+    /* An action's bitsets are kept by their non-zero words only (a 320-place AVS task has
+     * 57,000 actions over 110 words, of which an action touches a few: dense rows were 200 MB
+     * to fill, copy and scan). pre and pre_neg: per action (CSR pw_off), the index and bits
+     * of each non-zero word, pre's first (pw_n_pre of them; the one with the most bits
+     * first), then pre_neg's; what successor generation tests instead of 2W words. */
     int32_t *pw_off, *pw_n_pre, *pw_idx;
     word *pw_mask;
+    /* effects: per action (CSR ew_off), the words its add or delete effects touch, in
+     * ascending index, with the bits each sets and clears */
+    int32_t *ew_off, *ew_idx;
+    word *ew_add, *ew_del;
+    /* reads: per action (CSR rw_off), the words of every fact its applicability depends on
+     * (pre, pre_neg, clauses, facts read through derived predicates), ascending */
+    int32_t *rw_off, *rw_idx;
+    word *rw_mask;
     double *cost, *prob, *neglog; /* per relaxed action (extra: a member's, aux: 0, 0, 1) */
     int8_t *kind;                 /* K_* per relaxed action */
     int32_t *link;                /* merged: its fact X; aux: its position among X's */
@@ -119,7 +128,8 @@ typedef struct {
 
 static void task_free_arrays(TaskObject *t)
 {
-    void *ptrs[] = {t->pre, t->pre_neg, t->add, t->del, t->reads, t->cost, t->prob, t->neglog,
+    void *ptrs[] = {t->ew_off, t->ew_idx, t->ew_add, t->ew_del, t->rw_off, t->rw_idx,
+                    t->rw_mask, t->cost, t->prob, t->neglog,
                     t->pre_off, t->pre_facts, t->add_off, t->add_facts, t->cl_off, t->cl_pos,
                     t->cl_neg, t->unit_off, t->unit_fact, t->unit_clause, t->unit_pair,
                     t->unit_neg_off, t->unit_neg,
@@ -344,7 +354,6 @@ nomem:
 static int task_derive(TaskObject *t)
 {
     Py_ssize_t A = t->n_actions, W = t->W;
-    t->reads = xcalloc((size_t)(A * W), sizeof(word));
     t->unit_off = xcalloc((size_t)A + 1, sizeof(int32_t));
     t->n_pairs_of = xcalloc((size_t)A, sizeof(int32_t));
     Py_ssize_t n_cl = t->cl_off[A];
@@ -353,20 +362,15 @@ static int task_derive(TaskObject *t)
     t->unit_pair = xcalloc((size_t)n_cl, sizeof(int32_t));
     t->pair_action = xcalloc((size_t)n_cl, sizeof(int32_t));
     int32_t *pair_fact = xcalloc((size_t)n_cl, sizeof(int32_t));
-    if (!t->reads || !t->unit_off || !t->n_pairs_of || !t->unit_fact || !t->unit_clause ||
+    if (!t->unit_off || !t->n_pairs_of || !t->unit_fact || !t->unit_clause ||
         !t->unit_pair || !t->pair_action || !pair_fact)
         goto nomem;
     Py_ssize_t nu = 0, np = 0;
     for (Py_ssize_t a = 0; a < A; a++) {
-        word *r = t->reads + a * W;
-        for (Py_ssize_t i = 0; i < W; i++)
-            r[i] = t->pre[a * W + i] | t->pre_neg[a * W + i];
         t->unit_off[a] = (int32_t)nu;
         Py_ssize_t first_pair = np;
         for (int32_t k = t->cl_off[a]; k < t->cl_off[a + 1]; k++) {
             const word *pos = t->cl_pos + (Py_ssize_t)k * W, *neg = t->cl_neg + (Py_ssize_t)k * W;
-            for (Py_ssize_t i = 0; i < W; i++)
-                r[i] |= pos[i] | neg[i];
             int32_t f = -1;
             if (popcount_words(pos, W, &f) != 1 || !any_word(neg, W))
                 continue;
@@ -536,51 +540,241 @@ done:
     return ok;
 }
 
-/* TaskObject.pw_*: the non-zero words of each action's pre and pre_neg */
-static int sparse_pre(TaskObject *t)
+/* An action table's fact ids (`native.packed_rows`): one int64 buffer of n_actions + 1
+ * offsets, from 0 and monotone, then the ids, each in [0, n_facts). */
+typedef struct {
+    const int64_t *off, *val;
+} Rows;
+
+static int get_rows(Py_buffer *b, Py_ssize_t A, Py_ssize_t F, const char *what, Rows *r)
 {
-    Py_ssize_t A = t->n_actions, W = t->W, n = 0;
-    for (Py_ssize_t i = 0; i < A * W; i++)
-        n += (t->pre[i] != 0) + (t->pre_neg[i] != 0);
+    const int64_t *v = b->buf;
+    Py_ssize_t items = b->len / 8;
+    if (b->len % 8 || items < A + 1 || v[0] != 0)
+        goto bad;
+    for (Py_ssize_t a = 0; a < A; a++)
+        if (v[a] > v[a + 1])
+            goto bad;
+    if (items != A + 1 + v[A])
+        goto bad;
+    r->off = v;
+    r->val = v + A + 1;
+    for (Py_ssize_t a = 0; a < A; a++)
+        for (int64_t j = v[a]; j < v[a + 1]; j++)
+            if (r->val[j] < 0 || r->val[j] >= F) {
+                PyErr_Format(PyExc_ValueError, "native task: action %zd has a %s fact %lld "
+                             "outside [0, %zd)", a, what, (long long)r->val[j], F);
+                return -1;
+            }
+    return 0;
+bad:
+    PyErr_Format(PyExc_ValueError, "native task: %s is not a packed CSR over %zd actions",
+                 what, A);
+    return -1;
+}
+
+/* Scratch for turning fact lists into (word index, bits) lists: rows of W words kept zero
+ * between actions, and the words an action touched (stamp[i] == the action's mark). */
+typedef struct {
+    word *row[2];
+    uint32_t *stamp, mark;
+    int32_t *touched, n;
+    Py_ssize_t W;
+} WordScratch;
+
+static int scratch_alloc(WordScratch *x, Py_ssize_t W)
+{
+    memset(x, 0, sizeof(*x));
+    x->W = W;
+    x->row[0] = xcalloc((size_t)W, sizeof(word));
+    x->row[1] = xcalloc((size_t)W, sizeof(word));
+    x->stamp = xcalloc((size_t)W, sizeof(uint32_t));
+    x->touched = xcalloc((size_t)W, sizeof(int32_t));
+    return !x->row[0] || !x->row[1] || !x->stamp || !x->touched ? -1 : 0;
+}
+
+static void scratch_free(WordScratch *x)
+{
+    free(x->row[0]);
+    free(x->row[1]);
+    free(x->stamp);
+    free(x->touched);
+}
+
+/* A new action (or list): nothing touched yet. */
+static inline void scratch_begin(WordScratch *x)
+{
+    x->n = 0;
+    if (++x->mark == 0) { /* wrapped: forget every stamp */
+        memset(x->stamp, 0, (size_t)x->W * sizeof(uint32_t));
+        x->mark = 1;
+    }
+}
+
+static inline void scratch_word(WordScratch *x, int k, int32_t i, word bits)
+{
+    if (!bits)
+        return;
+    if (x->stamp[i] != x->mark) {
+        x->stamp[i] = x->mark;
+        x->touched[x->n++] = i;
+    }
+    x->row[k][i] |= bits;
+}
+
+static void scratch_facts(WordScratch *x, int k, const Rows *r, Py_ssize_t a)
+{
+    for (int64_t j = r->off[a]; j < r->off[a + 1]; j++)
+        scratch_word(x, k, (int32_t)(r->val[j] >> 6), (word)1 << (r->val[j] & 63));
+}
+
+/* The touched words in ascending order (insertion sort: an action touches a few). */
+static void scratch_sort(WordScratch *x)
+{
+    for (int32_t m = 1; m < x->n; m++) {
+        int32_t v = x->touched[m], at = m;
+        for (; at > 0 && x->touched[at - 1] > v; at--)
+            x->touched[at] = x->touched[at - 1];
+        x->touched[at] = v;
+    }
+}
+
+static inline void scratch_clear(WordScratch *x)
+{
+    for (int32_t m = 0; m < x->n; m++)
+        x->row[0][x->touched[m]] = x->row[1][x->touched[m]] = 0;
+}
+
+/* TaskObject.pw_* and ew_* from the actions' fact ids */
+static int sparse_rows(TaskObject *t, const Rows *pre, const Rows *neg, const Rows *add,
+                       const Rows *del)
+{
+    Py_ssize_t A = t->n_actions;
+    int64_t n_pw = pre->off[A] + neg->off[A], n_ew = add->off[A] + del->off[A];
+    if (n_pw > INT32_MAX / 2 || n_ew > INT32_MAX / 2)
+        return -1;
+    WordScratch x;
     t->pw_off = xcalloc((size_t)A + 1, sizeof(int32_t));
     t->pw_n_pre = xcalloc((size_t)A + 1, sizeof(int32_t));
-    t->pw_idx = xcalloc((size_t)n + 1, sizeof(int32_t));
-    t->pw_mask = xcalloc((size_t)n + 1, sizeof(word));
-    if (!t->pw_off || !t->pw_n_pre || !t->pw_idx || !t->pw_mask || n > INT32_MAX / 2)
+    t->pw_idx = xcalloc((size_t)n_pw + 1, sizeof(int32_t));
+    t->pw_mask = xcalloc((size_t)n_pw + 1, sizeof(word));
+    t->ew_off = xcalloc((size_t)A + 1, sizeof(int32_t));
+    t->ew_idx = xcalloc((size_t)n_ew + 1, sizeof(int32_t));
+    t->ew_add = xcalloc((size_t)n_ew + 1, sizeof(word));
+    t->ew_del = xcalloc((size_t)n_ew + 1, sizeof(word));
+    if (scratch_alloc(&x, t->W) || !t->pw_off || !t->pw_n_pre || !t->pw_idx || !t->pw_mask ||
+        !t->ew_off || !t->ew_idx || !t->ew_add || !t->ew_del) {
+        scratch_free(&x);
         return -1;
-    int32_t k = 0;
+    }
+    int32_t k = 0, e = 0;
     for (Py_ssize_t a = 0; a < A; a++) {
-        const word *pre = t->pre + a * W, *neg = t->pre_neg + a * W;
         t->pw_off[a] = k;
         int32_t first = k;
-        for (Py_ssize_t i = 0; i < W; i++)
-            if (pre[i]) {
-                t->pw_idx[k] = (int32_t)i;
-                t->pw_mask[k] = pre[i];
-                if (__builtin_popcountll(pre[i]) > __builtin_popcountll(t->pw_mask[first])) {
-                    t->pw_idx[k] = t->pw_idx[first]; /* the word with the most bits first */
-                    t->pw_mask[k] = t->pw_mask[first];
-                    t->pw_idx[first] = (int32_t)i;
-                    t->pw_mask[first] = pre[i];
-                }
-                k++;
+        scratch_begin(&x);
+        scratch_facts(&x, 0, pre, a);
+        scratch_sort(&x);
+        for (int32_t m = 0; m < x.n; m++) {
+            int32_t i = x.touched[m];
+            word bits = x.row[0][i];
+            t->pw_idx[k] = i;
+            t->pw_mask[k] = bits;
+            if (__builtin_popcountll(bits) > __builtin_popcountll(t->pw_mask[first])) {
+                t->pw_idx[k] = t->pw_idx[first]; /* the word with the most bits first */
+                t->pw_mask[k] = t->pw_mask[first];
+                t->pw_idx[first] = i;
+                t->pw_mask[first] = bits;
             }
+            k++;
+        }
+        scratch_clear(&x);
         t->pw_n_pre[a] = k - first;
-        for (Py_ssize_t i = 0; i < W; i++)
-            if (neg[i]) {
-                t->pw_idx[k] = (int32_t)i;
-                t->pw_mask[k] = neg[i];
-                k++;
-            }
+        scratch_begin(&x);
+        scratch_facts(&x, 0, neg, a);
+        scratch_sort(&x);
+        for (int32_t m = 0; m < x.n; m++) {
+            t->pw_idx[k] = x.touched[m];
+            t->pw_mask[k++] = x.row[0][x.touched[m]];
+        }
+        scratch_clear(&x);
+        t->ew_off[a] = e;
+        scratch_begin(&x);
+        scratch_facts(&x, 0, add, a);
+        scratch_facts(&x, 1, del, a);
+        scratch_sort(&x);
+        for (int32_t m = 0; m < x.n; m++) {
+            int32_t i = x.touched[m];
+            t->ew_idx[e] = i;
+            t->ew_add[e] = x.row[0][i];
+            t->ew_del[e++] = x.row[1][i];
+        }
+        scratch_clear(&x);
     }
     t->pw_off[A] = k;
+    t->ew_off[A] = e;
+    scratch_free(&x);
     return 0;
+}
+
+/* TaskObject.rw_*: per action the words of its pre and pre_neg facts, of its clauses, and of
+ * `extra` (n_actions * W words, or NULL: what it reads through derived predicates) */
+static int sparse_reads(TaskObject *t, const Rows *pre, const Rows *neg, const word *extra)
+{
+    Py_ssize_t A = t->n_actions, W = t->W;
+    WordScratch x;
+    int64_t cap = pre->off[A] + neg->off[A] + 16, n = 0;
+    t->rw_off = xcalloc((size_t)A + 1, sizeof(int32_t));
+    t->rw_idx = malloc((size_t)cap * sizeof(int32_t));
+    t->rw_mask = malloc((size_t)cap * sizeof(word));
+    if (scratch_alloc(&x, W) || !t->rw_off || !t->rw_idx || !t->rw_mask)
+        goto nomem;
+    for (Py_ssize_t a = 0; a < A; a++) {
+        t->rw_off[a] = (int32_t)n;
+        scratch_begin(&x);
+        scratch_facts(&x, 0, pre, a);
+        scratch_facts(&x, 0, neg, a);
+        for (int32_t k = t->cl_off[a]; k < t->cl_off[a + 1]; k++) {
+            const word *pos = t->cl_pos + (Py_ssize_t)k * W, *cn = t->cl_neg + (Py_ssize_t)k * W;
+            for (Py_ssize_t i = 0; i < W; i++)
+                scratch_word(&x, 0, (int32_t)i, pos[i] | cn[i]);
+        }
+        if (extra)
+            for (Py_ssize_t i = 0; i < W; i++)
+                scratch_word(&x, 0, (int32_t)i, extra[a * W + i]);
+        scratch_sort(&x);
+        if (n + x.n > cap) {
+            int64_t more = 2 * (n + x.n);
+            int32_t *idx = realloc(t->rw_idx, (size_t)more * sizeof(int32_t));
+            if (idx)
+                t->rw_idx = idx;
+            word *mask = realloc(t->rw_mask, (size_t)more * sizeof(word));
+            if (mask)
+                t->rw_mask = mask;
+            if (!idx || !mask)
+                goto nomem;
+            cap = more;
+        }
+        if (n + x.n > INT32_MAX / 2)
+            goto nomem;
+        for (int32_t m = 0; m < x.n; m++) {
+            t->rw_idx[n] = x.touched[m];
+            t->rw_mask[n++] = x.row[0][x.touched[m]];
+        }
+        scratch_clear(&x);
+    }
+    t->rw_off[A] = (int32_t)n;
+    scratch_free(&x);
+    return 0;
+nomem:
+    scratch_free(&x);
+    PyErr_NoMemory();
+    return -1;
 }
 
 /* The optional derived predicates' rules (b[0]: GroundAxioms.native_args) and what each
  * action reads through them (b[1]: n_actions * W words OR-ed into its reads, so that
- * commutes() sees the facts a derived precondition depends on). */
-static int task_axioms(TaskObject *t, Py_buffer *b)
+ * commutes() sees the facts a derived precondition depends on); then the reads. */
+static int task_axioms(TaskObject *t, Py_buffer *b, const Rows *pre, const Rows *neg)
 {
     if (b[0].obj && b[0].len) {
         if (b[0].len % 8) {
@@ -596,11 +790,9 @@ static int task_axioms(TaskObject *t, Py_buffer *b)
             PyErr_SetString(PyExc_ValueError, "native task: extra reads have the wrong size");
             return -1;
         }
-        const word *extra = b[1].buf;
-        for (Py_ssize_t i = 0; i < AW; i++)
-            t->reads[i] |= extra[i];
+        return sparse_reads(t, pre, neg, b[1].buf);
     }
-    return 0;
+    return sparse_reads(t, pre, neg, NULL);
 }
 
 static PyObject *task_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
@@ -625,12 +817,13 @@ static PyObject *task_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
     t->n_facts = n_facts;
     t->n_actions = n_actions;
     t->W = n_facts / 64 + 1;
-    Py_ssize_t AW = n_actions * t->W;
-    if (!(t->pre = copy_buffer(&b[0], AW, 8, "pre")) ||
-        !(t->pre_neg = copy_buffer(&b[1], AW, 8, "pre_neg")) ||
-        !(t->add = copy_buffer(&b[2], AW, 8, "add")) ||
-        !(t->del = copy_buffer(&b[3], AW, 8, "delete")) ||
-        !(t->cost = copy_buffer(&b[4], n_actions, 8, "cost")) ||
+    Rows pre, neg, add, del;
+    if (get_rows(&b[0], n_actions, n_facts, "pre", &pre) ||
+        get_rows(&b[1], n_actions, n_facts, "pre_neg", &neg) ||
+        get_rows(&b[2], n_actions, n_facts, "add", &add) ||
+        get_rows(&b[3], n_actions, n_facts, "delete", &del))
+        goto fail;
+    if (!(t->cost = copy_buffer(&b[4], n_actions, 8, "cost")) ||
         !(t->prob = copy_buffer(&b[5], n_actions, 8, "probability")) ||
         !(t->neglog = copy_buffer(&b[6], n_actions, 8, "neglog")))
         goto fail;
@@ -662,22 +855,12 @@ static PyObject *task_new(PyTypeObject *type, PyObject *args, PyObject *kwds)
     if (!(t->cl_pos = copy_buffer(&b[12], n_cl * t->W, 8, "clause pos")) ||
         !(t->cl_neg = copy_buffer(&b[13], n_cl * t->W, 8, "clause neg")))
         goto fail;
-    /* no bit at or above n_facts anywhere */
-    word top = (word)1 << (n_facts & 63);
-    word hi_mask = ~(top - 1);
-    word *all[] = {t->pre, t->pre_neg, t->add, t->del};
-    for (int k = 0; k < 4; k++)
-        for (Py_ssize_t a = 0; a < n_actions; a++)
-            if (all[k][a * t->W + t->W - 1] & hi_mask) {
-                PyErr_Format(PyExc_ValueError, "native task: action %zd has a fact >= %zd", a,
-                             n_facts);
-                goto fail;
-            }
-    if (sparse_pre(t)) {
+    if (sparse_rows(t, &pre, &neg, &add, &del)) {
         PyErr_NoMemory();
         goto fail;
     }
-    if (task_merge(t, n_rfacts, n_merged, b + 14) || task_derive(t) || task_axioms(t, b + 23))
+    if (task_merge(t, n_rfacts, n_merged, b + 14) || task_derive(t) ||
+        task_axioms(t, b + 23, &pre, &neg))
         goto fail;
     for (int i = 0; i < NBUF; i++)
         PyBuffer_Release(&b[i]);
@@ -1135,9 +1318,12 @@ static void cost_and_risk(const Search *s, Eval *e, const word *state, int use_m
 
 static int applicable(const TaskObject *t, Py_ssize_t W, int32_t a, const word *state)
 {
-    const word *pre = t->pre + a * W, *neg = t->pre_neg + a * W;
-    for (Py_ssize_t i = 0; i < W; i++)
-        if ((state[i] & pre[i]) != pre[i] || (state[i] & neg[i]))
+    int32_t j = t->pw_off[a], mid = j + t->pw_n_pre[a], end = t->pw_off[a + 1];
+    for (; j < mid; j++)
+        if ((state[t->pw_idx[j]] & t->pw_mask[j]) != t->pw_mask[j])
+            return 0;
+    for (; j < end; j++)
+        if (state[t->pw_idx[j]] & t->pw_mask[j])
             return 0;
     for (int32_t k = t->cl_off[a]; k < t->cl_off[a + 1]; k++) {
         const word *cp = t->cl_pos + (Py_ssize_t)k * W, *cn = t->cl_neg + (Py_ssize_t)k * W;
@@ -1653,14 +1839,36 @@ static inline int is_goal_state(const Search *s, const word *state)
     return 1;
 }
 
+/* Some word of action a's reads meets a word b's effects change (both lists ascending). */
+static inline int reads_changed(const TaskObject *t, int32_t a, int32_t b)
+{
+    int32_t i = t->rw_off[a], ie = t->rw_off[a + 1], j = t->ew_off[b], je = t->ew_off[b + 1];
+    while (i < ie && j < je) {
+        if (t->rw_idx[i] < t->ew_idx[j])
+            i++;
+        else if (t->rw_idx[i] > t->ew_idx[j])
+            j++;
+        else if (t->rw_mask[i++] & (t->ew_add[j] | t->ew_del[j]))
+            return 1;
+        else
+            j++;
+    }
+    return 0;
+}
+
 static inline int commutes(const TaskObject *t, Py_ssize_t W, int32_t a, int32_t b)
 {
-    const word *ra = t->reads + a * W, *rb = t->reads + b * W;
-    const word *aa = t->add + a * W, *da = t->del + a * W;
-    const word *ab = t->add + b * W, *db = t->del + b * W;
-    for (Py_ssize_t i = 0; i < W; i++) {
-        word w1 = aa[i] | da[i], w2 = ab[i] | db[i];
-        if ((ra[i] & w2) || (rb[i] & w1) || (aa[i] & db[i]) || (da[i] & ab[i]))
+    (void)W;
+    if (reads_changed(t, a, b) || reads_changed(t, b, a))
+        return 0;
+    /* one adds what the other deletes */
+    int32_t i = t->ew_off[a], ie = t->ew_off[a + 1], j = t->ew_off[b], je = t->ew_off[b + 1];
+    while (i < ie && j < je) {
+        if (t->ew_idx[i] < t->ew_idx[j])
+            i++;
+        else if (t->ew_idx[i] > t->ew_idx[j])
+            j++;
+        else if ((t->ew_add[i] & t->ew_del[j]) || (t->ew_del[i++] & t->ew_add[j++]))
             return 0;
     }
     return 1;
@@ -1811,9 +2019,11 @@ static int run_search(Search *s, const word *init, int32_t *goal_node, int64_t *
             if (grow_kids(s, n_kids, &kid_cap))
                 return -1;
             word *succ = s->kids + (Py_ssize_t)n_kids * W;
-            const word *ad = t->add + a * W, *de = t->del + a * W;
-            for (Py_ssize_t i = 0; i < W; i++)
-                succ[i] = (state[i] & ~de[i]) | ad[i];
+            memcpy(succ, state, 8 * (size_t)W);
+            for (int32_t e = t->ew_off[a]; e < t->ew_off[a + 1]; e++) {
+                int32_t i = t->ew_idx[e];
+                succ[i] = (succ[i] & ~t->ew_del[e]) | t->ew_add[e];
+            }
             if (t->ax.n_rules)
                 axioms_close(&t->ax, W, &s->ax, succ);
             double kc = c + t->cost[a], kp = p * t->prob[a];

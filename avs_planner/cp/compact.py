@@ -169,7 +169,7 @@ def _pieces(task: GroundTask, used: np.ndarray) -> tuple:
         delete=remap.matrix(a.delete), cost=a.cost, probability=a.probability,
         clauses={i: tuple((remap.bits(p), remap.bits(q)) for p, q in row)
                  for i, row in a.clauses.items()},
-        arg_ids=a.arg_ids, objects=a.objects, bits=None,
+        arg_ids=a.arg_ids, objects=a.objects,
     )
     fact_index = {atom: i for i, atom in enumerate(facts)}
     axioms = None if task.axioms is None else task.axioms.remap(remap.new_of.tolist())

@@ -1,18 +1,18 @@
 """Arrays derived from a grounding structure, and the per-call fixpoints that run on them.
 
 `derived(st)` is kept with its `GroundStructure` (`GroundStructure.memo`). It fills in, as calls
-need rows, each row's facts sorted and unique, as fact-id matrices and as uint64 bitset words;
-it also holds the rows' clause facts as CSR. A planning call takes its kept rows from these
-(`task_rows`) instead of sorting and packing them again. `reachable` and `relevant` are the
-grounder's two fixpoints, in C (`avs_planner.cp._fixpoint`) when built, else in numpy (the
-same result; tests compare them).
+need rows, each row's facts sorted and unique, as fact-id matrices (no bitset words: the native
+core keeps an action's non-zero words only, built from these ids); it also holds the rows'
+clause facts as CSR. A planning call takes its kept rows from these (`task_rows`) instead of
+sorting them again. `reachable` and `relevant` are the grounder's two fixpoints, in C
+(`avs_planner.cp._fixpoint`) when built, else in numpy (the same result; tests compare them).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from avs_planner.cp.structure import GroundStructure, bit_words, bitset, fact_matrix
+from avs_planner.cp.structure import GroundStructure, bitset, fact_matrix
 
 try:  # the compiled fixpoints; the numpy versions below compute the same when not built
     from avs_planner.cp import _fixpoint
@@ -31,14 +31,14 @@ def ids_of(mask: int) -> np.ndarray:
 
 class Derived:
     """Per structure row, filled on first use by `rows` (the numpy path of `task_rows`):
-    sorted unique fact ids (-1 padded at the end) and bitset words of pre, pre_neg, add,
-    delete. Computed at once: the rows' clause facts as (interleaved offsets, positives,
-    negatives) plus the row of each clause fact and each clause row's clauses as bitsets,
-    and (when the compiled fixpoints are built) the rows-by-fact indexes they take."""
+    sorted unique fact ids (-1 padded at the end) of pre, pre_neg, add, delete. Computed
+    at once: the rows' clause facts as (interleaved offsets, positives, negatives) plus the
+    row of each clause fact and each clause row's clauses as bitsets, and (when the compiled
+    fixpoints are built) the rows-by-fact indexes they take."""
 
     def __init__(self, st: GroundStructure):
         self._st = st
-        self._cache: tuple | None = None  # (done flags, matrices, bits), made by `rows`
+        self._cache: tuple | None = None  # (done flags, matrices), made by `rows`
         self.clauses = _clause_csr(st)
         clause_rows = sorted(st.clauses)
         self.clause_rows = np.array(clause_rows, dtype=np.int64)
@@ -65,32 +65,26 @@ class Derived:
         cache = self._cache
         if cache is None:  # one tuple, set at once: safe if calls interleave
             st = self._st
-            n_words = len(st.facts) // 64 + 1
             cache = self._cache = (
                 np.zeros((4, st.size), dtype=bool),  # per matrix: row filled in
                 tuple(np.empty(m.shape, dtype=np.int64)
                       for m in (st.pre, st.pre_neg, st.add, st.delete)),
-                tuple(np.empty((st.size, n_words), dtype="<u8") for _ in range(4)),
             )
         return cache
 
-    def rows(self, rows: np.ndarray) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
-        """The four matrices and bitset words of these rows (computing the missing ones,
-        kept per structure): the numpy fallback's path; compiled, `task_rows` sorts the
-        kept rows afresh instead."""
+    def rows(self, rows: np.ndarray) -> tuple[np.ndarray, ...]:
+        """The four matrices of these rows (computing the missing ones, kept per
+        structure): the numpy fallback's path; compiled, `task_rows` sorts the kept rows
+        afresh instead."""
         st, n = self._st, len(self._st.facts)
-        done, matrices, all_bits = self._row_cache()
+        done, matrices = self._row_cache()
         sources = (st.pre, st.pre_neg, st.add, st.delete)
-        for k, (source, matrix, bits) in enumerate(zip(sources, matrices, all_bits,
-                                                       strict=True)):
+        for k, (source, matrix) in enumerate(zip(sources, matrices, strict=True)):
             missing = rows[~done[k][rows]]  # per matrix: safe if calls interleave
-            sorted_rows = fact_matrix(np.take(source, missing, axis=0), n, None)
-            matrix[missing] = sorted_rows
-            bits[missing] = bit_words(sorted_rows, n)
+            matrix[missing] = fact_matrix(np.take(source, missing, axis=0), n, None)
             done[k][missing] = True
         # np.take: ~3x faster than m[rows] for a row gather
-        return (tuple(np.take(m, rows, axis=0) for m in matrices),
-                tuple(np.take(b, rows, axis=0) for b in all_bits))
+        return tuple(np.take(m, rows, axis=0) for m in matrices)
 
 
 def derived(st: GroundStructure) -> Derived:
@@ -131,36 +125,31 @@ def _clause_csr(st: GroundStructure) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
 
 def task_rows(st: GroundStructure, kept_rows: np.ndarray, read: np.ndarray
-              ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
-    """The kept rows' (pre, pre_neg, add, delete) fact-id matrices and bitset words, with
-    add and delete facts that `read` (bool over fact ids + pads) does not mark removed:
-    what `fact_matrix(rows, n, read)` gives. Compiled, the rows are sorted afresh into
-    k-row arrays (cheaper than filling, then gathering from, the structure-wide cache)."""
+              ) -> tuple[np.ndarray, ...]:
+    """The kept rows' (pre, pre_neg, add, delete) fact-id matrices, with add and delete
+    facts that `read` (bool over fact ids + pads) does not mark removed: what
+    `fact_matrix(rows, n, read)` gives. Compiled, the rows are sorted afresh into k-row
+    arrays (cheaper than filling, then gathering from, the structure-wide cache). No bitset
+    words: the native core keeps an action's non-zero words only, from these ids."""
     if _fixpoint is None:
         return _task_rows_numpy(st, kept_rows, read)
     n = len(st.facts)
     n_words = n // 64 + 1
     rows = np.ascontiguousarray(kept_rows, dtype=np.int64)
     read_facts = np.ascontiguousarray(read[:n], dtype=bool)
-    matrices, bits = [], []
+    matrices = []
     for source, mask in ((st.pre, None), (st.pre_neg, None), (st.add, read_facts),
                          (st.delete, read_facts)):
         out = np.empty((len(rows), source.shape[1]), dtype=np.int64)
-        words = np.empty((len(rows), n_words), dtype="<u8")
         _fixpoint.gather_rows(st.size, source, source.shape[1], n, n_words, rows, len(rows),
-                              mask, out, words)
+                              mask, out, None)
         matrices.append(out)
-        bits.append(words)
-    return tuple(matrices), tuple(bits)
+    return tuple(matrices)
 
 
 def _task_rows_numpy(st: GroundStructure, kept_rows: np.ndarray, read: np.ndarray
-                     ) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...]]:
-    n = len(st.facts)
-    (pre, pre_neg, add, delete), (pre_bits, neg_bits, add_bits, delete_bits) = (
-        derived(st).rows(kept_rows)
-    )
-    read_words = bit_words(np.flatnonzero(read[:n])[None, :], n)[0]
+                     ) -> tuple[np.ndarray, ...]:
+    pre, pre_neg, add, delete = derived(st).rows(kept_rows)
     matrices = [pre, pre_neg]
     for m in (add, delete):
         keep = (m >= 0) & read[m]
@@ -169,7 +158,7 @@ def _task_rows_numpy(st: GroundStructure, kept_rows: np.ndarray, read: np.ndarra
             m.sort(axis=1)
             m[m == _BIG] = -1
         matrices.append(m)
-    return tuple(matrices), (pre_bits, neg_bits, add_bits & read_words, delete_bits & read_words)
+    return tuple(matrices)
 
 
 def reachable(st: GroundStructure, init: np.ndarray, allowed: np.ndarray) -> np.ndarray:

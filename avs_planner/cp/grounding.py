@@ -462,9 +462,9 @@ def _action_table(st: GroundStructure, kept_rows: np.ndarray, cost: np.ndarray,
     last = st.memo.get("last_table")
     if last is not None and last[0] == key:
         return last[1], last[2], last[3]
-    (pre, pre_neg, add, delete), bits = task_rows(st, kept_rows, read)
+    pre, pre_neg, add, delete = task_rows(st, kept_rows, read)
     arrays = TaskArrays(
-        pre=pre, pre_neg=pre_neg, add=add, delete=delete, bits=bits,
+        pre=pre, pre_neg=pre_neg, add=add, delete=delete,
         cost=cost, probability=probability, clauses=clauses,
         arg_ids=np.take(st.arg_ids, kept_rows, axis=0), objects=st.space.names,
     )

@@ -19,7 +19,6 @@ from collections import OrderedDict
 from itertools import chain
 
 from avs_planner.cp.relaxed_merge import merge_task
-from avs_planner.cp.structure import bit_words
 from avs_planner.cp.symmetry import Symmetries
 from avs_planner.cp.task import GroundTask
 from avs_planner.errors import PlanningError
@@ -199,17 +198,39 @@ def _csr(lists, n_facts: int, where: str) -> tuple[array, array]:
     return offsets, values
 
 
+def packed_rows(offsets, values) -> bytes:
+    """One action table's fact ids as `_native.Task` takes them: the CSR's n_actions + 1
+    int64 offsets, then the ids (the core keeps each action's non-zero bitset words only)."""
+    import numpy as np
+
+    return (np.ascontiguousarray(offsets, dtype="<i8").tobytes()
+            + np.ascontiguousarray(values, dtype="<i8").tobytes())
+
+
+def _fact_ids(mask: int, n_facts: int, where) -> list[int]:  # noqa: ANN001 - a label thunk
+    """The facts of a bitset, ascending; PlanningError if one lies outside the task."""
+    if mask < 0 or mask >> n_facts:
+        raise PlanningError(f"native search: {where()} names a fact outside the task")
+    ids = []
+    while mask:
+        low = mask & -mask
+        ids.append(low.bit_length() - 1)
+        mask ^= low
+    return ids
+
+
 def task_args(task: GroundTask) -> tuple:
     """The arguments of `_native.Task` from the `GroundAction`s (any task)."""
     n_facts, actions = len(task.facts), task.actions
     n_bytes = 8 * words(n_facts)
-    masks = []
+    rows = []
     for field in ("pre", "pre_neg", "add", "delete"):
-        masks.append(b"".join(
-            _bits(getattr(a, field), n_bytes, n_facts, lambda a=a: a.label) for a in actions))
+        off, ids = _csr((_fact_ids(getattr(a, field), n_facts, lambda a=a: a.label)
+                         for a in actions), n_facts, "an action")
+        rows.append(packed_rows(off, ids))
     pre_off, pre_facts = _csr((a.pre_facts for a in actions), n_facts, "a precondition")
     add_off, add_facts = _csr((a.add_facts for a in actions), n_facts, "an effect")
-    return (n_facts, len(actions), *masks, *_check_actions(task),
+    return (n_facts, len(actions), *rows, *_check_actions(task),
             pre_off, pre_facts, add_off, add_facts, *_clauses(task, n_bytes, n_facts))
 
 
@@ -239,15 +260,10 @@ def task_arrays(task: GroundTask) -> tuple:
 
     pre, neg, add, delete = (matrix(m) for m in (arrays.pre, arrays.pre_neg, arrays.add,
                                                  arrays.delete))
-    given = arrays.bits
-    if given is not None and all(
-        b.dtype == np.dtype("<u8") and b.shape == (n_actions, n_words) for b in given
-    ):
-        masks = tuple(np.ascontiguousarray(b) for b in given)
-    else:
-        masks = tuple(bit_words(m, n_facts) for m in (pre, neg, add, delete))
-    return (n_facts, n_actions, *masks,
-            *_check_actions(task), *csr(pre), *csr(add),
+    pre_csr, add_csr = csr(pre), csr(add)
+    return (n_facts, n_actions, packed_rows(*pre_csr), packed_rows(*csr(neg)),
+            packed_rows(*add_csr), packed_rows(*csr(delete)),
+            *_check_actions(task), *pre_csr, *add_csr,
             *_clauses(task, 8 * n_words, n_facts))
 
 

@@ -120,9 +120,6 @@ class TaskArrays:
     """(actions, max arity) object ids of each action's arguments, padded with -1."""
     objects: Sequence[str] = ()
     """Object names by id (the ids of `arg_ids`)."""
-    bits: tuple[np.ndarray, ...] | None = None
-    """(pre, pre_neg, add, delete) as little-endian uint64 bitset words, one row per action
-    and `len(facts) // 64 + 1` words per row, if the grounder had them at hand."""
 
 
 @dataclass(frozen=True)

@@ -32,10 +32,11 @@ def test_compiled_task_rows_equal_the_numpy_path(corridor_structure, monkeypatch
             m.setattr(derived, "_fixpoint", None)
             plain = derived.task_rows(st, rows, read)
             st.memo.pop("derived")  # made without the compiled indexes: not for later tests
-        for got, expected in zip(compiled[0] + compiled[1], plain[0] + plain[1], strict=True):
+        assert len(compiled) == len(plain) == 4  # pre, pre_neg, add, delete
+        for got, expected in zip(compiled, plain, strict=True):
             assert got.dtype == expected.dtype and np.array_equal(got, expected)
     empty = derived.task_rows(st, np.zeros(0, dtype=np.int64), np.ones(n + 2, bool))
-    assert all(m.shape[0] == 0 for m in empty[0] + empty[1])
+    assert all(m.shape[0] == 0 for m in empty)
 
 
 def test_numeric_values_by_code_match_dict_lookups(corridor_structure):
