@@ -250,6 +250,27 @@ def test_bad_tasks_are_errors_not_crashes():
 
 
 @needs_native
+def test_packed_rows_are_checked_by_the_core():
+    """The core builds an action's non-zero words from packed fact ids (`packed_rows`): a
+    fact id outside the task, or offsets that are not a CSR over the actions, is a
+    ValueError naming the table, never memory read out of bounds."""
+    task = random_ground_task(1)
+    args = list(native.task_args(task))
+    n_facts, n_actions = args[0], args[1]
+    offsets = [0] * (n_actions + 1)
+    offsets[1:] = [1] * n_actions  # action 0 adds one fact, the others none
+    args[4] = native.packed_rows(offsets, [n_facts])  # add: a fact past the last
+    with pytest.raises(ValueError, match="add fact .* outside"):
+        native._native.Task(*args, *native.merge_args(merge_task(task)))
+    args[4] = native.packed_rows([0] * n_actions, [])  # one offset short
+    with pytest.raises(ValueError, match="add is not a packed CSR"):
+        native._native.Task(*args, *native.merge_args(merge_task(task)))
+    args[4] = native.packed_rows([0, 2] + [1] * (n_actions - 1), [0, 1])  # offsets decrease
+    with pytest.raises(ValueError, match="add is not a packed CSR"):
+        native._native.Task(*args, *native.merge_args(merge_task(task)))
+
+
+@needs_native
 @pytest.mark.slow
 def test_generated_avs_problem_and_many_random_tasks():
     """Longer sweep: a generated 8-place AVS problem (dual queue used for hundreds of
