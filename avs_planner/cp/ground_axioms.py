@@ -30,7 +30,7 @@ import numpy as np
 
 from avs_planner.cp.fact_rows import bitset
 from avs_planner.cp.ground_structure import GroundStructure
-from avs_planner.cp.task import GroundAction
+from avs_planner.cp.task import GroundAction, fact_ids
 
 Clause = tuple[tuple[int, ...], tuple[int, ...]]
 
@@ -128,7 +128,7 @@ class GroundAxioms:
             changed = False
             for head, read in support.items():
                 wider = read
-                for f in _ids(read & self.mask):
+                for f in fact_ids(read & self.mask):
                     wider |= support.get(f, 0)
                 if wider != read:
                     support[head] = wider
@@ -141,7 +141,7 @@ class GroundAxioms:
         if not derived:
             return reads
         support = self._support
-        for f in _ids(derived):
+        for f in fact_ids(derived):
             reads |= support.get(f, 0)
         return reads
 
@@ -192,15 +192,6 @@ class GroundAxioms:
                  *np.cumsum([0, *(len(r.clauses) for r in rules)]).tolist(),
                  *csr([p for p, _ in clauses]), *csr([n for _, n in clauses])]
         return np.array(parts, dtype="<i8")
-
-
-def _ids(bits: int) -> list[int]:
-    out = []
-    while bits:
-        low = bits & -bits
-        out.append(low.bit_length() - 1)
-        bits ^= low
-    return out
 
 
 def rules_of_rows(st: GroundStructure, rows: np.ndarray, derived: frozenset[str]

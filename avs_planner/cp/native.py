@@ -20,7 +20,7 @@ from itertools import chain
 
 from avs_planner.cp.relaxed_merge import merge_task
 from avs_planner.cp.symmetry import Symmetries
-from avs_planner.cp.task import GroundTask
+from avs_planner.cp.task import GroundTask, fact_ids
 from avs_planner.errors import PlanningError
 
 try:
@@ -211,12 +211,7 @@ def _fact_ids(mask: int, n_facts: int, where) -> list[int]:  # noqa: ANN001 - a 
     """The facts of a bitset, ascending; PlanningError if one lies outside the task."""
     if mask < 0 or mask >> n_facts:
         raise PlanningError(f"native search: {where()} names a fact outside the task")
-    ids = []
-    while mask:
-        low = mask & -mask
-        ids.append(low.bit_length() - 1)
-        mask ^= low
-    return ids
+    return fact_ids(mask)
 
 
 def task_args(task: GroundTask) -> tuple:

@@ -19,6 +19,16 @@ Atom = tuple[str, ...]
 """A ground atom: (predicate, arg1, ..., argN), names as in the problem."""
 
 
+def fact_ids(bits: int) -> list[int]:
+    """The facts of an int bitset, ascending."""
+    out = []
+    while bits:
+        low = bits & -bits
+        out.append(low.bit_length() - 1)
+        bits ^= low
+    return out
+
+
 def atom_str(atom: Atom) -> str:
     """PDDL-style text of an atom or action: `(move hall far)`."""
     return "(" + " ".join(atom) + ")"
