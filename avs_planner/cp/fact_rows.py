@@ -2,9 +2,10 @@
 
 Condition and effect arrays are padded to a common width with two codes (`_PAD_TRUE`, a fact
 that always holds, and `_PAD_NONE`, one nothing reads or makes true) until the facts are
-numbered; then rows are read back as sorted unique fact matrices (`fact_matrix`) or as bitsets:
-Python ints for the Python search and heuristics (`bitset`, `_row_masks`) and little-endian
-uint64 words for the native core (`bit_words`). The structure, its row compilation, the
+numbered; then rows are read back as sorted unique fact matrices (`fact_matrix`) or as Python
+int bitsets for the Python search and heuristics (`bitset`, `_row_masks`, which goes through
+little-endian uint64 words, `bit_words`). The native core takes the fact matrices and keeps an
+action's non-zero words itself (`native.packed_rows`). The structure, its row compilation, the
 derived arrays (`derived.py`) and the native packing (`native.py`) all share these layouts.
 """
 
@@ -34,7 +35,7 @@ def _row_masks(matrix: np.ndarray, n: int) -> list[int]:
 
 def bit_words(matrix: np.ndarray, n_facts: int) -> np.ndarray:
     """Each row's fact ids (>= 0; -1 is padding) as little-endian uint64 words, one spare bit
-    so that n_facts = 0 still has a word (the native core's layout)."""
+    so that n_facts = 0 still has a word (the layout of the native core's states)."""
     words = n_facts // 64 + 1
     out = np.zeros((matrix.shape[0], words), dtype="<u8")
     rows, cols = np.nonzero(matrix >= 0)
