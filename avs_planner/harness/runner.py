@@ -450,6 +450,7 @@ class Episode:
             reports = [o for part in parts for o in part["objects"]]
             correct = bool(reports) and all(o["correct"] for o in reports)
             task = {**self._task_fields(), "targets": parts}
+        map_score = self._map_score()
         return {
             "outcome": result.outcome.value, "reason": result.reason,
             "target": self.spec.form.name, "category": self.spec.category, "object": obj,
@@ -465,7 +466,10 @@ class Episode:
             "world": self.world_spec.name, "robot": self.robot.model,
             "strategy": self.spec.strategy, "details": result.details,
             "wall_time_s": round(self.trace.wall, 2),
-            **self._map_score(),
+            **map_score,
+            "target_evidence": self._target_evidence(
+                [obj] if obj else [o for part in task.get("targets", []) for o in part["objects"]],
+                map_score.get("map_score")),
             # what the robot's placeholders led to, against what the model predicted
             # (`conceptual_map/conceptual/calibration.py`; the mind's own record)
             "placeholders": self.mind.cmap.calibration.summary(),
@@ -512,6 +516,27 @@ class Episode:
 
         score = map_score(self.world_spec, self.mind, self.executor.stats.path)
         return {} if score is None else {"map_score": score}
+
+    def _target_evidence(self, reports: list[dict[str, Any]],
+                         score: dict[str, Any] | None) -> list[dict[str, Any]]:
+        """The looks' claims about where the target's true instances stand, against what the
+        camera saw of them and what `reports` named (`scoring.evidence_score`; the
+        harness's referee), each instance in the robot room `score` (the map score) matched
+        to its true room. For a task of several labels, its first."""
+        from avs_planner.harness.scoring import evidence_score
+
+        label = self.spec.target
+        robot_room = {r["name"]: r["robot_room"] for r in (score or {}).get("rooms", [])}
+        instances = []
+        for thing in self.robot.world.detectables:
+            if thing.label == label:
+                true_room = self.world_spec.room_at(float(thing.center[0]),
+                                                    float(thing.center[1]))
+                instances.append((thing.name, thing.center,
+                                  robot_room.get(true_room.name) if true_room else None))
+        detected = {name for name in self.robot.truth_of.values() if name}
+        reported = {o["truth"] for o in reports if o.get("truth")}
+        return evidence_score(instances, self.mind, label, detected, reported)
 
     def _dt_results(self) -> dict[str, int]:
         """`dt_confirmed` / `dt_rejected`: the DT sessions of the episode by their result

@@ -195,3 +195,37 @@ def map_score(world: Any, mind: Any, path: Sequence[Sequence[float]]) -> dict[st
     if robot is None:
         return None
     return score_map(true_rooms(world), robot, path)
+
+
+SUPPORT_REACH = 0.8  # m: a known object this near an instance (in the plane) may hold it
+
+
+def evidence_score(instances: Sequence[tuple[str, Sequence[float], str | None]], mind: Any,
+                   label: str, detected: set[str], reported: set[str]) -> list[dict[str, Any]]:
+    """How the robot's looks judged the places the target's true instances stand in, against
+    whether the camera ever saw them: for each instance (name, centre, the robot room that
+    `score_map` matched to its true room, or None), the share of `label`s in that room the
+    mind's looks claim they would have seen (1 - the ledger's `remaining`: searches and
+    frames in passing), the same for the spaces on and in known objects within
+    `SUPPORT_REACH` m (the largest), whether any frame detected it (`detected`: the world
+    entries detections were made of) and whether it was reported. A claim of 0.9 over
+    instances no frame ever detected says the looks are credited with more than they saw.
+    Scoring only: nothing the robot decides reads it."""
+    from conceptual_map.conceptual.existence import RelatedSpace
+
+    ledger = mind.cmap.objects
+    out: list[dict[str, Any]] = []
+    for name, centre, room in instances:
+        known = room is not None and mind.cmap.graph.has_room(room)
+        claim_room = 1.0 - ledger.remaining(room, label) if known else 0.0
+        claim_space = 0.0
+        for obj in mind.objects.values():
+            if obj.label == label or math.dist(obj.position[:2], centre[:2]) > SUPPORT_REACH:
+                continue
+            for relation in ("on", "in"):
+                space = RelatedSpace(relation, obj.id)
+                claim_space = max(claim_space, 1.0 - ledger.remaining(space, label))
+        out.append({"name": name, "room": room if known else None,
+                    "claimed_room": round(claim_room, 4), "claimed_support": round(claim_space, 4),
+                    "detected": name in detected, "reported": name in reported})
+    return out

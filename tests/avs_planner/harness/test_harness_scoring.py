@@ -178,3 +178,54 @@ def test_an_episode_summary_carries_what_its_placeholders_led_to(tmp_path: Path)
     events = [json.loads(line) for line in (tmp_path / "trace.jsonl").read_text().splitlines()]
     traced = [e["placeholders"] for e in events if e["type"] == "belief" and "placeholders" in e]
     assert traced and traced[-1] == placeholders
+
+
+def test_the_looks_claims_about_each_instance_are_scored_against_what_the_camera_saw() -> None:
+    """Each true instance of the target: the robot room holding it, what the ledger says
+    the looks there would have seen (the room, and the spaces of known objects beside it),
+    whether a frame ever detected it and whether it was reported."""
+    from types import SimpleNamespace
+
+    from avs_planner.harness.scoring import evidence_score
+    from conceptual_map.conceptual.existence import RelatedSpace
+
+    remaining = {("room1", "cup"): 0.25, (RelatedSpace("on", "object1"), "cup"): 0.1,
+                 (RelatedSpace("on", "object2"), "cup"): 0.5}
+    ledger = SimpleNamespace(remaining=lambda loc, label: remaining.get((loc, label), 1.0))
+    graph = SimpleNamespace(has_room=lambda rid: rid == "room1")
+    objects = {"object1": SimpleNamespace(id="object1", label="table", position=(1.0, 1.0, 0.4)),
+               "object2": SimpleNamespace(id="object2", label="shelf", position=(5.0, 5.0, 0.4)),
+               "object3": SimpleNamespace(id="object3", label="cup", position=(1.1, 1.0, 0.8))}
+    mind = SimpleNamespace(cmap=SimpleNamespace(objects=ledger, graph=graph), objects=objects)
+    scored = evidence_score([("cup1", (1.2, 1.1, 0.8), "room1"), ("cup2", (3.0, 2.0, 0.9), "room1"),
+                             ("cup3", (8.0, 8.0, 0.9), None)], mind, "cup",
+                            detected={"cup1", "cup2"}, reported={"cup1"})
+    assert scored == [
+        # on the table the ledger says searched 90%; the cup beside it (a known cup) is not
+        # a support
+        {"name": "cup1", "room": "room1", "claimed_room": 0.75, "claimed_support": 0.9,
+         "detected": True, "reported": True},
+        {"name": "cup2", "room": "room1", "claimed_room": 0.75, "claimed_support": 0.0,
+         "detected": True, "reported": False},
+        # in no room the robot mapped: nothing claimed
+        {"name": "cup3", "room": None, "claimed_room": 0.0, "claimed_support": 0.0,
+         "detected": False, "reported": False},
+    ]
+
+
+def test_an_episode_summary_scores_the_looks_at_the_targets_instances(tmp_path: Path) -> None:
+    """Fig. 3a: the cereal box the robot reports was detected, and the search of the table
+    it stands on is credited there; the summary file carries the same. (The kitchen, seen
+    through its door from the corridor, is matched to no robot room: nothing is claimed for
+    the room itself.)"""
+    summary = run_episode({"target": "cerealbox", "world": "office", "seed": 1,
+                           "output_dir": str(tmp_path)})
+    evidence = summary["target_evidence"]
+    assert json.loads((tmp_path / "summary.json").read_text())["target_evidence"] == evidence
+    assert evidence and all(0.0 <= e["claimed_room"] <= 1.0 for e in evidence)
+    assert summary["outcome"] == "found"
+    reported = [e for e in evidence if e["reported"]]
+    assert len(reported) == 1 and reported[0]["detected"]
+    assert reported[0]["claimed_support"] > 0.0
+    matched = {r["robot_room"] for r in summary["map_score"]["rooms"]}
+    assert all(e["room"] is None or e["room"] in matched for e in evidence)
