@@ -72,6 +72,8 @@ class ViewConeSearch:
         self.label, self.relation, self.location = label, relation, location
         self.on_look, self.on_session = on_look, on_session
         self.head: tuple[float, float] = (0.0, 0.0)  # where the camera points (pan, tilt)
+        # the target seen by a look's frame outside the searched location (`_detect_once`)
+        self.elsewhere: SeenLike | None = None
 
     def run(self) -> StepOutcome:
         ctx, robot, cfg = self.context, self.context.robot, self.context.config
@@ -111,6 +113,12 @@ class ViewConeSearch:
                 continue
             match = self._look(label, relation, location)
             session.update(action, match is not None, detection=match)
+            if match is None and self._confirmed_elsewhere():
+                # the look saw the target beside the location searched, and it held: stop
+                # here as the watch does on the way (the looks so far still count)
+                session.update(REJECT)
+                interrupted = True
+                break
         result = session.result
         ctx.stats.dt_decisions.extend(result.decision_times_s)
         ctx.emit("dt", label=label, relation=relation, location=location,
@@ -325,6 +333,7 @@ class ViewConeSearch:
         ctx.stats.views += 1
         if self.on_look is not None:
             self.on_look()
+        self.elsewhere = None
         match = self._detect_once(label, relation, location, self._also_for(label))
         if match is None:
             ctx.emit("observation", label=label, detected=False)
@@ -341,6 +350,25 @@ class ViewConeSearch:
         ctx.emit("observation", label=label, detected=agreed,
                  position=[round(v, 2) for v in match.position])
         return match if agreed else None
+
+    def _confirmed_elsewhere(self) -> bool:
+        """A look's first frame showed the target outside the location searched (on the
+        next support, across the room): confirmed by more frames as the watch confirms what
+        it sees, it becomes a known object (`Sensing.place_seen`) and the search stops for
+        the planner to report it. Before, such a detection only counted for the DT's belief
+        about the location, and was dropped: a book seen from a view cone on the shelf beside
+        the one searched was never looked at again, and the robot gave up (development
+        office 345)."""
+        seen, self.elsewhere = self.elsewhere, None
+        if seen is None:
+            return False
+        again = self.sensing.confirm(seen)
+        self.context.emit("observation", label=seen.label, detected=again, elsewhere=True,
+                          position=[round(v, 2) for v in seen.position])
+        if not again:
+            return False
+        self.sensing.unplaced.append(seen)
+        return self.sensing.place_seen() is not None
 
     def _glimpse_tops(self, label: str, relation: str, location: str) -> None:
         """A look for the target that saw none also looked at the tops of other known
@@ -378,6 +406,8 @@ class ViewConeSearch:
             self.sensing.glimpse(frame, list(also), self.head)
         seen = [s for s in frame if s.label == label]
         matches = [s for s in seen if self._inside(s, relation, location)]
+        if not matches and label == self.context.builder.task.target:
+            self.elsewhere = next((s for s in seen if not self.sensing.known_near(s)), None)
         for s in seen:
             self.context.stats.detections.append((s.position[0], s.position[1], label,
                                                   s in matches))
