@@ -271,8 +271,11 @@ class Executor:
             if obj is None:
                 return StepOutcome(StepStatus.FAILED, f"{step.args[0]} is not a known object")
             if obj.label == self.builder.task.target and not self.verify_report(obj):
-                # a false detection: forgotten, so the planner searches on without it
+                # a false detection, or a real one the verification's frames missed:
+                # forgotten, so the planner searches on without it, and kept as a spot to
+                # look at once more before the search gives up
                 self.mind.forget_object(obj.id)
+                self.mind.unverified.append((obj.label, obj.position))
                 self.found_sids.pop(obj.id, None)
                 return StepOutcome(StepStatus.FAILED, f"{obj.label} not seen again at "
                                    f"{_at(obj.position)} when looked at before reporting; "

@@ -80,6 +80,10 @@ class Mind:
     # sightings from the building memory not checked yet (`episode/memory.py`): never
     # known objects, so nothing is reported from memory alone
     remembered: list = field(default_factory=list)
+    # (label, position) of targets confirmed by frames that the verification before the
+    # report then missed: forgotten as objects, looked at once more before the search gives
+    # up (`strategies/switching/recovery.py`, `recheck_unverified`)
+    unverified: list[tuple[str, tuple[float, float, float]]] = field(default_factory=list)
     # (grid and rooms key, `viewcones.candidate_cells`' result): recomputed when either changes
     cell_cache: tuple | None = field(default=None, init=False, repr=False, compare=False)
     # vanished placeholders until the map tells what lay behind them: the building's

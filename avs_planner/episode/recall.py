@@ -99,6 +99,18 @@ def check_remembered(executor: Executor, labels: Collection[str],
     return found
 
 
+def check_spot(executor: Executor, label: str, position: tuple[float, float, float]
+               ) -> tuple[KnownObject | None, bool]:
+    """Look at one spot where `label` was seen, as a remembered sighting is checked: from the
+    nearest reachable standpoint that sees it, facing it; the known object confirmed there
+    (or None), and whether the robot got to look."""
+    sighting = Sighting(label, position, executor.robot.clock)
+    plan = _standpoints(executor, [sighting])
+    if not plan:
+        return None, False
+    return _check(executor, sighting, plan[0][1])
+
+
 def _standpoints(executor: Executor, todo: list[Sighting]
                  ) -> list[tuple[Sighting, tuple[float, float]]]:
     """Each sighting's nearest reachable standpoint, most likely and then nearest first."""

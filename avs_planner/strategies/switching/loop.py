@@ -273,6 +273,8 @@ class SwitchingLoop:
                 # nothing on the mapped part is worth searching, but exploring is worth
                 # more than the one chain of assumptions a plan puts on it (`_worth_it`)
                 result = self._plan_again("after exploring: nothing mapped was worth its cost")
+            elif self._remedies().recheck_unverified():
+                result = self._plan_again("after looking again where the target was seen")
             elif self._visit_uncertain_room():
                 result = self._plan_again("after visiting an uncertain room")
             elif self._doubt_categories():

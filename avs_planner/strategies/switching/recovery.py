@@ -8,10 +8,12 @@ remedies for when that rhythm breaks, so that each can be read (and tested) on i
   and a plan worth less than it costs, R p(pi) < c(pi), worse than giving up by the CP's
   own objective, becomes "no plan above the threshold" (`Recovery.worth_it`);
 - the steps taken before planning again, while the CP keeps timing out or no plan reaches
-  the threshold: explore the nearest placeholder, drop a support label, re-classify an
-  uncertain room, doubt room categories believed certain, retry spots the base was blocked
-  at. Each returns whether it did anything; the loop (`SwitchingLoop._recover`) decides
-  their order, plans again after each, and gives up when none is left.
+  the threshold: explore the nearest placeholder, drop a support label, look once more
+  where the verification before a report missed a target the frames had confirmed,
+  re-classify an uncertain room, doubt room categories believed certain, retry spots the
+  base was blocked at. Each returns whether it did anything; the loop
+  (`SwitchingLoop._recover`) decides their order, plans again after each, and gives up
+  when none is left.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from avs_planner.cp.continual import ContinualPlanner
 from avs_planner.cp.search import PlanResult, PlanStatus, PlanStep
 from avs_planner.episode.executor import Executor
 from avs_planner.episode.outcome import SearchResult
+from avs_planner.episode.recall import check_spot
 from avs_planner.episode.state_builder import StateBuilder
 from avs_planner.episode.trace import Trace
 
@@ -114,6 +117,32 @@ class Recovery:
         outcome = self.executor.visit_room(room)
         self.trace.emit("action", action=f"(classify {room})", status=outcome.status.value,
                         detail=outcome.detail, category=self.builder.category_belief(room))
+        return True
+
+    def recheck_unverified(self) -> bool:
+        """No plan is good enough: look once more at a spot where frames confirmed the target
+        and the verification before the report then missed it (`Mind.unverified`), from a
+        standpoint that sees it, as a remembered sighting is checked (`recall.check_spot`).
+        Confirmed, it is a known object again (the planner reports it, verifying first).
+        The verification rejects phantoms, and a real object seen from the one spot it steps
+        back to may be hidden by its shelf's side: in development office 345 a book the watch
+        had confirmed was forgotten that way at 218 s and the robot gave up at 1097 s. Each
+        spot once (it leaves the list)."""
+        mind = self.executor.mind
+        target = self.builder.task.target
+        spot = next((u for u in mind.unverified if u[0] == target), None)
+        if spot is None:
+            return False
+        mind.unverified.remove(spot)
+        label, position = spot
+        where = [round(v, 2) for v in position]
+        self.trace.emit("action", action=f"(look-again {label})", status="start",
+                        position=where)
+        known, looked = check_spot(self.executor, label, position)
+        self.trace.emit("action", action=f"(look-again {label})",
+                        status="done" if looked else "failed", position=where,
+                        detail=(f"seen again: {known.id}" if known is not None
+                                else "not seen" if looked else "no way to a spot that sees it"))
         return True
 
     def doubt_categories(self) -> bool:

@@ -151,6 +151,9 @@ def test_the_target_is_looked_at_again_before_it_is_reported(corridor, monkeypat
     # the false detection is forgotten: the planner may search its room again
     assert obj.id not in mind.objects and obj.id not in mind.cmap.objects.objects
     assert ("defined-exists", target, "in", obj.room) not in builder.build().atoms
+    # ... and kept as a spot to look at once more before the search gives up
+    assert mind.unverified == [(target, (x + 1.0, y + 1.0, 0.5))]
+    mind.unverified.clear()
     obj = mind.add_object(target, (x + 1.0, y + 1.0, 0.5))
     step = PlanStep("reportposition", (obj.id, target), 0.0, 1.0, False)
     frames[:] = [[], [Seen(7, target, (x + 1.1, y + 1.0, 0.5), 0.8)]]
@@ -275,3 +278,34 @@ def test_the_success_threshold_bounds_the_search_not_its_result(corridor, switch
     planner = ContinualPlanner(state.skeleton(), loop._options(), min_success=0.2)
     result = planner.replan(state.world_state())
     assert not result.solved or result.probability >= 0.2
+
+
+def test_a_spot_the_verification_missed_is_looked_at_once_more(corridor, monkeypatch) -> None:
+    """No plan is good enough: the loop looks once more at a spot where frames had confirmed
+    the target before the verification missed it (`Recovery.recheck_unverified`); seen
+    again, it is a known object for the planner to report. Each spot once; spots of other
+    labels are not the target's."""
+    from avs_planner.strategies.switching.loop import LoopConfig
+    from avs_planner.strategies.switching.recovery import Recovery
+
+    mind, builder, executor = corridor
+    _, (x, y) = _here(mind)
+    target = builder.task.target
+    spot = (x + 1.0, y + 0.5, 0.5)
+    trace = Trace(lambda: executor.robot.clock, None, None)
+    recovery = Recovery(builder, executor, trace, LoopConfig())
+    assert not recovery.recheck_unverified()  # nothing to look at again
+    mind.unverified.append(("stapler", spot))
+    assert not recovery.recheck_unverified() and mind.unverified == [("stapler", spot)]
+    mind.unverified.append((target, spot))
+    monkeypatch.setattr(executor.robot, "detect",
+                        lambda labels=None: [Seen(9, target, spot, 0.9)]
+                        if labels is None or target in labels else [])
+    assert recovery.recheck_unverified()
+    assert mind.unverified == [("stapler", spot)]  # the target's spot is used up
+    again = [o for o in mind.objects.values() if o.label == target]
+    assert len(again) == 1 and again[0].position == spot
+    events = [e for e in trace.events if e.get("action") == f"(look-again {target})"]
+    assert [e["status"] for e in events] == ["start", "done"]
+    assert events[1]["detail"] == f"seen again: {again[0].id}"
+    assert not recovery.recheck_unverified()  # once per spot
