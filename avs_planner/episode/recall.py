@@ -61,8 +61,14 @@ def check_remembered(executor: Executor, labels: Collection[str],
     skipped: list[Sighting] = []
     if not any(s.label in labels and s.weight >= CHECK_WEIGHT for s in mind.remembered):
         return found
-    executor.look_around()
     here = tuple(executor.robot.pose[:2])
+    known = _check_in_view(executor, labels, emit)
+    if known is not None:
+        # seen again where it was, from where the robot stands: the strategy's look round
+        # is skipped too (the robot has not moved)
+        executor.sensing.resumed = here
+        return [known]
+    executor.look_around()
     if any(obj.label in labels for obj in mind.objects.values()):
         executor.sensing.resumed = here  # a wanted object in view: nothing to check first
         return found
@@ -97,6 +103,55 @@ def check_remembered(executor: Executor, labels: Collection[str],
     if found or math.dist(here, executor.robot.pose[:2]) <= SAME_SPOT:
         executor.sensing.resumed = tuple(executor.robot.pose[:2])
     return found
+
+
+def _check_in_view(executor: Executor, labels: Collection[str], emit: Callable[..., Any]
+                   ) -> KnownObject | None:
+    """Before the look round: the sightings worth a check that the camera sees from where
+    the robot stands (a free line of sight in the map, the same room, within the detection
+    range), most likely first, are looked at by turning to them. The look round would reach
+    them only at their turn of the scan, in about 10 s, and without memory the robot knows
+    no direction better than another; with it, one turn and the frames of a confirmation
+    tell. One seen again becomes a known object (the first returned); one not seen is
+    dropped as a check drops it (missed by two frames of three, it is likelier gone than
+    not)."""
+    mind, robot = executor.mind, executor.robot
+    here = robot.pose[:2]
+    room = mind.room_at(here, floor_only=True)
+    if room is None:
+        return None
+    far = _sight_distance(executor)
+    occupied = mind.grid.state_grid() == CellState.OCCUPIED
+    camera = executor.camera
+    in_view = [s for s in mind.remembered if s.label in labels and s.weight >= CHECK_WEIGHT
+               and math.hypot(math.dist(s.position[:2], here),
+                              camera.height - s.position[2]) <= far
+               and mind.room_at(s.position[:2], floor_only=True) == room
+               and _in_sight(mind.grid, occupied, here, s.position[:2])]
+    reach = executor.config.same_object
+    for sighting in sorted(in_view, key=lambda s: (-s.weight, math.dist(s.position[:2],
+                                                                          here))):
+        if sighting not in mind.remembered:
+            continue  # the spot of a sighting checked before
+        known = _look_at(executor, sighting)
+        # older sightings of the same spot are answered by the same look
+        mind.remembered[:] = [s for s in mind.remembered if s.label != sighting.label
+                              or math.dist(s.position[:2], sighting.position[:2]) > reach]
+        emit("memory", checked=sighting.label, position=[round(v, 2) for v in
+                                                         sighting.position],
+             weight=round(sighting.weight, 3), seen=known is not None, in_view=True,
+             **({"object": known.id} if known is not None else {"dropped": True}))
+        if known is not None:
+            executor.sensing.locate()  # the place of the remembered map the robot is at
+            return known
+    return None
+
+
+def _sight_distance(executor: Executor) -> float:
+    """How far a look from where the robot stands counts as seeing a spot: the detection
+    range (the body's, else the camera's) with the margin a standpoint keeps from it."""
+    body = executor.mind.body
+    return 0.9 * (body.detect_range if body is not None else executor.camera.detect_range)
 
 
 def check_spot(executor: Executor, label: str, position: tuple[float, float, float]
@@ -179,6 +234,12 @@ def _check(executor: Executor, sighting: Sighting, stand: tuple[float, float]
         return near, True
     if outcome.status is not StepStatus.DONE:
         return None, False
+    return _look_at(executor, sighting), True
+
+
+def _look_at(executor: Executor, sighting: Sighting) -> KnownObject | None:
+    """Face the spot and look: the known object confirmed there, or None."""
+    mind = executor.mind
     seen = _Seen(sighting.label, sighting.position)
     x, y, _ = executor.robot.pose
     dx, dy = sighting.position[0] - x, sighting.position[1] - y
@@ -186,11 +247,11 @@ def _check(executor: Executor, sighting: Sighting, stand: tuple[float, float]
     executor.context.look(0.0, -math.atan2(executor.camera.height - sighting.position[2],
                                            max(math.hypot(dx, dy), 0.1)))
     if not executor.confirm(seen):
-        return None, True
+        return None
     room = mind.room_at(sighting.position[:2]) or mind.nearest_room(sighting.position[:2])
     if room is None:
-        return None, True
-    return mind.add_object(sighting.label, sighting.position, room=room), True
+        return None
+    return mind.add_object(sighting.label, sighting.position, room=room)
 
 
 def _known_near(objects, sighting: Sighting, reach: float  # noqa: ANN001 - known objects

@@ -106,3 +106,35 @@ def _half_turn_look(spec: EpisodeSpec) -> float:
     finally:
         episode.trace.close()
         episode.robot.world.close()
+
+
+def test_a_target_found_in_a_look_around_where_the_map_has_places_ends_it_there() -> None:
+    """Once the map has places (a later look, or the first in a building the robot
+    remembers), a target confirmed at some heading ends the look around at once: the
+    report's verification looks from there, and the scan behind would serve a search that
+    is over."""
+    import dataclasses
+    import math
+
+    spec = EpisodeSpec.from_dict({"target": "cerealbox", "world_file": WORLD, "seed": 0})
+    for _ in range(4):  # a frame confirms a sighting 9 times in 10
+        episode = Episode(spec)
+        try:
+            executor, robot = episode.executor, episode.executor.robot
+            executor.config = dataclasses.replace(executor.config, look_headings=6)
+            executor.watching = False  # a first look that maps the hall but sees no target
+            executor.look_around()
+            assert episode.mind.place_map.current_place is not None
+            assert not [o for o in episode.mind.objects.values() if o.label == "cerealbox"]
+            executor.watching = True
+            robot.turn_to(0.0)  # the table a quarter turn to the left
+            executor.look_around()
+            if not [o for o in episode.mind.objects.values() if o.label == "cerealbox"]:
+                continue
+            turned = (robot.pose[2] - 0.0) % (2 * math.pi)
+            assert turned < math.pi - 0.1, "the look went on past the heading that found it"
+            return
+        finally:
+            episode.trace.close()
+            episode.robot.world.close()
+    raise AssertionError("the cereal box to the left was never confirmed")

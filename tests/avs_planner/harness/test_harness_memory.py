@@ -107,3 +107,39 @@ def test_bad_memory_settings_and_files_are_named(tmp_path):
     (tmp_path / "memory.json").write_text("{not json", encoding="utf-8")
     with pytest.raises(EpisodeError, match="memory.json: not a building memory"):
         run_episode({"target": "cup", "memory": str(tmp_path)})
+
+
+# the robot starts in the kitchen, its back to the table with the cereal box
+KITCHEN = OFFICE.replace("robot: {model: pioneer, start: [6.0, 3.2, 0.0]}",
+                         "robot: {model: pioneer, start: [3.4, 5.4, 0.0]}")
+
+
+def test_a_sighting_in_view_of_the_start_is_looked_at_before_the_look_round(tmp_path):
+    """`recall._check_in_view`: a remembered object the camera sees from where the robot
+    stands is checked by turning to it, before and instead of the look round."""
+    assert KITCHEN != OFFICE
+    building = tmp_path / "building"
+    first = _task(KITCHEN, building, tmp_path / "task1")
+    assert first["outcome"] == "found" and first["correct"]
+    second_memory = tmp_path / "again"
+    shutil.copytree(building, second_memory)
+    second = _task(KITCHEN, second_memory, tmp_path / "task2")
+    checks = [e for e in _events(tmp_path / "task2", "memory") if "checked" in e]
+    assert checks[0]["in_view"] is True and checks[0]["seen"] is True
+    assert second["outcome"] == "found" and second["correct"]
+    assert second["distance_m"] == 0.0
+    assert [e["looked_around"] for e in _events(tmp_path / "task2", "belief")
+            if "looked_around" in e][0].startswith("skipped")
+    # one turn and the confirmation's frames instead of a turn all round
+    assert second["sim_time_s"] < 0.6 * first["sim_time_s"]
+    # the box carried away overnight: the look finds nothing there, the sighting is dropped
+    # and the search goes on as without it
+    moved = tmp_path / "moved"
+    shutil.copytree(building, moved)
+    third = _task(MOVED.replace("robot: {model: pioneer, start: [6.0, 3.2, 0.0]}",
+                                "robot: {model: pioneer, start: [3.4, 5.4, 0.0]}"),
+                  moved, tmp_path / "task3")
+    checks = [e for e in _events(tmp_path / "task3", "memory") if "checked" in e]
+    assert checks[0]["in_view"] is True and checks[0]["dropped"] is True
+    assert third["outcome"] == "found" and third["correct"]
+    assert third["object"]["position"][:2] != first["object"]["position"][:2]
