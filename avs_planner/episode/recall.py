@@ -3,13 +3,15 @@
 A sighting from an earlier task (`episode/memory.py`) is never reported as it stands: the
 object may have been moved since. Before a task's search begins, the robot checks the
 sightings of the labels it wants that are more likely still there than not (weight at least
-`CHECK_WEIGHT`, P = exp(-rate x days) from the knowledge's `mobility` section), most likely
-first and, among equals, nearest first: it drives to a standpoint that sees the spot (within
-the camera distance a report's verification uses, with a free line of sight in its map),
-faces it and looks. An object confirmed there, by the frames a new detection needs, becomes a
-known object of this task (the strategy reports it after its own verification); one not seen
-is dropped, with a `memory` trace event. Sightings it could not reach stay for a later task.
-Every strategy's task starts with the same check (the harness runs it before the strategy).
+`CHECK_WEIGHT`, P = exp(-rate x days) from the knowledge's `mobility` section). Those the
+camera sees from where the robot stands it looks at first by turning to them
+(`_check_in_view`); then, after a look round, the rest, most likely first and, among equals,
+nearest first: it drives to a standpoint that sees the spot (within the camera distance a
+report's verification uses, with a free line of sight in its map), faces it and looks. An
+object confirmed there, by the frames a new detection needs, becomes a known object of this
+task (the strategy reports it after its own verification); one not seen is dropped, with a
+`memory` trace event. Sightings it could not reach stay for a later task. Every strategy's
+task starts with the same check (the harness runs it before the strategy).
 """
 
 from __future__ import annotations
