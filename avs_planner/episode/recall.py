@@ -93,10 +93,7 @@ def check_remembered(executor: Executor, labels: Collection[str],
             skipped.append(sighting)
             continue
         mind.remembered.remove(sighting)
-        emit("memory", checked=sighting.label, position=[round(v, 2) for v in
-                                                         sighting.position],
-             weight=round(sighting.weight, 3), seen=known is not None,
-             **({"object": known.id} if known is not None else {"dropped": True}))
+        _emit_checked(emit, sighting, known)
         if known is not None:
             found.append(known)
     # where the robot stands now, the look round or the check's frames have looked: the
@@ -139,14 +136,19 @@ def _check_in_view(executor: Executor, labels: Collection[str], emit: Callable[.
         # older sightings of the same spot are answered by the same look
         mind.remembered[:] = [s for s in mind.remembered if s.label != sighting.label
                               or math.dist(s.position[:2], sighting.position[:2]) > reach]
-        emit("memory", checked=sighting.label, position=[round(v, 2) for v in
-                                                         sighting.position],
-             weight=round(sighting.weight, 3), seen=known is not None, in_view=True,
-             **({"object": known.id} if known is not None else {"dropped": True}))
+        _emit_checked(emit, sighting, known, in_view=True)
         if known is not None:
             executor.sensing.locate()  # the place of the remembered map the robot is at
             return known
     return None
+
+
+def _emit_checked(emit: Callable[..., Any], sighting: Sighting, known: KnownObject | None,
+                  **more: Any) -> None:
+    """The trace's `memory` event of one check: seen again (the known object) or dropped."""
+    emit("memory", checked=sighting.label, position=[round(v, 2) for v in sighting.position],
+         weight=round(sighting.weight, 3), seen=known is not None, **more,
+         **({"object": known.id} if known is not None else {"dropped": True}))
 
 
 def _sight_distance(executor: Executor) -> float:
