@@ -104,9 +104,16 @@ class BuildingMemory:
                     (*self.objects, *self.sightings), key=lambda o: o["seen_at"])}}
 
 
-def remember(mind: Mind, previous: BuildingMemory | None, start: float) -> BuildingMemory:
+def remember(mind: Mind, previous: BuildingMemory | None, start: float,
+             same_spot: float = 1.0) -> BuildingMemory:
     """The memory after a task that began at building time `start` (the mind's clock counts
-    from there): its map, evidence and objects, and the sightings it did not check."""
+    from there): its map, evidence and objects, and the sightings it did not check.
+
+    A sighting is superseded by a later one of its label within `same_spot` m (the
+    executor's `same_object`): by an object of the mind (seen, or recalled furniture, in
+    this task), or by a newer sighting not checked either. An object seen at the same spot
+    task after task (a plant nobody searches for) is then remembered once, at its latest,
+    instead of once per task."""
     grid = mind.grid
     objects, index = [], {}
     for oid, obj in mind.objects.items():
@@ -114,7 +121,7 @@ def remember(mind: Mind, previous: BuildingMemory | None, start: float) -> Build
         objects.append({"label": obj.label, "position": [round(v, 3) for v in obj.position],
                         "support": index.get(obj.support) if obj.support else None,
                         "seen_at": round(start + mind.seen_at.get(oid, mind.clock), 3)})
-    sightings = [s.to_json() for s in mind.remembered if isinstance(s, Sighting)]
+    sightings = [s.to_json() for s in _latest(mind, same_spot)]
     return BuildingMemory(
         tasks=(previous.tasks if previous is not None else 0) + 1,
         clock=start + mind.clock,
@@ -123,6 +130,23 @@ def remember(mind: Mind, previous: BuildingMemory | None, start: float) -> Build
         place_map=mind.place_map.export(), evidence=mind.cmap.graph.place_evidence(),
         objects=objects, sightings=sightings,
         saved=datetime.now(UTC).isoformat(timespec="seconds"))
+
+
+def _latest(mind: Mind, same_spot: float) -> list[Sighting]:
+    """The mind's unchecked sightings less those superseded (`remember`), oldest first."""
+    def near(label: str, position: tuple[float, ...], other_label: str,
+             other: tuple[float, ...]) -> bool:
+        return label == other_label and math.dist(position[:2], other[:2]) <= same_spot
+
+    kept: list[Sighting] = []
+    for s in sorted((s for s in mind.remembered if isinstance(s, Sighting)),
+                    key=lambda s: -s.seen_at):
+        if any(near(s.label, s.position, o.label, o.position) for o in mind.objects.values()):
+            continue
+        if any(near(s.label, s.position, k.label, k.position) for k in kept):
+            continue
+        kept.append(s)
+    return kept[::-1]
 
 
 def recall(mind: Mind, memory: BuildingMemory, start: float) -> dict[str, Any]:

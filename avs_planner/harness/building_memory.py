@@ -66,9 +66,11 @@ class EpisodeMemory:
 
         self.confirmed = len(check_remembered(executor, labels, counted, budget_left))
 
-    def keep(self, mind: Mind) -> dict[str, Any]:
-        """Write what the robot knows now to the memory; the summary's `memory` part."""
-        memory.save(memory.remember(mind, self.kept, self.start), self.directory)
+    def keep(self, mind: Mind, same_spot: float) -> dict[str, Any]:
+        """Write what the robot knows now to the memory (a sighting superseded by a later
+        one within `same_spot` m, the executor's `same_object`, is not kept); the summary's
+        `memory` part."""
+        memory.save(memory.remember(mind, self.kept, self.start, same_spot), self.directory)
         recalled = self.recalled or {}
         return {"tasks_before": self.kept.tasks if self.kept is not None else 0,
                 "building_clock_s": round(self.start, 1),

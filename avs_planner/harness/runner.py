@@ -393,7 +393,8 @@ class Episode:
                 result = search(self.context)
             summary = self.summary(result, start_clock, start_distance, targets)
             if self.memory is not None:
-                summary["memory"] = self.memory.keep(self.mind)
+                summary["memory"] = self.memory.keep(self.mind,
+                                                     self.executor.config.same_object)
             summary.update(self._learn(result))
             if self.out is not None:
                 write_summary(self.out / "summary.json", summary)

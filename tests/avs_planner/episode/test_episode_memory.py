@@ -87,6 +87,38 @@ def test_sightings_not_checked_are_kept_with_their_age(kept):
     assert ages == {o["label"]: o["seen_at"] for o in mem.objects if o["label"] != "table"}
 
 
+def test_an_object_seen_again_at_its_spot_is_remembered_once_at_its_latest(kept):
+    """A plant nobody searches for, seen at the same spot task after task, used to be kept
+    once per task (the new object beside every older sighting never checked)."""
+    _, mem = kept
+    for task in range(3):
+        mind = Mind()
+        start = mem.clock + memory.DAY_S
+        memory.recall(mind, mem, start=start)
+        room = next(iter(mind.place_map.rooms))
+        # the book seen again 0.3 m from where it lay; the cup not looked at (still kept)
+        mind.add_object("book", (5.3, 3.0, 0.1), room=room)
+        mem = memory.remember(mind, mem, start=start, same_spot=1.0)
+        books = [o for o in (*mem.objects, *mem.sightings) if o["label"] == "book"]
+        assert len(books) == 1 and books[0]["position"][0] == pytest.approx(5.3), task
+        assert books[0]["seen_at"] == pytest.approx(start + mind.clock)
+        assert [s["label"] for s in mem.sightings] == ["cup"]
+    # two sightings of one spot, neither checked: the newer is kept; another spot stays
+    mind = Mind()
+    memory.recall(mind, mem, start=mem.clock + memory.DAY_S)
+    cup = next(s for s in mind.remembered if s.label == "cup")
+    mind.remembered.append(Sighting("cup", (cup.position[0] + 0.4, *cup.position[1:]),
+                                    cup.seen_at + 10.0, cup.weight))
+    mind.remembered.append(Sighting("cup", (cup.position[0] + 3.0, *cup.position[1:]),
+                                    cup.seen_at - 10.0, cup.weight))
+    again = memory.remember(mind, mem, start=mem.clock + memory.DAY_S, same_spot=1.0)
+    kept_cups = sorted((s["seen_at"], s["position"][0]) for s in again.sightings
+                       if s["label"] == "cup")
+    assert kept_cups == [
+        (pytest.approx(cup.seen_at - 10.0), pytest.approx(cup.position[0] + 3.0)),
+        (pytest.approx(cup.seen_at + 10.0), pytest.approx(cup.position[0] + 0.4))]
+
+
 def test_files_round_trip(kept, tmp_path):
     _, mem = kept
     assert memory.load(tmp_path) is None  # a first task: nothing kept yet
