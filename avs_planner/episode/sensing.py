@@ -108,9 +108,30 @@ class Sensing:
         without a camera frame: in a building it remembers, the places are there already
         (the classifier's readings of them too), and a look at what is in view is the
         caller's."""
-        ctx = self.context
-        ctx.mind.sense(ctx.robot.scan(), [ctx.robot.pose], ctx.robot.clock)
+        self._emit_map_events(self._integrate([self.context.robot.pose]))
         self._record_pose()
+
+    def _integrate(self, poses: list[Pose]) -> list:
+        """A scan from `poses` into the mind's maps; the map events it made. What the
+        building's placeholders led to so far, when that changed, goes to the trace (and how
+        it corrects the placeholder model: `conceptual_map/conceptual/calibration.py`)."""
+        ctx = self.context
+        mind = ctx.mind
+        resolved = mind.placeholder_outcomes.resolved
+        events = mind.sense(ctx.robot.scan(), poses, ctx.robot.clock)
+        if mind.placeholder_outcomes.resolved != resolved:
+            ctx.emit("belief", placeholders=mind.cmap.calibration.summary())
+        return events
+
+    def _emit_map_events(self, events: list) -> None:
+        """The trace's count of a scan's map events by kind and change (its `belief` event
+        with `map_events`; the map snapshots follow it: `reporting/snapshots.py`)."""
+        if events:
+            kinds: dict[str, int] = {}
+            for e in events:
+                key = f"{e.kind.value}_{e.change.value}"
+                kinds[key] = kinds.get(key, 0) + 1
+            self.context.emit("belief", map_events=kinds)
 
     def sense(self, poses: list[Pose], watch: bool = False) -> KnownObject | None:
         """Integrate a scan from `poses`; the detector watches when asked or at a new place.
@@ -119,12 +140,7 @@ class Sensing:
         ctx = self.context
         mind = ctx.mind
         before = mind.place_map.current_place
-        resolved = mind.placeholder_outcomes.resolved
-        events = mind.sense(ctx.robot.scan(), poses, ctx.robot.clock)
-        if mind.placeholder_outcomes.resolved != resolved:
-            # what the building's placeholders led to so far, and how that corrects the
-            # placeholder model (`conceptual_map/conceptual/calibration.py`)
-            ctx.emit("belief", placeholders=mind.cmap.calibration.summary())
+        events = self._integrate(poses)
         place = mind.place_map.current_place
         if place is not None and (place != before or place not in mind.classified):
             self.classify()
@@ -135,12 +151,7 @@ class Sensing:
             # a target confirmed before the map had a room for it (the very first look) is
             # found now that the scan gave it one: the caller stops as for a watch's find
             seen = self.place_seen() or seen
-        if events:
-            kinds: dict[str, int] = {}
-            for e in events:
-                key = f"{e.kind.value}_{e.change.value}"
-                kinds[key] = kinds.get(key, 0) + 1
-            ctx.emit("belief", map_events=kinds)
+        self._emit_map_events(events)
         self._record_pose()
         return seen
 

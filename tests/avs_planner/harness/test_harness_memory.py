@@ -130,6 +130,10 @@ def test_a_sighting_in_view_of_the_start_is_looked_at_before_the_look_round(tmp_
     assert second["distance_m"] == 0.0
     assert [e["looked_around"] for e in _events(tmp_path / "task2", "belief")
             if "looked_around" in e][0].startswith("skipped")
+    # the scan that put the robot at its place of the remembered map is in the trace, as
+    # every scan's map events are (the map snapshots follow them)
+    assert any("map_events" in e and e["t"] >= checks[0]["t"]
+               for e in _events(tmp_path / "task2", "belief"))
     # one turn and the confirmation's frames instead of a turn all round
     assert second["sim_time_s"] < 0.6 * first["sim_time_s"]
     # the box carried away overnight: the look finds nothing there, the sighting is dropped
