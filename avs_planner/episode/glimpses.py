@@ -48,6 +48,8 @@ from conceptual_map.conceptual import RelatedSpace
 from conceptual_map.metric import CellState
 
 STANDPOINT = 1.0  # m: camera positions nearer than this are one standpoint
+# frames kept to credit to a support's top once it is known: a look round's dozen and more
+RECENT_FRAMES = 32
 MAX_LOOKS = 4  # standpoints counted per cell (beyond, a miss is practically ruled out)
 
 
@@ -69,6 +71,11 @@ class Glimpses:
         self.tops: dict[tuple[str, str], list[set[tuple[int, int]]]] = {}
         self._top_points = _disc_points(support_body)
         self.frames = 0
+        # the last frames checked for a label on tops (pose, pan, tilt, standpoint), and the
+        # supports whose top they were credited to (`_tops`)
+        self._recent: dict[str, list[tuple[tuple[float, float, float], float, float,
+                                           tuple[int, int]]]] = {}
+        self._credited: set[tuple[str, str]] = set()
 
     def frame(self, pose: tuple[float, float, float], pan: float, tilt: float,
               labels: Iterable[str], supports: Iterable[str] = (),
@@ -114,7 +121,8 @@ class Glimpses:
                     self._observe(label, room, share)
                     changed.setdefault(label, {})[room] = round(share, 3)
         if tops_label is not None:
-            self._tops(pose, pan, tilt, tops_label, supports, stand)
+            self._tops(pose, pan, tilt, tops_label, supports, stand,
+                       missed=tops_label in labels)
         return changed
 
     def _share(self, looks: list[int]) -> float:
@@ -131,23 +139,40 @@ class Glimpses:
         cmap.observe_glimpses(label, location, min(1.0, share))
 
     def _tops(self, pose: tuple[float, float, float], pan: float, tilt: float, label: str,
-              supports: Iterable[str], stand: tuple[int, int]) -> None:
+              supports: Iterable[str], stand: tuple[int, int], missed: bool = True) -> None:
+        """Each known support's top points this frame had in view, looked at once more from
+        `stand`. A support checked here for the first time is first credited with the
+        frames before this one (the last `RECENT_FRAMES`): the frames that found and
+        confirmed it had its top in view too, without the target on it, before it was a
+        known object; counted only from then on, a desk the first look round found kept
+        its whole prior share, and the CP planned a search of it as if nobody had looked.
+        `missed`: the frame did not show `label` (only such frames are kept for later)."""
+        recent = self._recent.setdefault(label, [])
         for oid in supports:
             obj = self.mind.objects.get(oid)
             if obj is None:
                 continue
-            seen = self._top_in_view(obj.position[:2], pose, pan, tilt, _top(obj))
-            if not seen.any():
-                continue
-            looks = self.tops.setdefault((label, oid), [set() for _ in self._top_points])
+            frames = [(pose, pan, tilt, stand)]
+            if (label, oid) not in self._credited:
+                self._credited.add((label, oid))
+                frames = [*recent, *frames]
             new = False
-            for i in np.flatnonzero(seen):
-                if stand not in looks[i] and len(looks[i]) < MAX_LOOKS:
-                    looks[i].add(stand)
-                    new = True
+            for f_pose, f_pan, f_tilt, f_stand in frames:
+                seen = self._top_in_view(obj.position[:2], f_pose, f_pan, f_tilt, _top(obj))
+                if not seen.any():
+                    continue
+                looks = self.tops.setdefault((label, oid), [set() for _ in self._top_points])
+                for i in np.flatnonzero(seen):
+                    if f_stand not in looks[i] and len(looks[i]) < MAX_LOOKS:
+                        looks[i].add(f_stand)
+                        new = True
             if new:
+                looks = self.tops[(label, oid)]
                 self._observe(label, RelatedSpace("on", oid),
                               self._share([len(where) for where in looks]))
+        if missed:
+            recent.append((pose, pan, tilt, stand))
+            del recent[:-RECENT_FRAMES]
 
     def top_share(self, oid: str, looks: Iterable[tuple[tuple[float, float, float], float,
                                                        float, int]]) -> float | None:

@@ -161,6 +161,40 @@ def test_a_support_top_seen_from_two_standpoints_is_two_looks(corridor) -> None:
     assert twice == pytest.approx(twice_seen * 0.36 ** 2 + (1 - twice_seen) * 0.36)
 
 
+def test_the_frames_before_a_support_was_known_count_for_its_top(corridor) -> None:
+    """The frames that found a table (before it was a known object) had its top in view
+    without the target on it: once the table is known, they count as looks at its top.
+    Counted only from then on, a desk found in the first look round kept its whole prior
+    share, and the CP planned a search of it as if nobody had looked."""
+    mind, _, executor = corridor
+    room, (x, y) = _room_and_pose(mind)
+    g = _glimpses(mind, executor)
+    # a frame that did not show the target (it is among the labels the frame did not show),
+    # with no support known yet
+    g.frame((x, y, 0.0), 0.0, -0.15, ["cerealbox"], [], tops_label="cerealbox")
+    table = mind.add_object("table", (x + 2.0, y, 0.375))
+    where = RelatedSpace("on", table.id)
+    assert mind.cmap.objects.remaining(where, "cerealbox") == pytest.approx(1.0)
+    # the next frame looks away from the table; the first one is credited to its top now
+    g.frame((x, y, math.pi), 0.0, -0.15, ["cerealbox"], [table.id], tops_label="cerealbox")
+    assert mind.cmap.objects.remaining(where, "cerealbox") == pytest.approx(0.36)
+    # once only
+    g.frame((x, y, math.pi), 0.0, -0.15, ["cerealbox"], [table.id], tops_label="cerealbox")
+    assert mind.cmap.objects.remaining(where, "cerealbox") == pytest.approx(0.36)
+
+
+def test_a_frame_that_showed_the_target_is_not_counted_for_a_support_later(corridor) -> None:
+    mind, _, executor = corridor
+    room, (x, y) = _room_and_pose(mind)
+    g = _glimpses(mind, executor)
+    # the target was in this frame: it is not among the labels the frame did not show
+    g.frame((x, y, 0.0), 0.0, -0.15, ["table"], [], tops_label="cerealbox")
+    table = mind.add_object("table", (x + 2.0, y, 0.375))
+    g.frame((x, y, math.pi), 0.0, -0.15, ["cerealbox"], [table.id], tops_label="cerealbox")
+    assert mind.cmap.objects.remaining(RelatedSpace("on", table.id), "cerealbox") == \
+        pytest.approx(1.0)
+
+
 # ---- the CP's objective as a stopping rule -------------------------------------------------
 
 def _result(steps: list[PlanStep], p: float, cost: float) -> PlanResult:
