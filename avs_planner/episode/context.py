@@ -89,6 +89,12 @@ class ExecutorConfig:
     # directions the detector looks in at a new place (`look_around`): 2 is ahead and behind;
     # 6 covers the whole turn with the camera's 60 degree field of view
     look_headings: int = 2
+    # a look around turns only to the headings whose frame is worth its time: one where
+    # R x P(the frame shows a wanted label, as the glimpses leave it) is below the frame's
+    # seconds is skipped, unless it would see space outside the entered rooms
+    # (`Sensing.look_around`, `Glimpses.frame_value`); needs `glimpses`, the switching
+    # strategy turns this on
+    look_by_value: bool = False
     # every frame also asks for the knowledge's furniture labels, and one that the frames
     # with its spot in view mostly showed becomes a known object: evidence for its room's
     # category (`episode/landmarks.py`); the switching strategy turns this on

@@ -38,7 +38,7 @@ support whose P(target on it) falls below the planner's threshold is settled
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 
@@ -124,6 +124,68 @@ class Glimpses:
             self._tops(pose, pan, tilt, tops_label, supports, stand,
                        missed=tops_label in labels)
         return changed
+
+    def frame_value(self, pose: tuple[float, float, float], pan: float, tilt: float,
+                    labels: Sequence[str], p_room: Callable[[str, str], float]) -> float:
+        """P(a frame from `pose`, the head at (`pan`, `tilt`), shows one of `labels`), as
+        the looks so far leave it: for each label and each room with candidate cells in
+        view, the room's P(label there) (`p_room(label, room)`, already thinned by these
+        looks) times the share of its unseen mass in view that this standpoint has not
+        looked at yet (a cell weighs (1 - p_detect) to the number of standpoints it was
+        looked at from, as `_share` counts it), times p_detect. Infinite when the frame
+        would see space outside the rooms the robot has entered (unknown cells, or free
+        floor no such room holds: a room beyond a door), which the map cannot price."""
+        if self._sees_beyond(pose, pan):
+            return math.inf
+        points, rooms = candidate_cells(self.mind)
+        if not len(points):
+            return math.inf
+        seen = self.in_view(points, pose, pan, tilt, self.camera.support_height)
+        if not seen.any():
+            return 0.0
+        keys = [tuple(k) for k in self._keys(points).tolist()]
+        stand = (round(pose[0] / STANDPOINT), round(pose[1] / STANDPOINT))
+        miss = 1.0 - self.p_detect
+        value = 0.0
+        for label in labels:
+            looks = self.cells.get(label, {})
+            counts = [looks.get(k, ()) for k in keys]
+            weight = np.array([miss ** len(c) for c in counts])
+            # a cell looked at from this standpoint already, or as often as `frame` counts,
+            # is no new chance (the same rule `frame` keeps)
+            fresh = seen & np.array([stand not in c and len(c) < MAX_LOOKS for c in counts],
+                                    dtype=bool)
+            for room in {r for r in rooms[fresh] if r is not None}:
+                mine = rooms == room
+                total = float(weight[mine].sum())
+                if total > 0.0:
+                    value += (self.p_detect * p_room(label, room)
+                              * float(weight[mine & fresh].sum()) / total)
+        return value
+
+    def _sees_beyond(self, pose: tuple[float, float, float], pan: float) -> bool:
+        """Whether a frame from `pose` would see, along a free line of sight, a cell that is
+        unknown or free floor no entered room holds (sampled over the field of view and the
+        counted range)."""
+        grid = self.mind.grid
+        owner, _ = self.mind.place_map.room_extents(grid)
+        cam = self.camera
+        angles = pose[2] + pan + np.linspace(-cam.hfov / 2, cam.hfov / 2, 9)
+        ranges = np.arange(self.min_range, self.max_range + 1e-9, 2.0 * grid.resolution)
+        points = (np.asarray(pose[:2])[None, None, :] + ranges[:, None, None]
+                  * np.stack([np.cos(angles), np.sin(angles)], axis=1)[None, :, :])
+        points = points.reshape(-1, 2)
+        points = points[self.line_of_sight(np.asarray(pose[:2]), points)]
+        if not len(points):
+            return False
+        cells = grid.to_cell(points)
+        inside = grid.inside(cells)
+        if not inside.all():
+            return True
+        where = tuple(cells.T)
+        state = grid.state_grid()[where]
+        return bool(np.any((state == CellState.UNKNOWN)
+                           | ((state == CellState.FREE) & (owner[where] == 0))))
 
     def _share(self, looks: list[int]) -> float:
         """Share of a location's objects the looks would have seen: 1 - mean miss."""

@@ -20,12 +20,15 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from avs_planner.cp.task import Atom
 from avs_planner.episode.context import SkillContext
 from avs_planner.episode.glimpses import Glimpses
 from avs_planner.episode.mind import KnownObject
 from avs_planner.episode.outcome import SeenLike
 from avs_planner.episode.viewcones import CameraModel
+from conceptual_map.errors import MapError
 
 Pose = tuple[float, float, float]
 
@@ -79,6 +82,7 @@ class Sensing:
         kept = self.kept
         found = self.watch()
         half = headings // 2
+        skipped: list[int] = []
         for k in range(1, headings):
             if (found is not None or self.kept > kept) and k > half:
                 break  # the target (or a label the task also wants) is here: the map is done
@@ -97,11 +101,57 @@ class Sensing:
                 # room: turn straight there (a frame at each heading on the way cost a second
                 # on every target seen in the first frame)
                 continue
-            ctx.robot.turn_to(yaw + 2.0 * math.pi * k / headings)
+            heading = yaw + 2.0 * math.pi * k / headings
+            # a heading before the half is on the way there (its turn is taken anyway); one
+            # after it costs its turn too
+            turn = 2.0 * math.pi / headings if k > half else 0.0
+            if k != half and found is None and not self._worth_a_frame(heading, turn):
+                # what this frame could show is worth less than its time; the scan behind
+                # (the laser's half) is still taken
+                skipped.append(k)
+                continue
+            ctx.robot.turn_to(heading)
             if k == half:
                 found = self.sense([ctx.robot.pose], watch=True) or found
             elif found is None:
                 found = self.watch()
+        if skipped:
+            ctx.emit("belief", look_skipped=[round(math.degrees(2.0 * math.pi * k / headings))
+                                             for k in skipped],
+                     reason="R x P(a frame there shows a wanted label) below its seconds")
+
+    def _worth_a_frame(self, yaw: float, extra_turn: float) -> bool:
+        """Whether a look-around frame at heading `yaw` (head ahead) is worth its time by
+        the planner's own objective, c + R (1 - p): R x P(the frame shows a label the task
+        wants) (`Glimpses.frame_value`) at least the seconds it costs, a frame and
+        `extra_turn` radians of turning (as the loop's worth test prices a plan). Always
+        True without `look_by_value`, glimpses or a body to price it with."""
+        ctx = self.context
+        body = ctx.mind.body
+        if self.glimpses is None or not ctx.config.look_by_value or body is None:
+            return True
+        task = ctx.builder.task
+        cmap = ctx.mind.cmap
+
+        def p_room(label: str, room: str) -> float:
+            try:
+                return cmap.p_object_at(label, room)
+            except (KeyError, MapError):
+                return 1.0  # a label or room the map cannot price: look
+
+        x, y, _ = ctx.robot.pose
+        pose, tilt = (x, y, yaw), ahead_tilt(ctx.camera)
+        labels = [task.target, *task.watch]
+        cost = body.sensing_time + body.turn_time(extra_turn)
+        floor = cost / ctx.config.miss_penalty
+        for sighting in ctx.mind.remembered:
+            # a spot the building's memory holds a wanted object at (P it is still there:
+            # the sighting's weight) is a search of its own, which the map's P leaves out
+            if sighting.label in labels and sighting.weight >= floor and self.glimpses.in_view(
+                    np.array([sighting.position[:2]]), pose, 0.0, tilt,
+                    sighting.position[2])[0]:
+                return True
+        return self.glimpses.frame_value(pose, 0.0, tilt, labels, p_room) >= floor
 
     def locate(self) -> None:
         """Integrate a scan from where the robot stands and put it at its place in the map,

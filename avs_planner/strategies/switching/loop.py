@@ -77,6 +77,8 @@ class LoopConfig:
     glimpses: bool = True
     # directions the detector looks in at each new place (`Executor.look_around`)
     look_headings: int = 6
+    # of those, only the ones whose frame is worth its time (`ExecutorConfig.look_by_value`)
+    look_by_value: bool = True
     # every frame also asks for furniture that tells a room's kind, kept when the frames
     # that had its spot in view mostly showed it (`episode/landmarks.py`)
     landmarks: bool = True
@@ -96,6 +98,7 @@ class LoopConfig:
         once."""
         return replace(base or ExecutorConfig(), miss_penalty=self.reward, watch=self.watch,
                        glimpses=self.glimpses, look_headings=self.look_headings,
+                       look_by_value=self.look_by_value and self.glimpses,
                        landmarks=self.landmarks)
 
     def builder_config(self, base: BuilderConfig | None = None) -> BuilderConfig:
