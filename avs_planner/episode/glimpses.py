@@ -92,7 +92,7 @@ class Glimpses:
         labels = list(labels)
         shown = {lab: where for lab, where in (shown or {}).items() if lab not in labels}
         self.frames += 1
-        stand = (round(pose[0] / STANDPOINT), round(pose[1] / STANDPOINT))
+        stand = _standpoint(pose)
         changed: dict[str, dict[str, float]] = {}
         points, rooms = (candidate_cells(self.mind) if labels or shown
                          else (np.zeros((0, 2)), np.zeros(0, dtype=object)))
@@ -144,7 +144,7 @@ class Glimpses:
         if not seen.any():
             return 0.0
         keys = [tuple(k) for k in self._keys(points).tolist()]
-        stand = (round(pose[0] / STANDPOINT), round(pose[1] / STANDPOINT))
+        stand = _standpoint(pose)
         miss = 1.0 - self.p_detect
         value = 0.0
         for label in labels:
@@ -329,6 +329,11 @@ class Glimpses:
         blocked = ~clear & tail
         after_block = np.maximum.accumulate(blocked, axis=1)
         return np.all(clear | ~before, axis=1) & ~np.any(after_block & clear & tail, axis=1)
+
+
+def _standpoint(pose: Sequence[float]) -> tuple[int, int]:
+    """The standpoint a camera position belongs to (`STANDPOINT` m cells)."""
+    return (round(pose[0] / STANDPOINT), round(pose[1] / STANDPOINT))
 
 
 def _top(obj: KnownObject) -> float:

@@ -7,6 +7,7 @@ entered."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -70,6 +71,8 @@ robot: {model: pr2, start: [1.5, 1.0, 0.0]}
 
 
 def _episode(events: list[dict]) -> Episode:
+    """An episode in the two-room world with the switching look round (glimpses, six
+    headings, `look_by_value`)."""
     episode = Episode(EpisodeSpec.from_dict({"target": "cerealbox", "world_file": WORLD}),
                       events.append)
     executor = episode.executor
@@ -79,67 +82,93 @@ def _episode(events: list[dict]) -> Episode:
     return episode
 
 
-def _second_look(episode: Episode, events: list[dict]) -> list[int]:
-    """Look around at the start, drive 2.5 m along the hall, look around again: the
-    headings the second look skipped."""
+@pytest.fixture()
+def look():
+    """`_episode` and its trace's events; closed after the test."""
+    events: list[dict] = []
+    episode = _episode(events)
+    try:
+        yield episode, events
+    finally:
+        episode.trace.close()
+        episode.robot.world.close()
+
+
+def _second_look(episode: Episode, events: list[dict],
+                 before: Callable[[], None] = lambda: None) -> list[int]:
+    """Look around at the start, drive 2.5 m along the hall, (`before`), look around
+    again: the headings the second look skipped."""
     sensing = episode.executor.sensing
     sensing.look_around()  # the first: everything unknown, every heading is looked at
     assert not [e for e in events if "look_skipped" in e]
     episode.executor.drive_to((4.0, 1.0))
+    before()
     events.clear()
     sensing.look_around()
     return [k for e in events if "look_skipped" in e for k in e["look_skipped"]]
 
 
-def test_a_look_around_skips_the_headings_not_worth_a_frame() -> None:
-    events: list[dict] = []
-    episode = _episode(events)
-    try:
-        robot = episode.robot
-        frames: list[float] = []
-        detect = robot.detect
-        robot.detect = lambda labels: frames.append(robot.clock) or detect(labels)
-        skipped = _second_look(episode, events)
-        room = episode.mind.place_map.room_of(episode.mind.place_map.current_place)
-        # a cereal box in the hall is unlikely: R x P of a heading that sees only a part of
-        # the mapped hall is below a frame's second; the laser's half (180) is always turned to
-        assert episode.mind.cmap.p_object_at("cerealbox", room) < 0.03
-        assert skipped and 180 not in skipped
-        body = episode.mind.body
-        full = 5 * body.turn_time(math.pi / 3) + 6 * body.sensing_time + 2 * body.scan_time
-        frames.clear()
-        clock = robot.clock
-        episode.executor.sensing.look_around()
-        # the same spot again: no cheaper than the look before it skipped, and never more
-        # frames than the headings looked at (a detection's confirming frames aside)
-        again = [k for e in events if "look_skipped" in e for k in e["look_skipped"]]
-        assert set(skipped) <= set(again[len(skipped):])
-        assert robot.clock - clock < full
-        assert len(frames) <= 6 - len(again[len(skipped):]) + 2, frames
-    finally:
-        episode.trace.close()
-        episode.robot.world.close()
+def test_a_look_around_skips_the_headings_not_worth_a_frame(look) -> None:
+    episode, events = look
+    robot = episode.robot
+    frames: list[float] = []
+    detect = robot.detect
+    robot.detect = lambda labels: frames.append(robot.clock) or detect(labels)
+    skipped = _second_look(episode, events)
+    room = episode.mind.place_map.room_of(episode.mind.place_map.current_place)
+    # a cereal box in the hall is unlikely: R x P of a heading that sees only a part of
+    # the mapped hall is below a frame's second; the laser's half (180) is always turned to
+    assert episode.mind.cmap.p_object_at("cerealbox", room) < 0.03
+    assert skipped and 180 not in skipped
+    body = episode.mind.body
+    full = 5 * body.turn_time(math.pi / 3) + 6 * body.sensing_time + 2 * body.scan_time
+    frames.clear()
+    clock = robot.clock
+    episode.executor.sensing.look_around()
+    # the same spot again: no cheaper than the look before it skipped, and never more
+    # frames than the headings looked at (a detection's confirming frames aside)
+    again = [k for e in events if "look_skipped" in e for k in e["look_skipped"]]
+    assert set(skipped) <= set(again[len(skipped):])
+    assert robot.clock - clock < full
+    assert len(frames) <= 6 - len(again[len(skipped):]) + 2, frames
 
 
-def test_a_likely_label_is_looked_for_at_every_new_heading() -> None:
-    events: list[dict] = []
-    episode = _episode(events)
-    try:
-        episode.mind.cmap.p_object_at = lambda *a, **k: 1.0  # the map is sure it is here
-        assert _second_look(episode, events) == []
-    finally:
-        episode.trace.close()
-        episode.robot.world.close()
+def test_a_likely_label_is_looked_for_at_every_new_heading(look) -> None:
+    episode, events = look
+    episode.mind.cmap.p_object_at = lambda *a, **k: 1.0  # the map is sure it is here
+    assert _second_look(episode, events) == []
 
 
-def test_without_look_by_value_every_heading_is_looked_at() -> None:
-    events: list[dict] = []
-    episode = _episode(events)
-    try:
-        episode.executor.config = replace(episode.executor.config, look_by_value=False)
-        episode.executor.sensing.look_around()
-        episode.executor.sensing.look_around()
-        assert not [e for e in events if "look_skipped" in e]
-    finally:
-        episode.trace.close()
-        episode.robot.world.close()
+def test_without_look_by_value_every_heading_is_looked_at(look) -> None:
+    episode, events = look
+    episode.executor.config = replace(episode.executor.config, look_by_value=False)
+    episode.executor.sensing.look_around()
+    episode.executor.sensing.look_around()
+    assert not [e for e in events if "look_skipped" in e]
+
+
+def test_a_remembered_sighting_in_view_is_looked_at() -> None:
+    """A spot the building's memory holds a wanted object at is looked at, whatever the
+    map's P for the room: the heading the second look skipped is taken when a sighting of
+    the target stands 2 m along it."""
+    from avs_planner.episode.memory import Sighting
+
+    def second(remember: bool) -> list[int]:
+        events: list[dict] = []
+        episode = _episode(events)
+        try:
+            def place_sighting() -> None:
+                x, y, yaw = episode.robot.pose
+                heading = yaw + math.radians(skipped[0])
+                episode.mind.remembered.append(Sighting(
+                    "cerealbox", (x + 2.0 * math.cos(heading), y + 2.0 * math.sin(heading),
+                                  episode.executor.camera.support_height), seen_at=0.0))
+
+            return _second_look(episode, events, place_sighting if remember else lambda: None)
+        finally:
+            episode.trace.close()
+            episode.robot.world.close()
+
+    skipped = second(False)
+    assert skipped
+    assert skipped[0] not in second(True)
